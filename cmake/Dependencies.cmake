@@ -1,0 +1,25 @@
+# Every dependency comes from Debian's packages, found in CONFIG mode (see ../shared/DEPENDENCIES.md).
+find_package(glm CONFIG REQUIRED)
+find_package(OpenImageIO CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+find_package(xtl CONFIG REQUIRED)      # xsimd's target links a bare xtl
+find_package(xsimd CONFIG REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(nlohmann_json CONFIG REQUIRED)
+find_package(tinyobjloader CONFIG REQUIRED)  # reports "2rc10": no version argument
+
+# OpenImageIO's target names /usr/include/opencv4, which exists only with libopencv-dev.
+foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+  get_target_property(_dirs OpenImageIO::OpenImageIO ${prop})
+  if(_dirs)
+    list(FILTER _dirs EXCLUDE REGEX "opencv4")
+    set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${prop} "${_dirs}")
+  endif()
+endforeach()
+
+if(QDMR_BUILD_TESTS)
+  find_package(GTest CONFIG REQUIRED)
+endif()
+if(QDMR_BUILD_BENCH)
+  find_package(benchmark CONFIG REQUIRED)
+endif()

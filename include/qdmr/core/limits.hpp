@@ -1,0 +1,23 @@
+#pragma once
+// Every hard limit of qdmr in one place.
+#include <cstdint>
+
+namespace qdmr::limits {
+
+inline constexpr int kMaxImageSide = 16384;         // output width/height and texture side
+inline constexpr int kMaxTextureSide = 16384;
+inline constexpr int kSubpixelBits = 8;             // fixed-point triangle setup
+inline constexpr int kSubpixelScale = 1 << kSubpixelBits;
+inline constexpr int kDefaultTileSize = 64;
+inline constexpr int kMinTileSize = 8;              // tiles are whole 8x8 coarse blocks
+inline constexpr int kMaxTileSize = 1024;
+inline constexpr int kCoarseBlockSize = 8;
+// Guard band in pixels beyond the viewport: vertices further out are clipped in x/y,
+// which keeps fixed-point coordinates (with kSubpixelBits) within +-2^23 and edge functions in int64.
+inline constexpr int kGuardBandPixels = 16384;
+inline constexpr int kMaxLayers = 4;
+inline constexpr int kMaxDirectionalLights = 4;
+inline constexpr int kMaxThreads = 256;
+inline constexpr std::uint64_t kMaxTriangles = 1ull << 28;
+
+}  // namespace qdmr::limits

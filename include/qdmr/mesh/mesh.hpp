@@ -1,0 +1,37 @@
+#pragma once
+// MeshData: indexed triangles with per-vertex tangent frames, built from a MeshDesc.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "qdmr/scene/scene.hpp"
+
+namespace qdmr {
+
+struct MeshData {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;    // unit length
+  std::vector<glm::vec4> tangents;   // xyz: unit tangent along +u, orthogonal to the normal; w: +-1, bitangent = w * cross(n, t)
+  std::vector<glm::vec2> uvs;
+  std::vector<std::uint32_t> indices;             // 3 per triangle, counter-clockwise front faces
+  std::vector<std::uint32_t> triangle_materials;  // obj only: per triangle, an index into `materials`; empty otherwise
+  std::vector<MaterialDesc> materials;            // obj only: materials from the MTL file (named "<mtl name>")
+
+  std::size_t vertex_count() const { return positions.size(); }
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// Builds a primitive or loads an OBJ (with MTL through tinyobjloader). `where` names the scene field for
+// messages ("scene.json: /objects/2/mesh"). Throws qdmr::Error on unreadable files, NaN/infinite data,
+// out-of-range indices. Degenerate triangles are kept (the rasterizer culls them) but their tangents are ignored.
+MeshData build_mesh(const MeshDesc& desc, const std::string& where);
+
+// Per-vertex tangent frames from positions, normals and UVs (accumulated per triangle, Gram-Schmidt
+// orthogonalised). Vertices whose UVs give no direction get any tangent orthogonal to the normal.
+void compute_tangents(MeshData& mesh);
+
+}  // namespace qdmr

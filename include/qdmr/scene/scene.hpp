@@ -1,0 +1,163 @@
+#pragma once
+// SceneDesc: what a scene file says, as plain validated values (no JSON past the loader).
+// Units: lengths in scene units, angles in degrees, colours linear RGB.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace qdmr {
+
+struct OutputDesc {
+  int width = 1920;
+  int height = 1080;
+  glm::vec3 background{0.05f, 0.06f, 0.08f};  // linear RGB where no triangle covers
+};
+
+struct CameraDesc {
+  glm::vec3 position{0.0f, -3.0f, 2.0f};
+  glm::vec3 target{0.0f, 0.0f, 0.0f};
+  glm::vec3 up{0.0f, 0.0f, 1.0f};
+  float fov_y_deg = 45.0f;  // vertical field of view
+  float near = 0.05f;
+  float far = 1000.0f;
+};
+
+struct DirectionalLightDesc {
+  glm::vec3 direction{0.3f, -0.4f, 0.87f};  // towards the light; normalised by the loader
+  glm::vec3 color{1.0f, 1.0f, 1.0f};
+  float intensity = 1.0f;
+};
+
+struct AmbientLightDesc {
+  glm::vec3 color{1.0f, 1.0f, 1.0f};
+  float intensity = 0.2f;
+};
+
+struct LightsDesc {
+  std::vector<DirectionalLightDesc> directional;  // up to limits::kMaxDirectionalLights
+  AmbientLightDesc ambient;
+};
+
+// A procedural pattern generated at load time; deterministic for (pattern, size, seed, parameters).
+enum class ProceduralPattern { Bricks, Cobbles, Sine, Steps, Spikes, Noise, Flat, Checker };
+
+struct ProceduralDesc {
+  ProceduralPattern pattern = ProceduralPattern::Noise;
+  int size = 512;            // power of two, 1 .. 16384
+  std::uint32_t seed = 1;
+  int cells = 8;             // bricks per row / stones / sine periods / steps / spikes per side; noise base frequency
+  int octaves = 5;           // noise only
+  float gain = 0.5f;         // noise only: amplitude ratio between octaves
+  float mortar = 0.08f;      // bricks and cobbles: gap width as a fraction of a cell
+};
+
+enum class TextureSource { None, File, Procedural, Constant, FromHeight };
+enum class Channel { Default, R, G, B, A, RGB, RGBA };
+
+// One texture slot. For albedo: colour from a file (sRGB decoded unless srgb=false), a constant,
+// or a procedural pattern coloured between color_low and color_high. For normals: a file, or
+// "from_height" (derived from the layer's height by central differences). For heights: one channel.
+struct TextureDesc {
+  TextureSource source = TextureSource::None;
+  std::filesystem::path file;        // absolute after loading (resolved against the scene file)
+  Channel channel = Channel::Default;
+  bool srgb = true;                  // albedo files only
+  ProceduralDesc procedural;
+  glm::vec4 constant{1.0f, 1.0f, 1.0f, 1.0f};
+  glm::vec3 color_low{0.25f, 0.22f, 0.2f};   // procedural albedo: colour at height 0
+  glm::vec3 color_high{0.75f, 0.7f, 0.65f};  // procedural albedo: colour at height 1
+  float variation = 0.15f;                    // procedural albedo: per-cell brightness jitter
+};
+
+enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
+
+struct LayerDesc {
+  TextureDesc albedo;            // default: constant white
+  TextureDesc normal;            // default: from_height when a height exists, else flat
+  NormalConvention normal_convention = NormalConvention::GL;
+  float normal_strength = 1.0f;  // scales tangent-space xy (and slopes for from_height)
+  TextureDesc height;            // default: none (flat)
+  float height_scale = 1.0f;     // h' = h * height_scale + height_offset
+  float height_offset = 0.0f;
+};
+
+enum class TechniqueKind { Normal };
+
+struct TechniqueDesc {
+  TechniqueKind kind = TechniqueKind::Normal;
+  float depth_scale = 0.05f;  // surface depth in UV units of one texture repeat (used by later techniques)
+};
+
+enum class Filter { Point, Bilinear, Trilinear };
+enum class AddressMode { Wrap, Clamp, Mirror };
+
+struct SamplingDesc {
+  Filter filter = Filter::Trilinear;
+  AddressMode address = AddressMode::Wrap;
+  float lod_bias = 0.0f;
+};
+
+enum class LightingModel { BlinnPhong };
+
+struct LightingDesc {
+  LightingModel model = LightingModel::BlinnPhong;
+  float specular = 0.25f;    // specular reflectance scale
+  float shininess = 32.0f;   // Blinn-Phong exponent
+};
+
+struct MaterialDesc {
+  std::string name;
+  std::vector<LayerDesc> layers;  // 1 .. limits::kMaxLayers; this release shades layer 0
+  TechniqueDesc technique;
+  SamplingDesc sampling;
+  LightingDesc lighting;
+};
+
+enum class MeshKind { Plane, Box, Sphere, Grid, Obj };
+
+struct MeshDesc {
+  MeshKind kind = MeshKind::Plane;
+  glm::vec2 size{2.0f, 2.0f};   // plane and grid: extent in x and y; box: edge length (x); sphere: diameter (x)
+  glm::vec2 uv_scale{1.0f, 1.0f};
+  int segments = 32;            // sphere: segments around the equator (rings = segments / 2)
+  int resolution = 64;          // grid: quads per side
+  TextureDesc height_map;       // grid: optional height map displacing vertices along +z
+  float height = 0.0f;          // grid: z extent of the height map (scene units)
+  std::filesystem::path file;   // obj: absolute path
+};
+
+struct TransformDesc {
+  glm::vec3 translate{0.0f};
+  glm::vec3 rotate_deg{0.0f};  // applied X, then Y, then Z
+  glm::vec3 scale{1.0f};
+};
+
+struct ObjectDesc {
+  std::string name;
+  MeshDesc mesh;
+  std::string material;  // a key of SceneDesc::materials; may be empty for obj meshes (their MTL materials are used)
+  TransformDesc transform;
+};
+
+struct SceneDesc {
+  std::filesystem::path file;  // the scene file (for messages)
+  OutputDesc output;
+  CameraDesc camera;
+  LightsDesc lights;
+  std::vector<MaterialDesc> materials;  // in file order
+  std::vector<ObjectDesc> objects;      // submission order
+
+  const MaterialDesc* find_material(const std::string& name) const {
+    for (const auto& m : materials)
+      if (m.name == name) return &m;
+    return nullptr;
+  }
+};
+
+}  // namespace qdmr

@@ -1,0 +1,27 @@
+#pragma once
+// Image: a level of texels as 32-bit floats, row-major, interleaved channels, row 0 at v = 0.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace qdmr {
+
+struct Image {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<float> texels;
+
+  Image() = default;
+  Image(int w, int h, int c) : width(w), height(h), channels(c), texels(std::size_t(w) * h * c, 0.0f) {}
+  float& at(int x, int y, int c) { return texels[(std::size_t(y) * width + x) * channels + c]; }
+  float at(int x, int y, int c) const { return texels[(std::size_t(y) * width + x) * channels + c]; }
+  std::size_t bytes() const { return texels.size() * sizeof(float); }
+};
+
+// Reads any image OpenImageIO can read (8/16-bit, half, float) as normalised floats, no colour conversion.
+// Throws qdmr::Error(where, ...) for missing, unreadable or corrupt files and sizes over the limits.
+Image read_image(const std::filesystem::path& file, const std::string& where);
+
+}  // namespace qdmr

@@ -1,0 +1,36 @@
+#pragma once
+// Textures of a material: level-0 images made from TextureDesc, and their box-filtered mip chains.
+#include <string>
+#include <vector>
+
+#include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/image.hpp"
+
+namespace qdmr {
+
+enum class TexturePurpose {
+  Albedo,  // 3 channels, linear RGB (sRGB files decoded)
+  Normal,  // 3 channels, tangent-space unit vector in [-1,1] (DX convention flipped to GL)
+  Height   // 1 channel, h in [0,1] after the layer's scale and offset
+};
+
+// Deterministic procedural height pattern in [0,1], size x size, 1 channel.
+Image generate_procedural(const ProceduralDesc& desc);
+
+// Level 0 of one texture slot. `height` is the layer's height image, needed for Normal from_height and
+// procedural albedo colouring (may be null otherwise). Throws qdmr::Error(where, ...) on bad input.
+Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerDesc& layer, const Image* height,
+                   const std::string& where);
+
+// Level 0 of a layer's height (or a 1x1 zero image when the layer has none), with scale/offset applied.
+Image make_layer_height(const LayerDesc& layer, const std::string& where);
+
+// Mip levels by 2x2 box filter down to 1x1 (odd sizes: the last row/column is folded into the previous
+// one's box; each level is max(1, floor(n/2))). Normal chains are renormalised per texel.
+struct MipChain {
+  std::vector<Image> levels;
+  std::size_t bytes() const;
+};
+MipChain build_mip_chain(Image level0, TexturePurpose purpose);
+
+}  // namespace qdmr

@@ -1,0 +1,61 @@
+#pragma once
+// SIMD types of this build. Private to src/: the architecture is fixed by the build flags (QDMR_SIMD),
+// so these types must never appear in a public header.
+#include <cstdint>
+
+#include <xsimd/xsimd.hpp>
+
+namespace qdmr::simd {
+
+using Arch = xsimd::default_arch;
+using Float = xsimd::batch<float, Arch>;
+using Int = xsimd::batch<std::int32_t, Arch>;
+using UInt = xsimd::batch<std::uint32_t, Arch>;
+using Mask = xsimd::batch_bool<float, Arch>;
+using IntMask = xsimd::batch_bool<std::int32_t, Arch>;
+
+inline constexpr int kLanes = static_cast<int>(Float::size);
+static_assert(kLanes == 4 || kLanes == 8, "qdmr batches hold one (SSE) or two (AVX2) 2x2 quads");
+inline constexpr int kQuadsPerBatch = kLanes / 4;
+
+// Lane layout inside one quad: 0 1 / 2 3 (x to the right, y down). Quad q occupies lanes 4q..4q+3.
+inline constexpr int kQuadTopLeft = 0, kQuadTopRight = 1, kQuadBottomLeft = 2, kQuadBottomRight = 3;
+
+// Bit i set = lane i active.
+inline std::uint32_t to_bits(const Mask& m) {
+  alignas(64) bool lanes[kLanes];
+  m.store_aligned(lanes);
+  std::uint32_t bits = 0;
+  for (int i = 0; i < kLanes; ++i) bits |= std::uint32_t(lanes[i]) << i;
+  return bits;
+}
+
+inline Mask from_bits(std::uint32_t bits) {
+  alignas(64) float lanes[kLanes];
+  for (int i = 0; i < kLanes; ++i) lanes[i] = ((bits >> i) & 1u) ? 1.0f : 0.0f;
+  return Float::load_aligned(lanes) != Float(0.0f);
+}
+
+// Coarse derivatives (what GPUs do): per quad, d/dx = top-right - top-left, d/dy = bottom-left - top-left,
+// the same value broadcast to the quad's four lanes.
+inline Float quad_ddx(const Float& v) {
+  alignas(64) float a[kLanes];
+  v.store_aligned(a);
+  for (int q = 0; q < kQuadsPerBatch; ++q) {
+    const float d = a[4 * q + kQuadTopRight] - a[4 * q + kQuadTopLeft];
+    for (int i = 0; i < 4; ++i) a[4 * q + i] = d;
+  }
+  return Float::load_aligned(a);
+}
+
+inline Float quad_ddy(const Float& v) {
+  alignas(64) float a[kLanes];
+  v.store_aligned(a);
+  for (int q = 0; q < kQuadsPerBatch; ++q) {
+    const float d = a[4 * q + kQuadBottomLeft] - a[4 * q + kQuadTopLeft];
+    for (int i = 0; i < 4; ++i) a[4 * q + i] = d;
+  }
+  return Float::load_aligned(a);
+}
+
+}  // namespace qdmr::simd

@@ -1,0 +1,40 @@
+#pragma once
+// Helpers shared by the tests: paths of the repo, the data folder and the built command, and running it.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace qdmr::test {
+
+std::filesystem::path source_dir();
+std::filesystem::path data_dir();  // QDMR_DATA_DIR; may not exist
+bool have_data();
+std::filesystem::path cli();       // the qdmr command of this build
+std::filesystem::path cli_sse();   // the SSE twin, empty when not built
+
+// A fresh empty directory under the system temp folder, removed by the destructor.
+class TempDir {
+public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs `program args...` without a shell; stdin is /dev/null.
+CommandResult run(const std::filesystem::path& program, const std::vector<std::string>& args);
+
+std::string read_file(const std::filesystem::path& file);
+void write_file(const std::filesystem::path& file, const std::string& text);
+
+}  // namespace qdmr::test
