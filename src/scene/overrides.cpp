@@ -1,0 +1,75 @@
+#include "scene/overrides.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "qdmr/core/error.hpp"
+
+namespace qdmr {
+
+SceneOverride parse_override(std::string_view text) {
+  const std::string where = "--set '" + std::string(text) + "'";
+  const auto equals = text.find('=');
+  if (equals == std::string_view::npos) throw Error(where, "expected POINTER=VALUE, e.g. /camera/fov_deg=30");
+  SceneOverride result{std::string(text.substr(0, equals)), std::string(text.substr(equals + 1))};
+  if (!result.pointer.starts_with('/'))
+    throw Error(where, "the JSON pointer must start with '/', e.g. /camera/fov_deg=30");
+  try {
+    static_cast<void>(nlohmann::json::json_pointer(result.pointer));  // throws on a bad ~ escape
+  } catch (const nlohmann::json::exception&) {
+    throw Error(where, "invalid JSON pointer '" + result.pointer + "' ('~' must be written ~0, '/' in a key ~1)");
+  }
+  return result;
+}
+
+namespace scene_detail {
+
+namespace {
+
+nlohmann::json parse_value(const std::string& text) {
+  nlohmann::json value = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  return value.is_discarded() ? nlohmann::json(text) : value;
+}
+
+void apply_override(nlohmann::json& document, const SceneOverride& override_, const std::string& file) {
+  const auto fail = [&](const std::string& what) {
+    throw Error(file + ": " + override_.pointer, "cannot apply --set: " + what);
+  };
+  nlohmann::json::json_pointer pointer;
+  try {
+    pointer = nlohmann::json::json_pointer{override_.pointer};
+  } catch (const nlohmann::json::exception&) {
+    fail("invalid JSON pointer");
+  }
+  if (pointer.empty()) fail("cannot replace the whole document");
+  const nlohmann::json::json_pointer parent_pointer = pointer.parent_pointer();
+  const std::string parent_text = parent_pointer.empty() ? "/" : parent_pointer.to_string();
+  if (!document.contains(parent_pointer)) fail(parent_text + " does not exist");
+  nlohmann::json& parent = document[parent_pointer];
+  const std::string& key = pointer.back();
+  nlohmann::json value = parse_value(override_.value);
+
+  if (parent.is_object()) {
+    parent[key] = std::move(value);
+  } else if (parent.is_array()) {
+    if (key == "-") {
+      parent.push_back(std::move(value));
+      return;
+    }
+    // contains() accepts only well-formed, in-range indices.
+    if (!document.contains(pointer))
+      fail("no element '" + key + "' in " + parent_text + " (it has " + std::to_string(parent.size()) +
+           " elements; use '-' to append)");
+    document[pointer] = std::move(value);
+  } else {
+    fail(parent_text + " is a " + parent.type_name() + ", not an object or array");
+  }
+}
+
+}  // namespace
+
+void apply_overrides(nlohmann::json& document, const std::vector<SceneOverride>& overrides, const std::string& file) {
+  for (const auto& override_ : overrides) apply_override(document, override_, file);
+}
+
+}  // namespace scene_detail
+}  // namespace qdmr

@@ -1,0 +1,413 @@
+#include "scene/validate.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#if __has_include(<unistd.h>)
+#include <unistd.h>
+#endif
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+#include "qdmr/core/limits.hpp"
+
+namespace qdmr::scene_detail {
+
+namespace {
+
+using nlohmann::json;
+
+// Colour, depth and AOV buffers of one frame cost about this much per pixel.
+constexpr std::uint64_t kFrameBytesPerPixel = 64;
+constexpr std::uint64_t kMiB = 1024 * 1024;
+
+std::optional<std::uint64_t> physical_memory_bytes() {
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGE_SIZE)
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long page_size = ::sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page_size > 0) return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
+#endif
+  return std::nullopt;
+}
+
+// The given member if present, else the object itself: where to point a message about a default.
+Value member_or_self(const Object& object, std::string_view key) { return object.find(key).value_or(object.value()); }
+
+// A number (both components alike) or an array of 2 numbers.
+glm::vec2 read_pair(const Value& value, Value::NumberCheck component) {
+  if (value.json().is_number()) {
+    const float v = static_cast<float>((value.*component)());
+    return {v, v};
+  }
+  value.require(
+      value.json().is_array() && value.json().size() == 2,
+      std::string("expected a number or an array of 2 numbers, got ") +
+          (value.json().is_array() ? "an array of " + std::to_string(value.json().size()) : value.json().type_name()));
+  return {(value.element(0).*component)(), (value.element(1).*component)()};
+}
+
+OutputDesc read_output(const Value& value) {
+  const Object object(value, {"width", "height", "background"});
+  OutputDesc output;
+  if (auto v = object.find("width")) output.width = static_cast<int>(v->integer(1, limits::kMaxImageSide));
+  if (auto v = object.find("height")) output.height = static_cast<int>(v->integer(1, limits::kMaxImageSide));
+  if (auto v = object.find("background")) output.background = v->color();
+
+  const std::uint64_t bytes =
+      static_cast<std::uint64_t>(output.width) * static_cast<std::uint64_t>(output.height) * kFrameBytesPerPixel;
+  if (const auto memory = physical_memory_bytes(); memory && bytes > *memory) {
+    value.fail("an output of " + std::to_string(output.width) + "x" + std::to_string(output.height) + " needs about " +
+               std::to_string(bytes / kMiB) + " MiB of frame buffers, more than this machine's " +
+               std::to_string(*memory / kMiB) + " MiB of memory");
+  }
+  return output;
+}
+
+CameraDesc read_camera(const Value& value) {
+  const Object object(value, {"position", "target", "up", "fov_deg", "near", "far"});
+  CameraDesc camera;
+  if (auto v = object.find("position")) camera.position = v->vec3();
+  if (auto v = object.find("target")) camera.target = v->vec3();
+  if (auto v = object.find("up")) camera.up = v->vec3();
+  if (auto v = object.find("fov_deg")) {
+    camera.fov_y_deg = static_cast<float>(v->number());
+    v->require(camera.fov_y_deg > 0 && camera.fov_y_deg < 180,
+               "must be greater than 0 and less than 180, got " + format_number(camera.fov_y_deg));
+  }
+  if (auto v = object.find("near")) camera.near = static_cast<float>(v->positive());
+  if (auto v = object.find("far")) camera.far = static_cast<float>(v->number());
+  member_or_self(object, "far")
+      .require(camera.far > camera.near, "far (" + format_number(camera.far) + ") must be greater than near (" +
+                                             format_number(camera.near) + ")");
+
+  const glm::vec3 view = camera.target - camera.position;
+  member_or_self(object, "target").require(glm::length(view) > 0, "the target must differ from the position");
+  const Value up = member_or_self(object, "up");
+  up.require(glm::length(camera.up) > 0, "the up vector must not be zero");
+  up.require(glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) > 1e-4f,
+             "the up vector must not be parallel to the view direction (target - position)");
+  return camera;
+}
+
+LightsDesc read_lights(const Value& value) {
+  enum class LightType { Directional, Ambient };
+  LightsDesc lights;
+  lights.ambient.intensity = 0.0f;  // only the lights listed exist
+  bool have_ambient = false;
+  for (const Value& light : value.array()) {
+    light.expect_type(json::value_t::object, "an object");
+    const auto type = light.member("type");
+    if (!type) light.fail("missing key 'type' (directional or ambient)");
+    if (type->choice<LightType>({{"directional", LightType::Directional}, {"ambient", LightType::Ambient}}) ==
+        LightType::Directional) {
+      const Object object(light, {"type", "direction", "color", "intensity"});
+      light.require(lights.directional.size() < static_cast<std::size_t>(limits::kMaxDirectionalLights),
+                    "at most " + std::to_string(limits::kMaxDirectionalLights) + " directional lights are supported");
+      DirectionalLightDesc directional;
+      if (auto v = object.find("direction")) {
+        directional.direction = v->vec3();
+        v->require(glm::length(directional.direction) > 0, "the direction must not be zero");
+      }
+      directional.direction = glm::normalize(directional.direction);
+      if (auto v = object.find("color")) directional.color = v->color();
+      if (auto v = object.find("intensity")) directional.intensity = static_cast<float>(v->non_negative());
+      lights.directional.push_back(directional);
+    } else {
+      const Object object(light, {"type", "color", "intensity"});
+      light.require(!have_ambient, "only one ambient light is allowed");
+      have_ambient = true;
+      lights.ambient = AmbientLightDesc{};
+      if (auto v = object.find("color")) lights.ambient.color = v->color();
+      if (auto v = object.find("intensity")) lights.ambient.intensity = static_cast<float>(v->non_negative());
+    }
+  }
+  return lights;
+}
+
+enum class Slot { Albedo, Normal, Height };
+
+void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
+  const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb"})
+                        : slot == Slot::Height ? Object(value, {"file", "channel"})
+                                               : Object(value, {"file"});
+  texture.source = TextureSource::File;
+  texture.file = object.required("file").existing_file();
+  if (auto v = object.find("channel")) {
+    texture.channel = v->choice<Channel>({{"r", Channel::R},
+                                          {"g", Channel::G},
+                                          {"b", Channel::B},
+                                          {"a", Channel::A},
+                                          {"rgb", Channel::RGB},
+                                          {"rgba", Channel::RGBA}});
+    v->require(slot != Slot::Height || (texture.channel != Channel::RGB && texture.channel != Channel::RGBA),
+               "a height reads one channel: r, g, b or a");
+  }
+  if (auto v = object.find("srgb")) texture.srgb = v->boolean();
+}
+
+void read_procedural(const Value& value, Slot slot, TextureDesc& texture) {
+  const Object object = slot == Slot::Albedo
+                            ? Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar",
+                                             "color_low", "color_high", "variation"})
+                            : Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar"});
+  texture.source = TextureSource::Procedural;
+  ProceduralDesc& p = texture.procedural;
+  p.pattern = object.required("procedural")
+                  .choice<ProceduralPattern>({{"bricks", ProceduralPattern::Bricks},
+                                              {"cobbles", ProceduralPattern::Cobbles},
+                                              {"sine", ProceduralPattern::Sine},
+                                              {"steps", ProceduralPattern::Steps},
+                                              {"spikes", ProceduralPattern::Spikes},
+                                              {"noise", ProceduralPattern::Noise},
+                                              {"flat", ProceduralPattern::Flat},
+                                              {"checker", ProceduralPattern::Checker}});
+  if (auto v = object.find("size")) {
+    p.size = static_cast<int>(v->integer(1, limits::kMaxTextureSide));
+    v->require((p.size & (p.size - 1)) == 0, "must be a power of two, got " + std::to_string(p.size));
+  }
+  if (auto v = object.find("seed"))
+    p.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
+  if (auto v = object.find("cells")) p.cells = static_cast<int>(v->integer(1, 4096));
+  if (auto v = object.find("octaves")) p.octaves = static_cast<int>(v->integer(1, 16));
+  if (auto v = object.find("gain")) p.gain = static_cast<float>(v->positive());
+  if (auto v = object.find("mortar")) p.mortar = static_cast<float>(v->number_in(0.0, 0.5));
+  if (auto v = object.find("color_low")) texture.color_low = v->color();
+  if (auto v = object.find("color_high")) texture.color_high = v->color();
+  if (auto v = object.find("variation")) texture.variation = static_cast<float>(v->number_in(0.0, 1.0));
+}
+
+void read_constant(const Value& value, Slot slot, TextureDesc& texture) {
+  const Object object(value, {"constant"});
+  const Value constant = object.required("constant");
+  texture.source = TextureSource::Constant;
+  if (slot == Slot::Height) {
+    const float h = static_cast<float>(constant.number_in(0.0, 1.0));
+    texture.constant = {h, h, h, 1.0f};
+    return;
+  }
+  if (constant.json().is_number()) {
+    const float v = static_cast<float>(constant.non_negative());
+    texture.constant = {v, v, v, 1.0f};
+    return;
+  }
+  const std::size_t n = constant.json().is_array() ? constant.json().size() : 0;
+  constant.require(n == 3 || n == 4,
+                   std::string("expected a number or an array of 3 or 4 numbers, got ") +
+                       (constant.json().is_array() ? "an array of " + std::to_string(n) : constant.json().type_name()));
+  for (std::size_t i = 0; i < n; ++i)
+    texture.constant[static_cast<int>(i)] = static_cast<float>(constant.element(i).non_negative());
+}
+
+// TEX: "path" | "from_height" (normals) | {"file": ...} | {"procedural": ...} | {"constant": ...}
+TextureDesc read_texture(const Value& value, Slot slot) {
+  TextureDesc texture;
+  if (value.json().is_string()) {
+    if (value.string() == "from_height") {
+      value.require(slot == Slot::Normal, "'from_height' is only valid for a normal map");
+      texture.source = TextureSource::FromHeight;
+    } else {
+      texture.source = TextureSource::File;
+      texture.file = value.existing_file();
+    }
+    return texture;
+  }
+  value.require(value.json().is_object(),
+                std::string("expected a file path or an object with 'file', 'procedural' or 'constant', got ") +
+                    value.json().type_name());
+  const bool file = value.member("file").has_value();
+  const bool procedural = value.member("procedural").has_value();
+  const bool constant = value.member("constant").has_value();
+  value.require(int(file) + int(procedural) + int(constant) == 1,
+                "expected exactly one of the keys 'file', 'procedural' or 'constant'");
+  value.require(slot != Slot::Normal || file, "a normal map is a file path or \"from_height\"");
+  if (file)
+    read_texture_file(value, slot, texture);
+  else if (procedural)
+    read_procedural(value, slot, texture);
+  else
+    read_constant(value, slot, texture);
+  return texture;
+}
+
+LayerDesc read_layer(const Value& value) {
+  const Object object(
+      value, {"albedo", "normal", "normal_convention", "normal_strength", "height", "height_scale", "height_offset"});
+  LayerDesc layer;
+  layer.albedo.source = TextureSource::Constant;
+  if (auto v = object.find("albedo")) layer.albedo = read_texture(*v, Slot::Albedo);
+  if (auto v = object.find("height")) layer.height = read_texture(*v, Slot::Height);
+  const bool has_height = layer.height.source != TextureSource::None;
+  if (auto v = object.find("normal")) {
+    layer.normal = read_texture(*v, Slot::Normal);
+    v->require(layer.normal.source != TextureSource::FromHeight || has_height,
+               "'from_height' needs a 'height' in the same layer");
+  } else if (has_height) {
+    layer.normal.source = TextureSource::FromHeight;
+  }
+  if (auto v = object.find("normal_convention"))
+    layer.normal_convention = v->choice<NormalConvention>({{"gl", NormalConvention::GL}, {"dx", NormalConvention::DX}});
+  if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
+  if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
+  if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
+  return layer;
+}
+
+MaterialDesc read_material(const Value& value, const std::string& name) {
+  const Object object(value, {"layers", "technique", "sampling", "lighting"});
+  MaterialDesc material;
+  material.name = name;
+  const Value layers = object.required("layers");
+  const std::vector<Value> items = layers.array();
+  layers.require(
+      !items.empty() && items.size() <= static_cast<std::size_t>(limits::kMaxLayers),
+      "expected 1 to " + std::to_string(limits::kMaxLayers) + " layers, got " + std::to_string(items.size()));
+  for (const Value& item : items) material.layers.push_back(read_layer(item));
+
+  if (auto v = object.find("technique")) {
+    const Object technique(*v, {"name", "depth_scale"});
+    if (auto t = technique.find("name"))
+      material.technique.kind = t->choice<TechniqueKind>({{"normal", TechniqueKind::Normal}});
+    if (auto t = technique.find("depth_scale")) material.technique.depth_scale = static_cast<float>(t->positive());
+  }
+  if (auto v = object.find("sampling")) {
+    const Object sampling(*v, {"filter", "address", "lod_bias"});
+    if (auto s = sampling.find("filter"))
+      material.sampling.filter = s->choice<Filter>(
+          {{"point", Filter::Point}, {"bilinear", Filter::Bilinear}, {"trilinear", Filter::Trilinear}});
+    if (auto s = sampling.find("address"))
+      material.sampling.address = s->choice<AddressMode>(
+          {{"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp}, {"mirror", AddressMode::Mirror}});
+    if (auto s = sampling.find("lod_bias")) material.sampling.lod_bias = static_cast<float>(s->number());
+  }
+  if (auto v = object.find("lighting")) {
+    const Object lighting(*v, {"model", "specular", "shininess"});
+    if (auto l = lighting.find("model"))
+      material.lighting.model = l->choice<LightingModel>({{"blinn_phong", LightingModel::BlinnPhong}});
+    if (auto l = lighting.find("specular")) material.lighting.specular = static_cast<float>(l->non_negative());
+    if (auto l = lighting.find("shininess")) material.lighting.shininess = static_cast<float>(l->positive());
+  }
+  return material;
+}
+
+std::vector<MaterialDesc> read_materials(const Value& value) {
+  value.expect_type(json::value_t::object, "an object mapping material names to materials");
+  std::vector<MaterialDesc> materials;
+  for (const auto& item : value.json().items()) {
+    if (item.key() == "comment") continue;
+    const Value material = *value.member(item.key());
+    material.require(!item.key().empty(), "a material name must not be empty");
+    materials.push_back(read_material(material, item.key()));
+  }
+  return materials;
+}
+
+MeshDesc read_mesh(const Value& value) {
+  value.expect_type(json::value_t::object, "an object");
+  const auto type = value.member("type");
+  if (!type) value.fail("missing key 'type' (plane, box, sphere, grid or obj)");
+  MeshDesc mesh;
+  mesh.kind = type->choice<MeshKind>({{"plane", MeshKind::Plane},
+                                      {"box", MeshKind::Box},
+                                      {"sphere", MeshKind::Sphere},
+                                      {"grid", MeshKind::Grid},
+                                      {"obj", MeshKind::Obj}});
+  const Object object = [&] {
+    switch (mesh.kind) {
+      case MeshKind::Plane:
+        return Object(value, {"type", "size", "uv_scale"});
+      case MeshKind::Box:
+        return Object(value, {"type", "size", "uv_scale"});
+      case MeshKind::Sphere:
+        return Object(value, {"type", "size", "segments", "uv_scale"});
+      case MeshKind::Grid:
+        return Object(value, {"type", "size", "resolution", "height_map", "height", "uv_scale"});
+      case MeshKind::Obj:
+        break;
+    }
+    return Object(value, {"type", "file"});
+  }();
+  if (mesh.kind == MeshKind::Obj) {
+    mesh.file = object.required("file").existing_file();
+    return mesh;
+  }
+  if (auto v = object.find("size")) {
+    const bool one_number = mesh.kind == MeshKind::Box || mesh.kind == MeshKind::Sphere;
+    if (one_number) {
+      const float s = static_cast<float>(v->positive());
+      mesh.size = {s, s};
+    } else {
+      mesh.size = read_pair(*v, &Value::positive);
+    }
+  }
+  if (auto v = object.find("uv_scale")) mesh.uv_scale = read_pair(*v, &Value::non_zero);
+  if (auto v = object.find("segments")) mesh.segments = static_cast<int>(v->integer(3, 4096));
+  if (auto v = object.find("resolution")) mesh.resolution = static_cast<int>(v->integer(1, 4096));
+  if (auto v = object.find("height_map")) mesh.height_map = read_texture(*v, Slot::Height);
+  if (auto v = object.find("height")) mesh.height = static_cast<float>(v->number());
+  return mesh;
+}
+
+TransformDesc read_transform(const Value& value) {
+  const Object object(value, {"translate", "rotate_deg", "scale"});
+  TransformDesc transform;
+  if (auto v = object.find("translate")) transform.translate = v->vec3();
+  if (auto v = object.find("rotate_deg")) transform.rotate_deg = v->vec3();
+  if (auto v = object.find("scale"))
+    transform.scale = v->json().is_number() ? glm::vec3(static_cast<float>(v->non_zero())) : v->vec3(&Value::non_zero);
+  return transform;
+}
+
+ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<MaterialDesc>& materials) {
+  const Object object(value, {"name", "mesh", "material", "transform"});
+  ObjectDesc result;
+  result.name = "object " + std::to_string(index);
+  if (auto v = object.find("name")) {
+    result.name = v->string();
+    v->require(!result.name.empty(), "an object name must not be empty");
+  }
+  result.mesh = read_mesh(object.required("mesh"));
+  if (auto v = object.find("material")) {
+    result.material = v->string();
+    if (!std::any_of(materials.begin(), materials.end(),
+                     [&](const MaterialDesc& m) { return m.name == result.material; })) {
+      std::vector<std::string> names;
+      for (const auto& material : materials) names.push_back(material.name);
+      v->fail(
+          "unknown material '" + result.material + "'" +
+          (names.empty() ? "; no materials are defined" : suggestion(result.material, names, "defined materials are")));
+    }
+  } else {
+    value.require(result.mesh.kind == MeshKind::Obj,
+                  "missing key 'material' (only obj meshes may leave it out to use their own MTL materials)");
+  }
+  if (auto v = object.find("transform")) result.transform = read_transform(*v);
+  return result;
+}
+
+}  // namespace
+
+SceneDesc validate_scene(const json& document, const Context& context) {
+  const Value root(context, document, "");
+  const Object object(root, {"output", "camera", "lights", "materials", "objects"});
+  SceneDesc scene;
+  scene.file = context.file;
+  if (auto v = object.find("output")) scene.output = read_output(*v);
+  if (auto v = object.find("camera")) scene.camera = read_camera(*v);
+  if (auto v = object.find("lights")) {
+    scene.lights = read_lights(*v);
+  } else {
+    scene.lights.directional.push_back(DirectionalLightDesc{});
+    scene.lights.directional.back().direction = glm::normalize(scene.lights.directional.back().direction);
+  }
+  if (auto v = object.find("materials")) scene.materials = read_materials(*v);
+  const std::vector<Value> objects = object.required("objects").array();
+  for (std::size_t i = 0; i < objects.size(); ++i) scene.objects.push_back(read_object(objects[i], i, scene.materials));
+  return scene;
+}
+
+}  // namespace qdmr::scene_detail
