@@ -28,6 +28,10 @@ struct MeshData {
 // Builds a primitive or loads an OBJ (with MTL through tinyobjloader). `where` names the scene field for
 // messages ("scene.json: /objects/2/mesh"). Throws qdmr::Error on unreadable files, NaN/infinite data,
 // out-of-range indices. Degenerate triangles are kept (the rasterizer culls them) but their tangents are ignored.
+// Grid: the height map spans the whole grid once (sampled at the vertex UV divided by uv_scale), so
+// uv_scale tiles the material without repeating the relief. OBJ: UVs are multiplied by uv_scale; MTL
+// map_Kd -> albedo, norm -> normal, disp (else bump/map_bump) -> height, paths made absolute against the
+// MTL file's folder; faces without a material use an appended constant white "default" material.
 MeshData build_mesh(const MeshDesc& desc, const std::string& where);
 
 // Per-vertex tangent frames from positions, normals and UVs (accumulated per triangle, Gram-Schmidt

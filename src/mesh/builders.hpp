@@ -1,0 +1,25 @@
+#pragma once
+// Private to the mesh module: one builder per MeshKind, and helpers they share.
+#include <cstdint>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "qdmr/mesh/mesh.hpp"
+
+namespace qdmr::mesh_detail {
+
+MeshData make_plane(const MeshDesc& desc);
+MeshData make_box(const MeshDesc& desc);
+MeshData make_sphere(const MeshDesc& desc);
+MeshData make_grid(const MeshDesc& desc, const std::string& where);
+// `where` names the file field ("scene.json: /objects/0/mesh/file").
+MeshData load_obj(const MeshDesc& desc, const std::string& where);
+
+// Throws when `triangles` exceeds limits::kMaxTriangles.
+void check_triangle_count(std::uint64_t triangles, const std::string& where);
+
+// A unit vector orthogonal to n (n need not be unit; (1,0,0) when n is zero).
+glm::vec3 any_orthogonal(const glm::vec3& n);
+
+}  // namespace qdmr::mesh_detail
