@@ -1,0 +1,61 @@
+#pragma once
+// FramePlan: what a scene requires before anything is built — the program variant of each material,
+// the textures and derived data to make, the AOVs, and the memory all of it will take.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "qdmr/render/render.hpp"
+#include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/texture.hpp"
+
+namespace qdmr {
+
+struct TextureRequest {
+  std::string key;           // identical requests share one texture
+  TexturePurpose purpose;
+  TextureDesc desc;
+  LayerDesc layer;           // the layer it belongs to (height for from_height normals, scale/offset)
+  std::string where;         // scene field, for messages
+  int width = 0, height = 0, channels = 0, levels = 0;
+  std::uint64_t bytes = 0;   // level 0 and its mip chain
+  std::vector<std::string> users;  // material names
+};
+
+struct MaterialPlan {
+  std::string name;
+  std::string program;       // the shading program variant
+  int albedo = -1, normal = -1;  // indices into FramePlan::textures
+  SamplingDesc sampling;
+  LightingDesc lighting;
+};
+
+struct MeshPlan {
+  std::string object;
+  std::string kind;
+  std::uint64_t vertices = 0, triangles = 0, bytes = 0;
+  bool estimated = false;    // obj: counted from the file, MTL materials resolved when prepared
+};
+
+struct FramePlan {
+  int width = 0, height = 0;
+  std::vector<MaterialPlan> materials;
+  std::vector<TextureRequest> textures;
+  std::vector<MeshPlan> meshes;
+  std::vector<Aov> aovs;
+  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0;
+  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes; }
+
+  std::string describe() const;  // human-readable, for `qdmr plan`
+  nlohmann::json to_json() const;
+};
+
+// Throws qdmr::Error for unreadable texture files (their headers are read to size them).
+FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options);
+
+// Adds the texture requests of one material (shared by planning and preparing) and returns its plan.
+MaterialPlan plan_material(const MaterialDesc& material, const std::string& where, std::vector<TextureRequest>& textures);
+
+}  // namespace qdmr

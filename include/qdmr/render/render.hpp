@@ -1,0 +1,67 @@
+#pragma once
+// Rendering a scene: the library's front door. The qdmr command is a thin layer over these calls.
+//
+//   qdmr::SceneDesc scene = qdmr::load_scene("scenes/plane.json");
+//   qdmr::Frame frame = qdmr::render_frame(scene, {});
+//   qdmr::write_frame(frame, "plane.png");
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "qdmr/scene/scene.hpp"
+
+namespace qdmr {
+
+enum class Aov { Depth, Normal, UV };
+std::optional<Aov> parse_aov(const std::string& name);
+std::string aov_name(Aov aov);
+std::vector<std::string> aov_names();
+
+struct RenderOptions {
+  int threads = 0;     // 0 = every core
+  int tile_size = 64;  // pixels, a multiple of 8 in [8, 1024]
+  std::vector<Aov> aovs;
+};
+
+// Throws qdmr::Error("option", ...) when options are out of range.
+void validate_options(const RenderOptions& options);
+
+struct RenderStats {
+  // Milliseconds per stage; load and write are filled in by whoever loads and writes.
+  double load_ms = 0, prepare_ms = 0, geometry_ms = 0, binning_ms = 0, raster_shade_ms = 0, write_ms = 0;
+  std::uint64_t triangles_in = 0, triangles_culled = 0, triangles_clipped = 0, triangles_rasterized = 0;
+  std::uint64_t tiles = 0, tile_bin_entries = 0, blocks_rejected = 0, blocks_full = 0, blocks_partial = 0;
+  std::uint64_t batches = 0, quads = 0, pixels_shaded = 0, pixels_depth_failed = 0;
+  int threads = 0, tile_size = 0, simd_lanes = 0;
+  std::string simd_arch;
+  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
+
+  nlohmann::json to_json() const;
+};
+
+struct AovImage {
+  Aov aov;
+  int channels = 0;
+  std::vector<float> pixels;  // width * height * channels
+};
+
+struct Frame {
+  int width = 0, height = 0;
+  std::vector<float> color;  // linear RGB, row 0 at the top
+  std::vector<AovImage> aovs;
+  RenderStats stats;
+};
+
+Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
+
+// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: half-float linear) through a temporary
+// file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
+void write_frame(const Frame& frame, const std::filesystem::path& file);
+// Writes one AOV (EXR/TIFF: float data; PNG: 8-bit, normals mapped to 0.5 + 0.5 n, depth divided by its maximum).
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
+
+}  // namespace qdmr

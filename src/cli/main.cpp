@@ -1,0 +1,197 @@
+// The qdmr command: a thin layer over the library (scene loading, planning, rendering, writing).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "qdmr/render/render.hpp"
+#include "qdmr/scene/load.hpp"
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+
+struct SceneArgs {
+  std::string scene;
+  std::vector<std::string> sets;
+  std::vector<std::string> aovs;  // NAME=FILE for render, NAME for plan
+};
+
+struct RenderArgs {
+  std::string output;
+  int width = 0, height = 0;
+  int threads = -1;  // absent: every core
+  int tile = qdmr::RenderOptions{}.tile_size;
+  std::string stats;
+};
+
+std::vector<qdmr::SceneOverride> overrides(const SceneArgs& args, const RenderArgs* render) {
+  std::vector<qdmr::SceneOverride> result;
+  for (const std::string& s : args.sets) result.push_back(qdmr::parse_override(s));
+  if (render && render->width > 0) result.push_back({"/output/width", std::to_string(render->width)});
+  if (render && render->height > 0) result.push_back({"/output/height", std::to_string(render->height)});
+  return result;
+}
+
+qdmr::Aov aov_from(const std::string& name) {
+  if (auto aov = qdmr::parse_aov(name)) return *aov;
+  std::string valid;
+  for (const std::string& n : qdmr::aov_names()) valid += (valid.empty() ? "" : ", ") + n;
+  throw qdmr::Error("--aov", "unknown AOV '" + name + "' (valid: " + valid + ")");
+}
+
+void check_output_path(const std::string& option, const std::filesystem::path& out, const std::filesystem::path& scene) {
+  std::string ext = out.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
+    throw qdmr::Error(option + " " + out.string(), "unsupported image type '" + ext + "' (use .png, .exr or .tif)");
+  const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
+  if (!std::filesystem::is_directory(folder))
+    throw qdmr::Error(option + " " + out.string(), "folder does not exist: " + folder.string());
+  std::error_code ec;
+  if (std::filesystem::equivalent(out, scene, ec))
+    throw qdmr::Error(option + " " + out.string(), "refusing to overwrite the scene file");
+}
+
+// Writes text through a temporary file and a rename.
+void write_text_file(const std::filesystem::path& file, const std::string& text) {
+  const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
+  const std::filesystem::path temporary = folder / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()));
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    if (!out.flush()) {
+      std::filesystem::remove(temporary);
+      throw qdmr::Error(file.string(), "cannot write file");
+    }
+  }
+  std::filesystem::rename(temporary, file);
+}
+
+int run_render(const SceneArgs& args, const RenderArgs& render) {
+  using Clock = std::chrono::steady_clock;
+  qdmr::RenderOptions options;
+  if (render.threads == 0) throw qdmr::Error("--threads", "must be at least 1 (omit it to use every core)");
+  options.threads = render.threads < 0 ? 0 : render.threads;
+  options.tile_size = render.tile;
+  qdmr::validate_options(options);
+  check_output_path("-o", render.output, args.scene);
+  std::vector<std::pair<qdmr::Aov, std::filesystem::path>> aov_files;
+  std::set<std::string> seen;
+  for (const std::string& spec : args.aovs) {
+    const auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+      throw qdmr::Error("--aov " + spec, "expected NAME=FILE, e.g. --aov depth=depth.exr");
+    const std::string name = spec.substr(0, eq);
+    if (!seen.insert(name).second) throw qdmr::Error("--aov " + spec, "AOV '" + name + "' given twice");
+    aov_files.emplace_back(aov_from(name), spec.substr(eq + 1));
+    check_output_path("--aov", aov_files.back().second, args.scene);
+    options.aovs.push_back(aov_files.back().first);
+  }
+  if (!render.stats.empty() && !std::filesystem::is_directory(std::filesystem::path(render.stats).parent_path().empty()
+                                                                  ? std::filesystem::path(".")
+                                                                  : std::filesystem::path(render.stats).parent_path()))
+    throw qdmr::Error("--stats " + render.stats, "folder does not exist");
+
+  auto start = Clock::now();
+  const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
+  const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+
+  qdmr::Frame frame = qdmr::render_frame(scene, options);
+  frame.stats.load_ms = load_ms;
+
+  start = Clock::now();
+  qdmr::write_frame(frame, render.output);
+  for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file);
+  frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  if (!render.stats.empty()) write_text_file(render.stats, frame.stats.to_json().dump(2) + "\n");
+  const qdmr::RenderStats& s = frame.stats;
+  std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
+              frame.width, frame.height, static_cast<unsigned long long>(s.triangles_rasterized),
+              static_cast<unsigned long long>(s.pixels_shaded),
+              s.load_ms + s.prepare_ms + s.geometry_ms + s.binning_ms + s.raster_shade_ms + s.write_ms, s.threads,
+              s.simd_arch.c_str());
+  return 0;
+}
+
+int run_plan(const SceneArgs& args, bool as_json) {
+  qdmr::RenderOptions options;
+  std::set<std::string> seen;
+  for (const std::string& name : args.aovs) {
+    if (!seen.insert(name).second) throw qdmr::Error("--aov " + name, "AOV given twice");
+    options.aovs.push_back(aov_from(name));
+  }
+  const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, nullptr));
+  const qdmr::FramePlan plan = qdmr::plan_frame(scene, options);
+  if (as_json)
+    std::cout << plan.to_json().dump(2) << "\n";
+  else
+    std::cout << plan.describe();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "qdmr: a CPU rasterizer for per-pixel displacement mapping (quadtree displacement mapping and friends).\n"
+      "Renders a JSON scene to an image, the same bits on any machine and thread count.\n\n"
+      "  qdmr render scenes/plane.json -o plane.png\n"
+      "  qdmr render scenes/terrain.json -o t.exr --set /camera/fov_deg=30 --aov depth=depth.exr --stats stats.json\n"
+      "  qdmr plan scenes/terrain.json\n\n"
+      "The scene format is described in docs/scene-format.md."};
+  app.require_subcommand(1);
+
+  SceneArgs render_scene;
+  RenderArgs render;
+  CLI::App* render_cmd = app.add_subcommand("render", "Render a scene to an image");
+  render_cmd->add_option("scene", render_scene.scene, "Scene file (JSON)")->required();
+  render_cmd->add_option("-o,--output", render.output, "Output image: .png (8-bit sRGB), .tif (16-bit sRGB) or .exr (linear half)")
+      ->required();
+  render_cmd->add_option("--width", render.width, "Override /output/width (pixels)")->check(CLI::PositiveNumber);
+  render_cmd->add_option("--height", render.height, "Override /output/height (pixels)")->check(CLI::PositiveNumber);
+  render_cmd->add_option("--threads", render.threads, "Worker threads (default: every core)");
+  render_cmd->add_option("--tile", render.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
+  render_cmd->add_option("--set", render_scene.sets,
+                         "Override a scene value before validation: /json/pointer=VALUE (VALUE is JSON; a bare word is a "
+                         "string). Repeatable, e.g. --set /camera/fov_deg=30");
+  render_cmd->add_option("--aov", render_scene.aovs, "Also write an AOV: NAME=FILE with NAME one of depth, normal, uv. Repeatable");
+  render_cmd->add_option("--stats", render.stats, "Write timings and counters as JSON to this file");
+
+  SceneArgs plan_scene;
+  bool plan_json = false;
+  CLI::App* plan_cmd = app.add_subcommand("plan", "Print what a scene requires: programs, textures, derived data, memory");
+  plan_cmd->add_option("scene", plan_scene.scene, "Scene file (JSON)")->required();
+  plan_cmd->add_option("--set", plan_scene.sets, "Override a scene value: /json/pointer=VALUE (repeatable)");
+  plan_cmd->add_option("--aov", plan_scene.aovs, "AOV names to plan for (repeatable)");
+  plan_cmd->add_flag("--json", plan_json, "Print the plan as JSON");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+  try {
+    if (render_cmd->parsed()) return run_render(render_scene, render);
+    if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);
+  } catch (const qdmr::Error& e) {
+    std::fprintf(stderr, "qdmr: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "qdmr: error: out of memory (try a smaller --width/--height or textures)\n");
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "qdmr: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,127 @@
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/det_math.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/render/render.hpp"
+
+namespace qdmr {
+namespace {
+
+enum class Container { Png, Tiff, Exr };
+
+Container container_of(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".png") return Container::Png;
+  if (ext == ".tif" || ext == ".tiff") return Container::Tiff;
+  if (ext == ".exr") return Container::Exr;
+  throw Error(file.string(), "unsupported image type '" + ext + "' (use .png, .tif or .exr)");
+}
+
+// Exact sRGB transfer curve, with the deterministic pow so every machine writes the same bytes.
+float linear_to_srgb(float v) {
+  if (!(v > 0.0f)) return 0.0f;  // also maps NaN to black
+  if (v >= 1.0f) return 1.0f;
+  if (v <= 0.0031308f) return 12.92f * v;
+  return 1.055f * detmath::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+template <typename T>
+std::vector<T> quantize(const std::vector<float>& values, float max_code, bool srgb) {
+  std::vector<T> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    float v = srgb ? linear_to_srgb(values[i]) : values[i];
+    v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    out[i] = T(std::floor(v * max_code + 0.5f));
+  }
+  return out;
+}
+
+// Writes pixels (float, `channels` per pixel) through a temporary file in the target folder, then renames.
+void write_pixels(const std::filesystem::path& file, int width, int height, int channels, const std::vector<float>& pixels,
+                  bool srgb) {
+  const Container container = container_of(file);
+  const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
+  if (!std::filesystem::is_directory(folder)) throw Error(file.string(), "folder does not exist: " + folder.string());
+  std::string temporary_name = ".";  // appended piecewise: GCC 12 warns falsely on a chain of string '+'
+  temporary_name.append(file.filename().string()).append(".tmp").append(std::to_string(::getpid()));
+  temporary_name.append(file.extension().string());
+  const std::filesystem::path temporary = folder / temporary_name;
+
+  OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
+  std::vector<std::uint8_t> bytes8;
+  std::vector<std::uint16_t> bytes16;
+  const void* data = pixels.data();
+  if (container == Container::Png) {
+    format = OIIO::TypeDesc::UINT8;
+    bytes8 = quantize<std::uint8_t>(pixels, 255.0f, srgb);
+    data = bytes8.data();
+  } else if (container == Container::Tiff && srgb) {
+    format = OIIO::TypeDesc::UINT16;
+    bytes16 = quantize<std::uint16_t>(pixels, 65535.0f, true);
+    data = bytes16.data();
+  }
+  OIIO::ImageSpec spec(width, height, channels, container == Container::Exr ? OIIO::TypeDesc::HALF : format);
+  if (container == Container::Exr && !srgb) spec.set_format(OIIO::TypeDesc::FLOAT);
+  if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
+  auto output = OIIO::ImageOutput::create(temporary.string());
+  bool ok = output && output->open(temporary.string(), spec) && output->write_image(format, data) && output->close();
+  std::string message = output ? output->geterror() : OIIO::geterror();
+  output.reset();
+  std::error_code ec;
+  if (ok) {
+    std::filesystem::rename(temporary, file, ec);
+    if (ec) message = ec.message();
+    ok = !ec;
+  }
+  if (!ok) {
+    std::filesystem::remove(temporary, ec);
+    throw Error(file.string(), "cannot write image: " + (message.empty() ? std::string("unknown error") : message));
+  }
+}
+
+}  // namespace
+
+void write_frame(const Frame& frame, const std::filesystem::path& file) {
+  write_pixels(file, frame.width, frame.height, 3, frame.color, true);
+}
+
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {
+  const AovImage* image = nullptr;
+  for (const AovImage& a : frame.aovs)
+    if (a.aov == aov) image = &a;
+  if (!image) throw Error(file.string(), "AOV '" + aov_name(aov) + "' was not rendered");
+  if (container_of(file) != Container::Png) {
+    write_pixels(file, frame.width, frame.height, image->channels, image->pixels, false);
+    return;
+  }
+  // 8-bit PNG: map the values into [0, 1] so the picture is readable.
+  std::vector<float> mapped = image->pixels;
+  if (aov == Aov::Normal)
+    for (float& v : mapped) v = 0.5f + 0.5f * v;
+  if (aov == Aov::UV)
+    for (float& v : mapped) v -= std::floor(v);
+  if (aov == Aov::Depth) {
+    float max_depth = 0.0f;
+    for (float v : mapped) max_depth = std::max(max_depth, v);
+    if (max_depth > 0.0f)
+      for (float& v : mapped) v /= max_depth;
+  }
+  if (image->channels == 2) {  // PNG has no two-channel colour: u, v into red and green
+    std::vector<float> rgb(mapped.size() / 2 * 3, 0.0f);
+    for (std::size_t i = 0; i < mapped.size() / 2; ++i) {
+      rgb[3 * i] = mapped[2 * i];
+      rgb[3 * i + 1] = mapped[2 * i + 1];
+    }
+    mapped = std::move(rgb);
+  }
+  write_pixels(file, frame.width, frame.height, image->channels == 2 ? 3 : image->channels, mapped, false);
+}
+
+}  // namespace qdmr

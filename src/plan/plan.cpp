@@ -1,0 +1,285 @@
+#include "qdmr/plan/plan.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include "qdmr/core/error.hpp"
+
+namespace qdmr {
+namespace {
+
+const char* purpose_name(TexturePurpose p) {
+  switch (p) {
+    case TexturePurpose::Albedo: return "albedo";
+    case TexturePurpose::Normal: return "normal";
+    case TexturePurpose::Height: return "height";
+  }
+  return "?";
+}
+
+const char* filter_name(Filter f) {
+  switch (f) {
+    case Filter::Point: return "point";
+    case Filter::Bilinear: return "bilinear";
+    case Filter::Trilinear: return "trilinear";
+  }
+  return "?";
+}
+
+std::string source_key(const TextureDesc& d) {
+  std::ostringstream k;
+  switch (d.source) {
+    case TextureSource::None: k << "none"; break;
+    case TextureSource::File: k << "file:" << d.file.string() << ":ch" << int(d.channel) << ":srgb" << d.srgb; break;
+    case TextureSource::Constant: k << "const:" << d.constant.x << "," << d.constant.y << "," << d.constant.z << "," << d.constant.w; break;
+    case TextureSource::Procedural: {
+      const ProceduralDesc& p = d.procedural;
+      k << "proc:" << int(p.pattern) << ":" << p.size << ":" << p.seed << ":" << p.cells << ":" << p.octaves << ":" << p.gain
+        << ":" << p.mortar;
+      break;
+    }
+    case TextureSource::FromHeight: k << "from_height"; break;
+  }
+  return k.str();
+}
+
+std::string height_key(const LayerDesc& layer) {
+  std::ostringstream k;
+  k << source_key(layer.height) << ":scale" << layer.height_scale << ":offset" << layer.height_offset;
+  return k.str();
+}
+
+std::string request_key(const TextureDesc& d, TexturePurpose purpose, const LayerDesc& layer) {
+  std::ostringstream k;
+  k << purpose_name(purpose) << "|" << source_key(d);
+  if (purpose == TexturePurpose::Albedo && d.source == TextureSource::Procedural)
+    k << ":low" << d.color_low.x << "," << d.color_low.y << "," << d.color_low.z << ":high" << d.color_high.x << ","
+      << d.color_high.y << "," << d.color_high.z << ":var" << d.variation;
+  if (purpose == TexturePurpose::Normal)
+    k << ":conv" << int(layer.normal_convention) << ":strength" << layer.normal_strength;
+  if (purpose == TexturePurpose::Height || d.source == TextureSource::FromHeight ||
+      (purpose == TexturePurpose::Albedo && d.source == TextureSource::Procedural))
+    k << "|height:" << height_key(layer);
+  return k.str();
+}
+
+// Level-0 size of a texture without building it (file headers are read).
+std::pair<int, int> texture_size(const TextureDesc& d, const LayerDesc& layer, const std::string& where) {
+  switch (d.source) {
+    case TextureSource::None:
+    case TextureSource::Constant: return {1, 1};
+    case TextureSource::Procedural: return {d.procedural.size, d.procedural.size};
+    case TextureSource::FromHeight:
+      if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {1, 1};
+      return texture_size(layer.height, layer, where);
+    case TextureSource::File: {
+      auto input = OIIO::ImageInput::open(d.file.string());
+      if (!input) throw Error(where + "/file", "cannot read '" + d.file.string() + "': " + OIIO::geterror());
+      const OIIO::ImageSpec& spec = input->spec();
+      return {spec.width, spec.height};
+    }
+  }
+  return {1, 1};
+}
+
+int mip_levels(int w, int h) {
+  int levels = 1;
+  while (w > 1 || h > 1) {
+    w = std::max(1, w / 2);
+    h = std::max(1, h / 2);
+    ++levels;
+  }
+  return levels;
+}
+
+std::uint64_t chain_bytes(int w, int h, int channels) {
+  std::uint64_t bytes = 0;
+  for (;;) {
+    bytes += std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(channels) * sizeof(float);
+    if (w == 1 && h == 1) return bytes;
+    w = std::max(1, w / 2);
+    h = std::max(1, h / 2);
+  }
+}
+
+int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, TexturePurpose purpose,
+                const LayerDesc& layer, const std::string& where, const std::string& user) {
+  const std::string key = request_key(desc, purpose, layer);
+  for (std::size_t i = 0; i < textures.size(); ++i) {
+    if (textures[i].key != key) continue;
+    if (std::find(textures[i].users.begin(), textures[i].users.end(), user) == textures[i].users.end())
+      textures[i].users.push_back(user);
+    return int(i);
+  }
+  TextureRequest r;
+  r.key = key;
+  r.purpose = purpose;
+  r.desc = desc;
+  r.layer = layer;
+  r.where = where;
+  const auto [w, h] = texture_size(desc, layer, where);
+  r.width = w;
+  r.height = h;
+  r.channels = purpose == TexturePurpose::Height ? 1 : 3;
+  r.levels = mip_levels(w, h);
+  r.bytes = chain_bytes(w, h, r.channels);
+  r.users.push_back(user);
+  textures.push_back(std::move(r));
+  return int(textures.size() - 1);
+}
+
+std::uint64_t count_obj_lines(const std::filesystem::path& file, std::uint64_t& faces) {
+  std::ifstream in(file);
+  std::string line;
+  std::uint64_t vertices = 0;
+  faces = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("v ", 0) == 0) ++vertices;
+    else if (line.rfind("f ", 0) == 0) ++faces;
+  }
+  return vertices;
+}
+
+MeshPlan plan_mesh(const ObjectDesc& object) {
+  MeshPlan m;
+  m.object = object.name;
+  const MeshDesc& d = object.mesh;
+  switch (d.kind) {
+    case MeshKind::Plane: m.kind = "plane"; m.vertices = 4; m.triangles = 2; break;
+    case MeshKind::Box: m.kind = "box"; m.vertices = 24; m.triangles = 12; break;
+    case MeshKind::Sphere: {
+      m.kind = "sphere";
+      const std::uint64_t rings = std::uint64_t(std::max(2, d.segments / 2));
+      m.vertices = (std::uint64_t(d.segments) + 1) * (rings + 1);
+      m.triangles = std::uint64_t(d.segments) * rings * 2;
+      break;
+    }
+    case MeshKind::Grid:
+      m.kind = "grid";
+      m.vertices = (std::uint64_t(d.resolution) + 1) * (std::uint64_t(d.resolution) + 1);
+      m.triangles = 2ull * std::uint64_t(d.resolution) * std::uint64_t(d.resolution);
+      break;
+    case MeshKind::Obj: {
+      m.kind = "obj " + d.file.filename().string();
+      std::uint64_t faces = 0;
+      m.vertices = count_obj_lines(d.file, faces);
+      m.triangles = faces;
+      m.estimated = true;
+      break;
+    }
+  }
+  // position, normal, tangent, uv per vertex; three indices and a material id per triangle
+  m.bytes = m.vertices * (3 + 3 + 4 + 2) * sizeof(float) + m.triangles * 4 * sizeof(std::uint32_t);
+  return m;
+}
+
+std::string mib(std::uint64_t bytes) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(2);
+  s << double(bytes) / (1024.0 * 1024.0) << " MiB";
+  return s.str();
+}
+
+std::uint64_t aov_channels(Aov aov) {
+  switch (aov) {
+    case Aov::Depth: return 1;
+    case Aov::Normal: return 3;
+    case Aov::UV: return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+MaterialPlan plan_material(const MaterialDesc& material, const std::string& where,
+                           std::vector<TextureRequest>& textures) {
+  MaterialPlan plan;
+  plan.name = material.name;
+  plan.sampling = material.sampling;
+  plan.lighting = material.lighting;
+  plan.program = std::string("normal_mapping | blinn_phong | ") + filter_name(material.sampling.filter);
+  const LayerDesc& layer = material.layers.at(0);
+  const std::string layer_where = where + "/layers/0";
+  plan.albedo = add_request(textures, layer.albedo, TexturePurpose::Albedo, layer, layer_where + "/albedo", material.name);
+  plan.normal = add_request(textures, layer.normal, TexturePurpose::Normal, layer, layer_where + "/normal", material.name);
+  return plan;
+}
+
+FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
+  FramePlan plan;
+  plan.width = scene.output.width;
+  plan.height = scene.output.height;
+  plan.aovs = options.aovs;
+  const std::string file = scene.file.string();
+  for (const ObjectDesc& object : scene.objects) {
+    plan.meshes.push_back(plan_mesh(object));
+    plan.mesh_bytes += plan.meshes.back().bytes;
+  }
+  for (const MaterialDesc& material : scene.materials) {
+    const bool used = std::any_of(scene.objects.begin(), scene.objects.end(),
+                                  [&](const ObjectDesc& o) { return o.material == material.name; });
+    if (!used) continue;  // unused materials cost nothing
+    plan.materials.push_back(plan_material(material, file + ": /materials/" + material.name, plan.textures));
+  }
+  for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
+  std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
+  for (Aov aov : plan.aovs) per_pixel += aov_channels(aov);
+  plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
+  return plan;
+}
+
+std::string FramePlan::describe() const {
+  std::ostringstream s;
+  s << "output: " << width << "x" << height << "\n";
+  s << "materials (" << materials.size() << "):\n";
+  for (const MaterialPlan& m : materials) {
+    s << "  " << m.name << ": " << m.program << "\n";
+    s << "    albedo: texture " << m.albedo << ", normal: texture " << m.normal << "\n";
+  }
+  s << "textures to build (" << textures.size() << "):\n";
+  for (std::size_t i = 0; i < textures.size(); ++i) {
+    const TextureRequest& t = textures[i];
+    s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << "x" << t.channels
+      << ", box mip chain of " << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
+  }
+  s << "derived data: none (normal mapping needs no quadtree, cone map, AO or blend maps)\n";
+  s << "meshes (" << meshes.size() << "):\n";
+  for (const MeshPlan& m : meshes)
+    s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles"
+      << (m.estimated ? " (counted from the file)" : "") << ", " << mib(m.bytes) << "\n";
+  s << "aovs:";
+  if (aovs.empty()) s << " none";
+  for (Aov a : aovs) s << " " << aov_name(a);
+  s << "\n";
+  s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes) << ", meshes "
+    << mib(mesh_bytes) << ", total " << mib(total_bytes()) << "\n";
+  return s.str();
+}
+
+nlohmann::json FramePlan::to_json() const {
+  nlohmann::json j;
+  j["width"] = width;
+  j["height"] = height;
+  for (const MaterialPlan& m : materials)
+    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal}});
+  for (const TextureRequest& t : textures)
+    j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
+                             {"channels", t.channels}, {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where},
+                             {"users", t.users}});
+  for (const MeshPlan& m : meshes)
+    j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
+                           {"bytes", m.bytes}, {"estimated", m.estimated}});
+  j["aovs"] = nlohmann::json::array();
+  for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
+  j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
+                 {"total_bytes", total_bytes()}};
+  return j;
+}
+
+}  // namespace qdmr

@@ -1,0 +1,33 @@
+#pragma once
+// Binning: each triangle goes to every screen tile its bounds touch, in submission order.
+#include <cstdint>
+#include <vector>
+
+#include "raster/triangle_setup.hpp"
+
+namespace qdmr {
+
+struct TileGrid {
+  int width = 0, height = 0;  // viewport in pixels
+  int tile_size = 64;
+  int tiles_x = 0, tiles_y = 0;
+
+  TileGrid(int w, int h, int tile) : width(w), height(h), tile_size(tile), tiles_x((w + tile - 1) / tile), tiles_y((h + tile - 1) / tile) {}
+  int count() const { return tiles_x * tiles_y; }
+  PixelRect rect(int tile) const {
+    const int tx = tile % tiles_x, ty = tile / tiles_x;
+    PixelRect r;
+    r.x0 = tx * tile_size;
+    r.y0 = ty * tile_size;
+    r.x1 = std::min(width, r.x0 + tile_size) - 1;
+    r.y1 = std::min(height, r.y0 + tile_size) - 1;
+    return r;
+  }
+};
+
+// bins[tile] lists triangle indices (into the setups) in submission order.
+using TileBins = std::vector<std::vector<std::uint32_t>>;
+
+TileBins bin_triangles(const std::vector<TriangleSetup>& setups, const TileGrid& grid);
+
+}  // namespace qdmr

@@ -1,0 +1,68 @@
+#pragma once
+// Geometry stage: object vertices to clip space, near/far and guard-band clipping, back-face culling,
+// viewport transform to fixed point. Output triangles keep submission order.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include "qdmr/mesh/mesh.hpp"
+
+namespace qdmr {
+
+// Per-vertex values interpolated across triangles, in this order.
+enum Varying : int { kWorldX, kWorldY, kWorldZ, kNormalX, kNormalY, kNormalZ, kTangentX, kTangentY, kTangentZ, kTangentW, kU, kV,
+                     kVaryingCount };
+
+struct ClipVertex {
+  glm::vec4 clip;  // homogeneous clip-space position (GL convention: -w <= z <= w)
+  std::array<float, kVaryingCount> varyings;
+};
+
+// One mesh instance to draw: the mesh, its model matrix and the frame-material index of each triangle.
+struct DrawItem {
+  const MeshData* mesh = nullptr;
+  glm::mat4 model{1.0f};
+  std::uint32_t material = 0;               // used when the mesh has no per-triangle materials
+  std::vector<std::uint32_t> mesh_materials; // mesh-local material id -> frame material index
+};
+
+// A triangle ready for setup: fixed-point screen positions (y down), oriented so that the doubled
+// signed area orient2d(p0, p1, p2) is positive, and its vertices (indices into GeometryResult::vertices).
+struct ScreenTriangle {
+  std::array<std::int32_t, 3> x, y;
+  std::array<std::uint32_t, 3> vertex;
+  std::uint32_t material;
+};
+
+struct ScreenVertex {
+  float inv_w;   // 1 / clip w (w = view-space depth)
+  float z;       // window depth in [0, 1]
+  std::array<float, kVaryingCount> varyings;
+};
+
+struct GeometryCounters {
+  std::uint64_t triangles_in = 0;
+  std::uint64_t culled_backface = 0;    // back-facing or zero area after snapping
+  std::uint64_t culled_outside = 0;     // entirely outside the view volume
+  std::uint64_t clipped = 0;            // crossed near/far or the guard band and were clipped
+  std::uint64_t triangles_out = 0;
+};
+
+struct GeometryResult {
+  std::vector<ScreenVertex> vertices;
+  std::vector<ScreenTriangle> triangles;
+  GeometryCounters counters;
+};
+
+struct Viewport {
+  int width = 0;
+  int height = 0;
+};
+
+GeometryResult run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, const glm::mat4& projection,
+                            const Viewport& viewport);
+
+}  // namespace qdmr

@@ -1,0 +1,202 @@
+#include "raster/tile_raster.hpp"
+
+#include <algorithm>
+#include <bit>
+
+#include "qdmr/core/limits.hpp"
+
+namespace qdmr {
+namespace {
+
+using simd::Float;
+using simd::kLanes;
+
+constexpr int kBatchWidth = 2 * simd::kQuadsPerBatch;  // pixels per batch row
+constexpr int kBlock = limits::kCoarseBlockSize;
+static_assert(kBlock % 4 == 0, "coarse blocks hold whole batches in both SSE and AVX2 builds");
+
+// Lane layout: quad q covers pixels (2q, 0) .. (2q+1, 1) of the batch, lanes 0 1 / 2 3 inside the quad.
+constexpr int lane_dx(int lane) { return (lane / 4) * 2 + (lane % 2); }
+constexpr int lane_dy(int lane) { return (lane % 4) / 2; }
+
+struct EdgeSteps {
+  std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
+};
+
+EdgeSteps edge_steps(const TriangleSetup& s) {
+  EdgeSteps e;
+  for (int i = 0; i < 3; ++i)
+    for (int l = 0; l < kLanes; ++l)
+      e.lane[i][l] = -std::int64_t(s.dy[i]) * limits::kSubpixelScale * lane_dx(l) +
+                     std::int64_t(s.dx[i]) * limits::kSubpixelScale * lane_dy(l);
+  return e;
+}
+
+// Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside.
+int classify_block(const TriangleSetup& s, int bx, int by) {
+  bool full = true;
+  for (int i = 0; i < 3; ++i) {
+    std::int64_t lo = INT64_MAX, hi = INT64_MIN;
+    for (int corner = 0; corner < 4; ++corner) {
+      const std::int64_t X = pixel_centre_fixed(bx + (corner & 1) * (kBlock - 1));
+      const std::int64_t Y = pixel_centre_fixed(by + (corner >> 1) * (kBlock - 1));
+      const std::int64_t w = s.edge(i, X, Y) + s.bias[i];
+      lo = std::min(lo, w);
+      hi = std::max(hi, w);
+    }
+    if (hi < 0) return 0;
+    if (lo < 0) full = false;
+  }
+  return full ? 2 : 1;
+}
+
+class TileRasterizer {
+public:
+  TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters)
+      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters) {}
+
+  void triangle(const TriangleSetup& s) {
+    ++counters_.bin_entries;
+    PixelRect r;
+    r.x0 = std::max(s.bounds.x0, tile_.x0);
+    r.y0 = std::max(s.bounds.y0, tile_.y0);
+    r.x1 = std::min(s.bounds.x1, tile_.x1);
+    r.y1 = std::min(s.bounds.y1, tile_.y1);
+    if (r.empty()) return;
+    setup_ = &s;
+    steps_ = edge_steps(s);
+    program_ = ctx_.programs[s.material];
+    for (int v = 0; v < 3; ++v) vertex_[v] = &ctx_.geometry->vertices[s.vertex[v]];
+
+    for (int by = r.y0 - r.y0 % kBlock; by <= r.y1; by += kBlock) {
+      for (int bx = r.x0 - r.x0 % kBlock; bx <= r.x1; bx += kBlock) {
+        const int kind = classify_block(s, bx, by);
+        if (kind == 0) {
+          ++counters_.blocks_rejected;
+          continue;
+        }
+        ++(kind == 2 ? counters_.blocks_full : counters_.blocks_partial);
+        const int y_begin = std::max(by, r.y0 & ~1), y_end = std::min(by + kBlock - 1, r.y1);
+        const int x_begin = std::max(bx, r.x0 - r.x0 % kBatchWidth), x_end = std::min(bx + kBlock - 1, r.x1);
+        for (int y = y_begin; y <= y_end; y += 2)
+          for (int x = x_begin; x <= x_end; x += kBatchWidth) batch(x, y, kind == 2);
+      }
+    }
+  }
+
+private:
+  void batch(int x, int y, bool full) {
+    const TriangleSetup& s = *setup_;
+    const std::int64_t X = pixel_centre_fixed(x), Y = pixel_centre_fixed(y);
+    std::int64_t w[3][kLanes];
+    std::uint32_t inside = 0;
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t base = s.edge(i, X, Y);
+      for (int l = 0; l < kLanes; ++l) w[i][l] = base + steps_.lane[i][l];
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      const int px = x + lane_dx(l), py = y + lane_dy(l);
+      if (px > tile_.x1 || py > tile_.y1) continue;
+      const bool in = full || ((w[0][l] + s.bias[0]) | (w[1][l] + s.bias[1]) | (w[2][l] + s.bias[2])) >= 0;
+      inside |= std::uint32_t(in) << l;
+    }
+    if (inside == 0) return;
+
+    alignas(64) float e[3][kLanes];
+    alignas(64) float stored_depth[kLanes];
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < kLanes; ++l) e[i][l] = float(w[i][l]);
+    for (int l = 0; l < kLanes; ++l)
+      stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+    const Float e0 = Float::load_aligned(e[0]), e1 = Float::load_aligned(e[1]), e2 = Float::load_aligned(e[2]);
+    const Float z = e0 * Float(s.z_over_area[0]) + e1 * Float(s.z_over_area[1]) + e2 * Float(s.z_over_area[2]);
+    const std::uint32_t pass = inside & simd::to_bits(z < Float::load_aligned(stored_depth));
+    counters_.pixels_depth_failed += std::popcount(inside) - std::popcount(pass);
+    if (pass == 0) return;
+
+    // Perspective-correct barycentrics: edge values weighted by 1/w, normalised.
+    const Float p0 = e0 * Float(s.inv_w[0]), p1 = e1 * Float(s.inv_w[1]), p2 = e2 * Float(s.inv_w[2]);
+    const Float sum = p0 + p1 + p2;
+    const Float inv_sum = Float(1.0f) / sum;
+    const Float b0 = p0 * inv_sum, b1 = p1 * inv_sum, b2 = p2 * inv_sum;
+
+    Fragments in;
+    alignas(64) float px[kLanes], py[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      px[l] = float(x + lane_dx(l)) + 0.5f;
+      py[l] = float(y + lane_dy(l)) + 0.5f;
+    }
+    in.pixel_x = Float::load_aligned(px);
+    in.pixel_y = Float::load_aligned(py);
+    for (int k = 0; k < kVaryingCount; ++k)
+      in.varyings[k] = b0 * Float(vertex_[0]->varyings[k]) + b1 * Float(vertex_[1]->varyings[k]) +
+                       b2 * Float(vertex_[2]->varyings[k]);
+    in.view_depth = Float(float(s.area2)) * inv_sum;
+    in.covered = simd::from_bits(pass);
+
+    ShadeOutput out;
+    program_->shade(in, out);
+    write(x, y, pass, z, in, out);
+  }
+
+  void write(int x, int y, std::uint32_t pass, const Float& z, const Fragments& in, const ShadeOutput& out) {
+    alignas(64) float zs[kLanes], color[3][kLanes], normal[3][kLanes], uv[2][kLanes], view_depth[kLanes];
+    z.store_aligned(zs);
+    for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
+    const bool want_normal = !fb_.normal.empty(), want_uv = !fb_.uv.empty(), want_depth = !fb_.view_depth.empty();
+    if (want_normal)
+      for (int c = 0; c < 3; ++c) out.normal[c].store_aligned(normal[c]);
+    if (want_uv) {
+      in.varyings[kU].store_aligned(uv[0]);
+      in.varyings[kV].store_aligned(uv[1]);
+    }
+    if (want_depth) in.view_depth.store_aligned(view_depth);
+    for (int l = 0; l < kLanes; ++l) {
+      if (!((pass >> l) & 1u)) continue;
+      const std::size_t i = fb_.index(x + lane_dx(l), y + lane_dy(l));
+      fb_.depth[i] = zs[l];
+      for (int c = 0; c < 3; ++c) fb_.color[3 * i + c] = color[c][l];
+      if (want_normal)
+        for (int c = 0; c < 3; ++c) fb_.normal[3 * i + c] = normal[c][l];
+      if (want_uv) {
+        fb_.uv[2 * i] = uv[0][l];
+        fb_.uv[2 * i + 1] = uv[1][l];
+      }
+      if (want_depth) fb_.view_depth[i] = view_depth[l];
+    }
+    ++counters_.batches_shaded;
+    counters_.pixels_shaded += std::popcount(pass);
+    for (int q = 0; q < simd::kQuadsPerBatch; ++q) counters_.quads_shaded += ((pass >> (4 * q)) & 0xFu) != 0;
+  }
+
+  const RasterContext& ctx_;
+  Framebuffer& fb_;
+  PixelRect tile_;
+  TileCounters& counters_;
+  const TriangleSetup* setup_ = nullptr;
+  EdgeSteps steps_{};
+  const ShadingProgram* program_ = nullptr;
+  const ScreenVertex* vertex_[3] = {};
+};
+
+}  // namespace
+
+TileCounters& TileCounters::operator+=(const TileCounters& o) {
+  bin_entries += o.bin_entries;
+  blocks_rejected += o.blocks_rejected;
+  blocks_full += o.blocks_full;
+  blocks_partial += o.blocks_partial;
+  batches_shaded += o.batches_shaded;
+  quads_shaded += o.quads_shaded;
+  pixels_shaded += o.pixels_shaded;
+  pixels_depth_failed += o.pixels_depth_failed;
+  return *this;
+}
+
+void raster_tile(const RasterContext& context, const PixelRect& tile, const std::vector<std::uint32_t>& bin,
+                 TileCounters& counters) {
+  TileRasterizer rasterizer(context, tile, counters);
+  for (std::uint32_t index : bin) rasterizer.triangle((*context.setups)[index]);
+}
+
+}  // namespace qdmr

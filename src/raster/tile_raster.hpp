@@ -1,0 +1,36 @@
+#pragma once
+// Rasterizes one screen tile: coarse 8x8 block rejection, then batches of 2x2 quads through the
+// shading program with early depth test. Knows nothing about meshes or materials beyond program indices.
+#include <cstdint>
+#include <vector>
+
+#include "raster/binner.hpp"
+#include "raster/framebuffer.hpp"
+#include "shade/program.hpp"
+
+namespace qdmr {
+
+struct TileCounters {
+  std::uint64_t bin_entries = 0;       // triangles visited by this tile
+  std::uint64_t blocks_rejected = 0;   // 8x8 blocks skipped by the coarse test
+  std::uint64_t blocks_full = 0;       // 8x8 blocks entirely inside a triangle (no per-pixel edge test)
+  std::uint64_t blocks_partial = 0;
+  std::uint64_t batches_shaded = 0;    // program invocations
+  std::uint64_t quads_shaded = 0;      // 2x2 quads with at least one written pixel
+  std::uint64_t pixels_shaded = 0;     // lanes written (covered and passed the depth test)
+  std::uint64_t pixels_depth_failed = 0;
+
+  TileCounters& operator+=(const TileCounters& o);
+};
+
+struct RasterContext {
+  const GeometryResult* geometry = nullptr;
+  const std::vector<TriangleSetup>* setups = nullptr;
+  std::vector<const ShadingProgram*> programs;  // indexed by TriangleSetup::material
+  Framebuffer* framebuffer = nullptr;
+};
+
+void raster_tile(const RasterContext& context, const PixelRect& tile, const std::vector<std::uint32_t>& bin,
+                 TileCounters& counters);
+
+}  // namespace qdmr

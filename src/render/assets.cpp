@@ -1,0 +1,100 @@
+#include "render/assets.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include "qdmr/core/error.hpp"
+#include "shade/normal_mapping.hpp"
+
+namespace qdmr {
+namespace {
+
+MipChain build_texture(const TextureRequest& request) {
+  const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight ||
+                            (request.purpose == TexturePurpose::Albedo && request.desc.source == TextureSource::Procedural);
+  Image height;
+  if (needs_height) height = make_layer_height(request.layer, request.where);
+  Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
+  return build_mip_chain(std::move(level0), request.purpose);
+}
+
+}  // namespace
+
+std::vector<DrawItem> Assets::draw_items() const {
+  std::vector<DrawItem> items(meshes.size());
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    items[i].mesh = &meshes[i];
+    items[i].material = object_material[i];
+    items[i].mesh_materials = object_mtl_materials[i];
+  }
+  return items;
+}
+
+std::uint64_t Assets::texture_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const MipChain& t : textures) bytes += t.bytes();
+  return bytes;
+}
+
+std::uint64_t Assets::mesh_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const MeshData& m : meshes)
+    bytes += m.vertex_count() * (sizeof(glm::vec3) * 2 + sizeof(glm::vec4) + sizeof(glm::vec2)) +
+             (m.indices.size() + m.triangle_materials.size()) * sizeof(std::uint32_t);
+  return bytes;
+}
+
+Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
+  Assets assets;
+  const std::string file = scene.file.string();
+  const std::size_t objects = scene.objects.size();
+  assets.meshes.resize(objects);
+  tbb::parallel_for(std::size_t(0), objects, [&](std::size_t i) {
+    assets.meshes[i] = build_mesh(scene.objects[i].mesh, file + ": /objects/" + std::to_string(i) + "/mesh");
+  });
+
+  // Frame materials: the scene's materials that some object uses, then each obj's MTL materials.
+  std::vector<int> scene_material_index(scene.materials.size(), -1);
+  assets.object_material.assign(objects, 0);
+  assets.object_mtl_materials.resize(objects);
+  for (std::size_t i = 0; i < objects; ++i) {
+    const ObjectDesc& object = scene.objects[i];
+    if (!object.material.empty()) {
+      std::size_t m = 0;
+      while (m < scene.materials.size() && scene.materials[m].name != object.material) ++m;
+      if (m == scene.materials.size())
+        throw Error(file + ": /objects/" + std::to_string(i) + "/material", "unknown material '" + object.material + "'");
+      if (scene_material_index[m] < 0) {
+        scene_material_index[m] = int(assets.materials.size());
+        assets.materials.push_back(plan_material(scene.materials[m], file + ": /materials/" + scene.materials[m].name,
+                                                 assets.requests));
+      }
+      assets.object_material[i] = std::uint32_t(scene_material_index[m]);
+      // An explicit material overrides the MTL: every triangle of the object uses it.
+      assets.object_mtl_materials[i].assign(assets.meshes[i].materials.size(), assets.object_material[i]);
+      continue;
+    }
+    for (std::size_t k = 0; k < assets.meshes[i].materials.size(); ++k) {
+      MaterialDesc mtl = assets.meshes[i].materials[k];
+      mtl.name = object.name + "/" + mtl.name;
+      assets.object_mtl_materials[i].push_back(std::uint32_t(assets.materials.size()));
+      assets.materials.push_back(plan_material(mtl, file + ": /objects/" + std::to_string(i) + "/mesh/file", assets.requests));
+    }
+    if (assets.meshes[i].materials.empty())
+      throw Error(file + ": /objects/" + std::to_string(i) + "/material", "required (the mesh has no MTL materials)");
+  }
+
+  assets.textures.resize(assets.requests.size());
+  tbb::parallel_for(std::size_t(0), assets.requests.size(),
+                    [&](std::size_t i) { assets.textures[i] = build_texture(assets.requests[i]); });
+
+  for (const MaterialPlan& m : assets.materials) {
+    SurfaceTextures textures;
+    textures.albedo = &assets.textures[std::size_t(m.albedo)];
+    textures.normal = &assets.textures[std::size_t(m.normal)];
+    textures.sampler = SamplerState{m.sampling.filter, m.sampling.address, m.sampling.lod_bias};
+    assets.programs.push_back(std::make_unique<NormalMappingProgram>(textures, m.lighting, lights));
+  }
+  return assets;
+}
+
+}  // namespace qdmr

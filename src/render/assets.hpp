@@ -1,0 +1,32 @@
+#pragma once
+// Assets: everything a frame's plan asks to build — meshes, textures with their mip chains, and one
+// shading program per material — made once, read-only while drawing.
+#include <memory>
+#include <vector>
+
+#include "qdmr/mesh/mesh.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "raster/geometry.hpp"
+#include "shade/lighting.hpp"
+#include "shade/program.hpp"
+
+namespace qdmr {
+
+struct Assets {
+  std::vector<MeshData> meshes;                 // one per scene object
+  std::vector<std::uint32_t> object_material;   // frame material of each object (unused for obj with MTL)
+  std::vector<std::vector<std::uint32_t>> object_mtl_materials;  // obj: MTL material id -> frame material
+  std::vector<MaterialPlan> materials;          // frame materials: the scene's, then those of MTL files
+  std::vector<TextureRequest> requests;
+  std::vector<MipChain> textures;               // parallel to requests
+  std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
+
+  std::vector<DrawItem> draw_items() const;     // model matrices left as identity
+  std::uint64_t texture_bytes() const;
+  std::uint64_t mesh_bytes() const;
+};
+
+// Builds meshes and textures in parallel (in the caller's task arena). Throws qdmr::Error on bad input.
+Assets prepare_assets(const SceneDesc& scene, const LightRig& lights);
+
+}  // namespace qdmr

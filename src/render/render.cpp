@@ -1,0 +1,203 @@
+#include "qdmr/render/render.hpp"
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <memory>
+#include <thread>
+
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/trigonometric.hpp>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "core/simd.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "raster/binner.hpp"
+#include "raster/tile_raster.hpp"
+#include "render/assets.hpp"
+
+namespace qdmr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux reports KiB
+}
+
+glm::mat4 model_matrix(const TransformDesc& t) {
+  glm::mat4 m = glm::translate(glm::mat4(1.0f), t.translate);
+  m = glm::rotate(m, glm::radians(t.rotate_deg.z), glm::vec3(0, 0, 1));
+  m = glm::rotate(m, glm::radians(t.rotate_deg.y), glm::vec3(0, 1, 0));
+  m = glm::rotate(m, glm::radians(t.rotate_deg.x), glm::vec3(1, 0, 0));
+  return glm::scale(m, t.scale);
+}
+
+Framebuffer make_framebuffer(const SceneDesc& scene, const RenderOptions& options) {
+  Framebuffer fb;
+  fb.width = scene.output.width;
+  fb.height = scene.output.height;
+  const std::size_t pixels = std::size_t(fb.width) * std::size_t(fb.height);
+  fb.color.resize(pixels * 3);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    fb.color[3 * i] = scene.output.background.x;
+    fb.color[3 * i + 1] = scene.output.background.y;
+    fb.color[3 * i + 2] = scene.output.background.z;
+  }
+  fb.depth.assign(pixels, 1.0f);
+  for (Aov aov : options.aovs) {
+    if (aov == Aov::Depth) fb.view_depth.assign(pixels, 0.0f);
+    if (aov == Aov::Normal) fb.normal.assign(pixels * 3, 0.0f);
+    if (aov == Aov::UV) fb.uv.assign(pixels * 2, 0.0f);
+  }
+  return fb;
+}
+
+}  // namespace
+
+std::optional<Aov> parse_aov(const std::string& name) {
+  if (name == "depth") return Aov::Depth;
+  if (name == "normal") return Aov::Normal;
+  if (name == "uv") return Aov::UV;
+  return std::nullopt;
+}
+
+std::string aov_name(Aov aov) {
+  switch (aov) {
+    case Aov::Depth: return "depth";
+    case Aov::Normal: return "normal";
+    case Aov::UV: return "uv";
+  }
+  return "?";
+}
+
+std::vector<std::string> aov_names() { return {"depth", "normal", "uv"}; }
+
+void validate_options(const RenderOptions& options) {
+  if (options.threads < 0 || options.threads > limits::kMaxThreads)
+    throw Error("--threads", "must be between 1 and " + std::to_string(limits::kMaxThreads) + " (or 0 for every core), got " +
+                                 std::to_string(options.threads));
+  if (options.tile_size < limits::kMinTileSize || options.tile_size > limits::kMaxTileSize ||
+      options.tile_size % limits::kCoarseBlockSize != 0)
+    throw Error("--tile", "must be a multiple of 8 between " + std::to_string(limits::kMinTileSize) + " and " +
+                              std::to_string(limits::kMaxTileSize) + ", got " + std::to_string(options.tile_size));
+}
+
+nlohmann::json RenderStats::to_json() const {
+  nlohmann::json j;
+  j["time_ms"] = {{"load", load_ms},         {"prepare", prepare_ms},          {"geometry", geometry_ms},
+                  {"binning", binning_ms},   {"raster_shade", raster_shade_ms}, {"write", write_ms},
+                  {"total", load_ms + prepare_ms + geometry_ms + binning_ms + raster_shade_ms + write_ms}};
+  j["triangles"] = {{"in", triangles_in}, {"culled", triangles_culled}, {"clipped", triangles_clipped},
+                    {"rasterized", triangles_rasterized}};
+  j["tiles"] = {{"count", tiles}, {"size", tile_size}, {"bin_entries", tile_bin_entries}};
+  j["blocks"] = {{"rejected", blocks_rejected}, {"full", blocks_full}, {"partial", blocks_partial}};
+  j["shading"] = {{"batches", batches}, {"quads", quads}, {"pixels_shaded", pixels_shaded},
+                  {"pixels_depth_failed", pixels_depth_failed}, {"simd_lanes", simd_lanes}, {"simd_arch", simd_arch}};
+  j["threads"] = threads;
+  j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes},
+                 {"mesh_bytes", mesh_bytes}, {"peak_rss_bytes", peak_rss_bytes}};
+  return j;
+}
+
+Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
+  validate_options(options);
+  const int threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  // Lets an arena larger than the core count run without oneTBB's warning.
+  tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+  tbb::task_arena arena(threads);
+
+  Frame frame;
+  RenderStats& stats = frame.stats;
+  stats.threads = threads;
+  stats.tile_size = options.tile_size;
+  stats.simd_lanes = simd::kLanes;
+  stats.simd_arch = simd::Arch::name();
+
+  arena.execute([&] {
+    auto start = Clock::now();
+    const LightRig lights = LightRig::from_scene(scene);
+    const Assets assets = prepare_assets(scene, lights);
+    stats.prepare_ms = ms_since(start);
+    stats.texture_bytes = assets.texture_bytes();
+    stats.mesh_bytes = assets.mesh_bytes();
+
+    start = Clock::now();
+    const Viewport viewport{scene.output.width, scene.output.height};
+    std::vector<DrawItem> draws = assets.draw_items();
+    for (std::size_t i = 0; i < draws.size(); ++i) draws[i].model = model_matrix(scene.objects[i].transform);
+    const CameraDesc& cam = scene.camera;
+    const glm::mat4 view = glm::lookAt(cam.position, cam.target, cam.up);
+    const glm::mat4 projection =
+        glm::perspective(glm::radians(cam.fov_y_deg), float(viewport.width) / float(viewport.height), cam.near, cam.far);
+    const GeometryResult geometry = run_geometry(draws, view, projection, viewport);
+    stats.geometry_ms = ms_since(start);
+    stats.triangles_in = geometry.counters.triangles_in;
+    stats.triangles_culled = geometry.counters.culled_backface + geometry.counters.culled_outside;
+    stats.triangles_clipped = geometry.counters.clipped;
+    stats.triangles_rasterized = geometry.counters.triangles_out;
+
+    start = Clock::now();
+    std::vector<TriangleSetup> setups(geometry.triangles.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
+    });
+    const TileGrid grid(viewport.width, viewport.height, options.tile_size);
+    const TileBins bins = bin_triangles(setups, grid);
+    stats.binning_ms = ms_since(start);
+    stats.tiles = std::uint64_t(grid.count());
+
+    start = Clock::now();
+    Framebuffer fb = make_framebuffer(scene, options);
+    stats.framebuffer_bytes = fb.bytes();
+    RasterContext context;
+    context.geometry = &geometry;
+    context.setups = &setups;
+    context.framebuffer = &fb;
+    for (const auto& program : assets.programs) context.programs.push_back(program.get());
+    std::vector<TileCounters> tile_counters(std::size_t(grid.count()));
+    tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
+      for (int tile = range.begin(); tile != range.end(); ++tile)
+        raster_tile(context, grid.rect(tile), bins[std::size_t(tile)], tile_counters[std::size_t(tile)]);
+    });
+    TileCounters total;
+    for (const TileCounters& c : tile_counters) total += c;  // in tile order
+    stats.raster_shade_ms = ms_since(start);
+    stats.tile_bin_entries = total.bin_entries;
+    stats.blocks_rejected = total.blocks_rejected;
+    stats.blocks_full = total.blocks_full;
+    stats.blocks_partial = total.blocks_partial;
+    stats.batches = total.batches_shaded;
+    stats.quads = total.quads_shaded;
+    stats.pixels_shaded = total.pixels_shaded;
+    stats.pixels_depth_failed = total.pixels_depth_failed;
+
+    frame.width = fb.width;
+    frame.height = fb.height;
+    frame.color = std::move(fb.color);
+    for (Aov aov : options.aovs) {
+      AovImage image{aov, 0, {}};
+      if (aov == Aov::Depth) image = {aov, 1, std::move(fb.view_depth)};
+      if (aov == Aov::Normal) image = {aov, 3, std::move(fb.normal)};
+      if (aov == Aov::UV) image = {aov, 2, std::move(fb.uv)};
+      frame.aovs.push_back(std::move(image));
+    }
+  });
+  stats.peak_rss_bytes = peak_rss_bytes();
+  return frame;
+}
+
+}  // namespace qdmr

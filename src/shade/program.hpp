@@ -1,0 +1,28 @@
+#pragma once
+// The shading program interface: one batch of lanes (whole 2x2 quads) in, colour and AOVs out.
+#include "core/simd.hpp"
+#include "raster/geometry.hpp"
+
+namespace qdmr {
+
+// Interpolated inputs of one batch. Every lane carries values, including helper lanes outside the triangle
+// (extrapolated, as on a GPU), so quad derivatives are defined; only `covered` lanes are written.
+struct Fragments {
+  simd::Float pixel_x, pixel_y;  // pixel centres
+  simd::Float varyings[kVaryingCount];
+  simd::Float view_depth;        // distance along the view axis
+  simd::Mask covered;            // inside the triangle and passed the depth test
+};
+
+struct ShadeOutput {
+  simd::Float color[3];   // linear RGB
+  simd::Float normal[3];  // world-space shading normal (for the "normal" AOV)
+};
+
+class ShadingProgram {
+public:
+  virtual ~ShadingProgram() = default;
+  virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
+};
+
+}  // namespace qdmr
