@@ -17,12 +17,13 @@ enum class TexturePurpose {
 // Deterministic procedural height pattern in [0,1], size x size, 1 channel.
 Image generate_procedural(const ProceduralDesc& desc);
 
-// Level 0 of one texture slot. `height` is the layer's height image, needed for Normal from_height and
-// procedural albedo colouring (may be null otherwise). Throws qdmr::Error(where, ...) on bad input.
+// Level 0 of one texture slot. `height` is the layer's height image, needed for Normal from_height (may be
+// null otherwise); a procedural albedo is coloured by its own pattern. from_height strength 1 is the normal of
+// a surface whose depth range (h from 0 to 1) is 1/16 of a texture repeat. Throws qdmr::Error(where, ...).
 Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerDesc& layer, const Image* height,
                    const std::string& where);
 
-// Level 0 of a layer's height (or a 1x1 zero image when the layer has none), with scale/offset applied.
+// Level 0 of a layer's height with scale/offset applied; a layer without one is flat at the top (1x1, h = 1).
 Image make_layer_height(const LayerDesc& layer, const std::string& where);
 
 // Mip levels by 2x2 box filter down to 1x1 (odd sizes: the last row/column is folded into the previous

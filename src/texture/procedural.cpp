@@ -1,0 +1,303 @@
+// Procedural height patterns. Every pattern is a function of the texel centre (u, v) in [0,1)^2 that is
+// periodic with period 1 (cell lattices wrap modulo their count), so textures tile seamlessly. Only integer
+// hashes and IEEE basic operations (+ - * / sqrt, floor) are used: the same bits on every machine.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "qdmr/texture/texture.hpp"
+#include "texture/internal.hpp"
+
+namespace qdmr {
+namespace {
+
+std::uint32_t mix(std::uint32_t h) {
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+
+// `mixed` = mix(seed), hoisted out of loops.
+std::uint32_t hash_mixed(std::uint32_t x, std::uint32_t y, std::uint32_t mixed) { return mix(x + mix(y + mixed)); }
+
+std::uint32_t hash(std::uint32_t x, std::uint32_t y, std::uint32_t seed) { return hash_mixed(x, y, mix(seed)); }
+
+// [0, 1) with 24 bits.
+double unit(std::uint32_t h) { return double(h >> 8) * (1.0 / 16777216.0); }
+
+// i modulo n for i in [-n, 2n).
+int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
+
+double fract(double x) { return x - std::floor(x); }
+
+double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
+
+double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
+
+// sin(2*pi*t) by folding to [-1/4, 1/4] and a degree-13 Taylor polynomial (error < 1e-9).
+double sin_2pi(double t) {
+  t = fract(t);
+  if (t > 0.5) t -= 1.0;
+  if (t > 0.25) t = 0.5 - t;
+  if (t < -0.25) t = -0.5 - t;
+  const double x = 6.283185307179586 * t, x2 = x * x;
+  return x * (1 - x2 / 6 * (1 - x2 / 20 * (1 - x2 / 42 * (1 - x2 / 72 * (1 - x2 / 110 * (1 - x2 / 156))))));
+}
+
+struct Texel {
+  double h;
+  double cell = 0.5;
+};
+
+// Running bond: `cells` bricks per row, 2*cells rows, odd rows shifted by half a brick. Distances are in
+// brick heights (a brick is 2 x 1); the mortar gap is `mortar` brick heights wide, bevels 0.25.
+struct Bricks {
+  int cells;
+  double mortar;
+  std::uint32_t seed;
+  Texel operator()(double u, double v) const {
+    const double py = v * (2 * cells);
+    const int row = int(std::floor(py));
+    const double fy = py - row;
+    const double px = u * cells + ((row & 1) ? 0.5 : 0.0);
+    const double col = std::floor(px);
+    const double fx = px - col;
+    const double edge = std::min(2.0 * std::min(fx, 1.0 - fx), std::min(fy, 1.0 - fy));
+    const double c = unit(hash(std::uint32_t(wrap(int(col), cells)), std::uint32_t(row), seed));
+    const double top = 1.0 - 0.1 * c;
+    return {top * smoothstep(clamp01((edge - 0.5 * mortar) / 0.25)), c};
+  }
+};
+
+// Voronoi stones, `cells` per side, each a dome (circular profile) over its distance to the cell border.
+struct Cobbles {
+  int cells;
+  double mortar;
+  std::vector<double> px, py, value;  // feature point (in cell units, within its cell) and value per cell
+
+  Cobbles(int n, double m, std::uint32_t seed) : cells(n), mortar(m) {
+    px.resize(std::size_t(n) * n);
+    py.resize(px.size());
+    value.resize(px.size());
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const std::uint32_t h = hash(std::uint32_t(i), std::uint32_t(j), seed);
+        const std::size_t k = std::size_t(j) * n + i;
+        px[k] = 0.15 + 0.7 * double(h & 0xFFFFu) / 65536.0;
+        py[k] = 0.15 + 0.7 * double(h >> 16) / 65536.0;
+        value[k] = unit(hash(std::uint32_t(i), std::uint32_t(j), seed ^ 0x5bd1e995u));
+      }
+  }
+
+  Texel operator()(double u, double v) const {
+    const double x = u * cells, y = v * cells;
+    const int ix = int(std::floor(x)), iy = int(std::floor(y));
+    double qx[9], qy[9];
+    std::size_t id[9];
+    int nearest = 0;
+    double best = 1e30;
+    for (int k = 0; k < 9; ++k) {
+      const int cx = ix + k % 3 - 1, cy = iy + k / 3 - 1;
+      id[k] = std::size_t(wrap(cy, cells)) * cells + std::size_t(wrap(cx, cells));
+      qx[k] = cx + px[id[k]];
+      qy[k] = cy + py[id[k]];
+      const double d2 = (qx[k] - x) * (qx[k] - x) + (qy[k] - y) * (qy[k] - y);
+      if (d2 < best) best = d2, nearest = k;
+    }
+    // Distance to the cell border: the nearest bisector between the nearest point and any other.
+    double edge = 1e30;
+    for (int k = 0; k < 9; ++k) {
+      if (k == nearest) continue;
+      const double dx = qx[k] - qx[nearest], dy = qy[k] - qy[nearest];
+      const double len = std::sqrt(dx * dx + dy * dy);
+      const double mx = 0.5 * (qx[k] + qx[nearest]) - x, my = 0.5 * (qy[k] + qy[nearest]) - y;
+      edge = std::min(edge, (mx * dx + my * dy) / len);
+    }
+    const double t = clamp01((edge - 0.5 * mortar) / 0.3);
+    const double c = value[id[nearest]];
+    return {(0.8 + 0.2 * c) * std::sqrt(t * (2.0 - t)), c};
+  }
+};
+
+struct Sine {
+  int cells;
+  Texel operator()(double u, double v) const {
+    return {clamp01(0.5 + 0.25 * (sin_2pi(u * cells) + sin_2pi(v * cells)))};
+  }
+};
+
+// `cells` terraces from 0 to 1 along a diagonal triangle wave (up then down once per repeat).
+struct Steps {
+  int cells;
+  std::uint32_t seed;
+  Texel operator()(double u, double v) const {
+    const double tri = 1.0 - std::abs(2.0 * fract(u + v) - 1.0);
+    const int k = std::min(int(std::floor(tri * cells)), cells - 1);
+    return {cells == 1 ? 1.0 : double(k) / (cells - 1), unit(hash(std::uint32_t(k), 0, seed))};
+  }
+};
+
+// cells x cells cones of radius half a cell, tip (h = 1) at each cell centre.
+struct Spikes {
+  int cells;
+  std::uint32_t seed;
+  Texel operator()(double u, double v) const {
+    const double x = u * cells, y = v * cells;
+    const double ix = std::floor(x), iy = std::floor(y);
+    const double dx = x - ix - 0.5, dy = y - iy - 0.5;
+    return {std::max(0.0, 1.0 - 2.0 * std::sqrt(dx * dx + dy * dy)),
+            unit(hash(std::uint32_t(ix), std::uint32_t(iy), seed))};
+  }
+};
+
+// fBm of periodic gradient noise (quintic fade, 8 gradient directions); the sum is remapped to [0,1] over
+// the image afterwards. Octaves finer than a texel are skipped (they would only alias).
+struct Noise {
+  std::vector<std::int64_t> frequency;
+  std::vector<double> amplitude;
+  std::vector<std::uint32_t> mixed_seed;
+
+  explicit Noise(const ProceduralDesc& d) {
+    double a = 1.0;
+    for (int o = 0; o < d.octaves; ++o, a *= d.gain) {
+      const std::int64_t f = std::int64_t(d.cells) << o;
+      if (o > 0 && f > d.size) break;
+      frequency.push_back(f);
+      amplitude.push_back(a);
+      mixed_seed.push_back(mix(d.seed + std::uint32_t(o) * 0x9e3779b9u));
+    }
+  }
+
+  static double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
+
+  double gradient(std::int64_t i, std::int64_t j, std::uint32_t s, double dx, double dy) const {
+    constexpr double r = 0.7071067811865476;
+    static constexpr double gx[8] = {1, -1, 0, 0, r, -r, r, -r};
+    static constexpr double gy[8] = {0, 0, 1, -1, r, r, -r, -r};
+    const std::uint32_t k = hash_mixed(std::uint32_t(i), std::uint32_t(j), s) >> 29;
+    return gx[k] * dx + gy[k] * dy;
+  }
+
+  Texel operator()(double u, double v) const {
+    double sum = 0.0;
+    for (std::size_t o = 0; o < frequency.size(); ++o) {
+      const std::int64_t f = frequency[o];
+      const std::uint32_t s = mixed_seed[o];
+      const double x = u * double(f), y = v * double(f);
+      const double fx = std::floor(x), fy = std::floor(y);
+      // u, v in (0, 1): lattice indices in [0, f), only the next one wraps.
+      const std::int64_t i = std::int64_t(fx), j = std::int64_t(fy), i1 = i + 1 == f ? 0 : i + 1, j1 = j + 1 == f ? 0 : j + 1;
+      const double tx = x - fx, ty = y - fy;
+      const double n00 = gradient(i, j, s, tx, ty), n10 = gradient(i1, j, s, tx - 1, ty);
+      const double n01 = gradient(i, j1, s, tx, ty - 1), n11 = gradient(i1, j1, s, tx - 1, ty - 1);
+      const double wx = fade(tx), wy = fade(ty);
+      const double a = n00 + (n10 - n00) * wx, b = n01 + (n11 - n01) * wx;
+      sum += amplitude[o] * (a + (b - a) * wy);
+    }
+    return {sum};
+  }
+};
+
+// The top (h = 1), so a flat pattern adds no depth.
+struct Flat {
+  Texel operator()(double, double) const { return {1.0}; }
+};
+
+// Squares of size/cells texels; an odd `cells` puts two equal squares side by side at the wrap.
+struct Checker {
+  int cells;
+  std::uint32_t seed;
+  Texel operator()(double u, double v) const {
+    const auto i = std::int64_t(std::floor(u * cells)), j = std::int64_t(std::floor(v * cells));
+    return {double((i + j) & 1), unit(hash(std::uint32_t(i), std::uint32_t(j), seed))};
+  }
+};
+
+template <class Pattern>
+Image fill(int size, bool with_cells, const Pattern& pattern) {
+  Image out(size, size, with_cells ? 2 : 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, size), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      const double v = (y + 0.5) / size;
+      for (int x = 0; x < size; ++x) {
+        const Texel t = pattern((x + 0.5) / size, v);
+        out.at(x, y, 0) = float(t.h);
+        if (with_cells) out.at(x, y, 1) = float(t.cell);
+      }
+    }
+  });
+  return out;
+}
+
+// Noise: remap the raw sums to [0,1] by the image's min and max (exact, so independent of the split).
+Image fill_normalised(int size, bool with_cells, const Noise& noise) {
+  Image out = fill(size, with_cells, noise);
+  const int c = out.channels;
+  const std::size_t n = std::size_t(size) * size;
+  using Range = std::pair<float, float>;
+  const Range range = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n), Range{out.texels[0], out.texels[0]},
+      [&](const tbb::blocked_range<std::size_t>& r, Range m) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          m = {std::min(m.first, out.texels[i * c]), std::max(m.second, out.texels[i * c])};
+        return m;
+      },
+      [](Range a, Range b) { return Range{std::min(a.first, b.first), std::max(a.second, b.second)}; });
+  const double low = range.first, span = double(range.second) - low;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      float& h = out.texels[i * c];
+      h = span > 0.0 ? float(clamp01((h - low) / span)) : 0.5f;
+    }
+  });
+  return out;
+}
+
+void validate(const ProceduralDesc& d) {
+  const auto fail = [](const std::string& what) { return Error("procedural pattern", what); };
+  if (d.size < 1 || d.size > limits::kMaxTextureSide || (d.size & (d.size - 1)) != 0)
+    throw fail("size " + std::to_string(d.size) + " is not a power of two in 1.." +
+               std::to_string(limits::kMaxTextureSide));
+  if (d.cells < 1 || d.cells > limits::kMaxTextureSide)
+    throw fail("cells " + std::to_string(d.cells) + " is outside 1.." + std::to_string(limits::kMaxTextureSide));
+  if (d.octaves < 1 || d.octaves > 16) throw fail("octaves " + std::to_string(d.octaves) + " is outside 1..16");
+  if (!(d.gain >= 0.0f && d.gain <= 1.0f)) throw fail("gain must be in [0, 1]");
+  if (!(d.mortar >= 0.0f && d.mortar < 1.0f)) throw fail("mortar must be in [0, 1)");
+}
+
+}  // namespace
+
+namespace texture_detail {
+
+Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
+  validate(d);
+  switch (d.pattern) {
+    case ProceduralPattern::Bricks: return fill(d.size, with_cells, Bricks{d.cells, d.mortar, d.seed});
+    case ProceduralPattern::Cobbles: return fill(d.size, with_cells, Cobbles(d.cells, d.mortar, d.seed));
+    case ProceduralPattern::Sine: return fill(d.size, with_cells, Sine{d.cells});
+    case ProceduralPattern::Steps: return fill(d.size, with_cells, Steps{d.cells, d.seed});
+    case ProceduralPattern::Spikes: return fill(d.size, with_cells, Spikes{d.cells, d.seed});
+    case ProceduralPattern::Noise: return fill_normalised(d.size, with_cells, Noise(d));
+    case ProceduralPattern::Flat: return fill(d.size, with_cells, Flat{});
+    case ProceduralPattern::Checker: return fill(d.size, with_cells, Checker{d.cells, d.seed});
+  }
+  throw Error("procedural pattern", "unknown pattern");
+}
+
+}  // namespace texture_detail
+
+Image generate_procedural(const ProceduralDesc& desc) { return texture_detail::generate_pattern(desc, false); }
+
+}  // namespace qdmr

@@ -1,0 +1,240 @@
+// Level-0 images of a layer's texture slots.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/texture/texture.hpp"
+#include "texture/internal.hpp"
+
+namespace qdmr {
+namespace {
+
+template <class F>
+void for_rows(int height, F&& row) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y != r.end(); ++y) row(y);
+  });
+}
+
+const char* channel_name(Channel c) {
+  switch (c) {
+    case Channel::Default: return "default";
+    case Channel::R: return "r";
+    case Channel::G: return "g";
+    case Channel::B: return "b";
+    case Channel::A: return "a";
+    case Channel::RGB: return "rgb";
+    case Channel::RGBA: return "rgba";
+  }
+  return "?";
+}
+
+// Source channel of each output channel (`count` = 1 or 3) for a selection; single channels are replicated.
+std::vector<int> select_channels(const Image& image, Channel channel, int count, const TextureDesc& desc,
+                                 const std::string& where) {
+  const auto fail = [&](const std::string& what) {
+    return Error(where, "'" + desc.file.string() + "' has " + std::to_string(image.channels) + " channel(s): " + what);
+  };
+  int single = -1;
+  switch (channel) {
+    case Channel::Default:
+      if (count == 3 && image.channels >= 3) return {0, 1, 2};
+      single = 0;
+      break;
+    case Channel::R: single = 0; break;
+    case Channel::G: single = 1; break;
+    case Channel::B: single = 2; break;
+    case Channel::A: single = 3; break;
+    case Channel::RGB:
+      if (count != 3) throw fail("channel 'rgb' selects 3 channels, this texture takes 1");
+      if (image.channels < 3) throw fail("channel 'rgb' needs 3");
+      return {0, 1, 2};
+    case Channel::RGBA: throw fail("channel 'rgba' selects 4 channels, this texture takes " + std::to_string(count));
+  }
+  if (single >= image.channels) throw fail(std::string("channel '") + channel_name(channel) + "' does not exist");
+  return std::vector<int>(std::size_t(count), single);
+}
+
+Image pick(const Image& src, const std::vector<int>& channels) {
+  Image out(src.width, src.height, int(channels.size()));
+  for_rows(src.height, [&](int y) {
+    for (int x = 0; x < src.width; ++x)
+      for (int c = 0; c < out.channels; ++c) out.at(x, y, c) = src.at(x, y, channels[std::size_t(c)]);
+  });
+  return out;
+}
+
+Image constant(std::initializer_list<float> values) {
+  Image out(1, 1, int(values.size()));
+  std::copy(values.begin(), values.end(), out.texels.begin());
+  return out;
+}
+
+// Unit vector of (x, y, z); a zero or non-finite vector becomes (0, 0, 1).
+void normalise(float& x, float& y, float& z) {
+  const double len2 = double(x) * x + double(y) * y + double(z) * z;
+  if (!(len2 > 0.0) || !std::isfinite(len2)) {
+    x = 0.0f, y = 0.0f, z = 1.0f;
+    return;
+  }
+  const double inv = 1.0 / std::sqrt(len2);
+  x = float(x * inv), y = float(y * inv), z = float(z * inv);
+}
+
+void apply_height_transform(Image& image, const LayerDesc& layer) {
+  for_rows(image.height, [&](int y) {
+    for (int x = 0; x < image.width; ++x) {
+      float& h = image.at(x, y, 0);
+      h = std::clamp(h * layer.height_scale + layer.height_offset, 0.0f, 1.0f);
+    }
+  });
+}
+
+Image albedo_texture(const TextureDesc& desc, const std::string& where) {
+  switch (desc.source) {
+    case TextureSource::None: return constant({1.0f, 1.0f, 1.0f});
+    case TextureSource::Constant: return constant({desc.constant.r, desc.constant.g, desc.constant.b});
+    case TextureSource::File: {
+      const Image file = read_image(desc.file, where);
+      Image rgb = pick(file, select_channels(file, desc.channel, 3, desc, where));
+      if (desc.srgb) {
+        // 8-bit values (k / 255 exactly, as read_image gives them) from a table; the same results, faster.
+        std::array<float, 256> table;
+        for (int k = 0; k < 256; ++k) table[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
+        for_rows(rgb.height, [&](int y) {
+          float* row = &rgb.at(0, y, 0);
+          for (int i = 0; i < rgb.width * 3; ++i) {
+            const float k = std::floor(row[i] * 255.0f + 0.5f);
+            const bool in_table = k >= 0.0f && k <= 255.0f && k / 255.0f == row[i];
+            row[i] = in_table ? table[std::size_t(k)] : texture_detail::srgb_to_linear(row[i]);
+          }
+        });
+      }
+      return rgb;
+    }
+    case TextureSource::Procedural: {
+      // lerp(color_low, color_high, h) times a brightness jitter per pattern cell.
+      const Image pattern = texture_detail::generate_pattern(desc.procedural, true);
+      Image rgb(pattern.width, pattern.height, 3);
+      for_rows(rgb.height, [&](int y) {
+        for (int x = 0; x < rgb.width; ++x) {
+          const float h = pattern.at(x, y, 0);
+          const float jitter = 1.0f + desc.variation * (pattern.at(x, y, 1) - 0.5f);
+          for (int c = 0; c < 3; ++c) {
+            const float colour = desc.color_low[c] + (desc.color_high[c] - desc.color_low[c]) * h;
+            rgb.at(x, y, c) = std::max(0.0f, colour * jitter);
+          }
+        }
+      });
+      return rgb;
+    }
+    case TextureSource::FromHeight: break;
+  }
+  throw Error(where, "an albedo texture cannot be 'from_height'");
+}
+
+// Normals of the surface z = h * kFromHeightDepth * strength (UV units), by central differences with wrap.
+Image normals_from_height(const Image& height, float strength) {
+  const int w = height.width, h = height.height;
+  Image out(w, h, 3);
+  const double kx = strength * texture_detail::kFromHeightDepth * w * 0.5;
+  const double ky = strength * texture_detail::kFromHeightDepth * h * 0.5;
+  for_rows(h, [&](int y) {
+    const int up = (y + h - 1) % h, down = (y + 1) % h;
+    for (int x = 0; x < w; ++x) {
+      const int left = (x + w - 1) % w, right = (x + 1) % w;
+      float nx = float(-kx * (double(height.at(right, y, 0)) - height.at(left, y, 0)));
+      float ny = float(-ky * (double(height.at(x, down, 0)) - height.at(x, up, 0)));
+      float nz = 1.0f;
+      normalise(nx, ny, nz);
+      out.at(x, y, 0) = nx, out.at(x, y, 1) = ny, out.at(x, y, 2) = nz;
+    }
+  });
+  return out;
+}
+
+Image normal_texture(const TextureDesc& desc, const LayerDesc& layer, const Image* height, const std::string& where) {
+  const float flip = layer.normal_convention == NormalConvention::DX ? -1.0f : 1.0f;
+  const float strength = layer.normal_strength;
+  switch (desc.source) {
+    case TextureSource::None: return constant({0.0f, 0.0f, 1.0f});
+    case TextureSource::Constant: {
+      float x = desc.constant.x * strength, y = desc.constant.y * strength, z = desc.constant.z;
+      normalise(x, y, z);
+      return constant({x, y, z});
+    }
+    case TextureSource::File: {
+      const Image file = read_image(desc.file, where);
+      if (desc.channel != Channel::Default && desc.channel != Channel::RGB)
+        throw Error(where, std::string("a normal map takes channels 'rgb', not '") + channel_name(desc.channel) + "'");
+      if (file.channels < 3)
+        throw Error(where, "'" + desc.file.string() + "' has " + std::to_string(file.channels) +
+                               " channel(s); a normal map needs 3");
+      Image out(file.width, file.height, 3);
+      for_rows(out.height, [&](int y) {
+        for (int x = 0; x < out.width; ++x) {
+          float nx = (2.0f * file.at(x, y, 0) - 1.0f) * strength;
+          float ny = (2.0f * file.at(x, y, 1) - 1.0f) * strength * flip;
+          float nz = 2.0f * file.at(x, y, 2) - 1.0f;
+          normalise(nx, ny, nz);
+          out.at(x, y, 0) = nx, out.at(x, y, 1) = ny, out.at(x, y, 2) = nz;
+        }
+      });
+      return out;
+    }
+    case TextureSource::FromHeight:
+      if (!height) throw Error(where, "a 'from_height' normal map needs the layer's height");
+      return normals_from_height(*height, strength);
+    case TextureSource::Procedural: break;
+  }
+  throw Error(where, "a normal map cannot be procedural; use 'from_height' with a procedural height");
+}
+
+Image height_texture(const TextureDesc& desc, const LayerDesc& layer, const std::string& where) {
+  Image out;
+  switch (desc.source) {
+    case TextureSource::None: return constant({1.0f});  // flat at the top, whatever the scale and offset
+    case TextureSource::Constant: out = constant({desc.constant.x}); break;
+    case TextureSource::File: {
+      const Image file = read_image(desc.file, where);
+      out = pick(file, select_channels(file, desc.channel, 1, desc, where));
+      break;
+    }
+    case TextureSource::Procedural: out = generate_procedural(desc.procedural); break;
+    case TextureSource::FromHeight: throw Error(where, "a height texture cannot be 'from_height'");
+  }
+  apply_height_transform(out, layer);
+  return out;
+}
+
+}  // namespace
+
+namespace texture_detail {
+
+float srgb_to_linear(float c) {
+  const double v = c;
+  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+}
+
+}  // namespace texture_detail
+
+Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerDesc& layer, const Image* height,
+                   const std::string& where) {
+  switch (purpose) {
+    case TexturePurpose::Albedo: return albedo_texture(desc, where);
+    case TexturePurpose::Normal: return normal_texture(desc, layer, height, where);
+    case TexturePurpose::Height: return height_texture(desc, layer, where);
+  }
+  throw Error(where, "unknown texture purpose");
+}
+
+Image make_layer_height(const LayerDesc& layer, const std::string& where) {
+  return make_texture(layer.height, TexturePurpose::Height, layer, nullptr, where);
+}
+
+}  // namespace qdmr

@@ -1,0 +1,184 @@
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/texture/texture.hpp"
+#include "support/test_support.hpp"
+#include "texture/internal.hpp"
+
+namespace qdmr {
+namespace {
+
+template <class T>
+void write_png(const std::filesystem::path& file, int w, int h, int channels, const std::vector<T>& data) {
+  auto out = OIIO::ImageOutput::create(file.string());
+  ASSERT_TRUE(out);
+  const OIIO::ImageSpec spec(w, h, channels, sizeof(T) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  ASSERT_TRUE(out->open(file.string(), spec));
+  ASSERT_TRUE(out->write_image(spec.format, data.data()));
+  ASSERT_TRUE(out->close());
+}
+
+// 8-bit RGB ramp: texel (x, y) = (x + 16y, 255 - x, 7 * y) in a 16x16 image.
+std::vector<std::uint8_t> ramp8() {
+  std::vector<std::uint8_t> data;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) data.insert(data.end(), {std::uint8_t(x + 16 * y), std::uint8_t(255 - x), std::uint8_t(7 * y)});
+  return data;
+}
+
+TEST(TextureImage, Reads8BitPngExactly) {
+  test::TempDir dir;
+  const auto data = ramp8();
+  write_png(dir / "a.png", 16, 16, 3, data);
+  const Image img = read_image(dir / "a.png", "test");
+  ASSERT_EQ(img.width, 16);
+  ASSERT_EQ(img.height, 16);
+  ASSERT_EQ(img.channels, 3);
+  for (std::size_t i = 0; i < data.size(); ++i) ASSERT_EQ(img.texels[i], data[i] / 255.0f) << i;
+}
+
+TEST(TextureImage, Reads16BitPngExactly) {
+  test::TempDir dir;
+  std::vector<std::uint16_t> data;
+  for (int i = 0; i < 8 * 4; ++i) data.push_back(std::uint16_t(i * 2047 + (i == 31 ? 1 : 0)));  // 0 .. 65535
+  write_png(dir / "b.png", 8, 4, 1, data);
+  const Image img = read_image(dir / "b.png", "test");
+  ASSERT_EQ(img.channels, 1);
+  for (std::size_t i = 0; i < data.size(); ++i) ASSERT_EQ(img.texels[i], data[i] / 65535.0f) << i;
+}
+
+TEST(TextureImage, BadFilesThrow) {
+  test::TempDir dir;
+  write_png(dir / "good.png", 16, 16, 3, ramp8());
+  const std::string bytes = test::read_file(dir / "good.png");
+  test::write_file(dir / "truncated.png", bytes.substr(0, bytes.size() / 2));
+  test::write_file(dir / "garbage.png", std::string(300, 'x'));
+  write_png(dir / "wide.png", 16385, 1, 1, std::vector<std::uint8_t>(16385, 0));  // over the texture limit
+  for (const char* name : {"truncated.png", "garbage.png", "missing.png", "wide.png"}) {
+    try {
+      read_image(dir / name, "scene.json: /materials/0");
+      ADD_FAILURE() << name << " did not throw";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("scene.json: /materials/0: cannot read '" + (dir / name).string() + "': "), std::string::npos)
+          << message;
+    }
+  }
+}
+
+TEST(TextureImage, SrgbDecodeExact) {
+  using texture_detail::srgb_to_linear;
+  EXPECT_EQ(srgb_to_linear(0.0f), 0.0f);
+  EXPECT_EQ(srgb_to_linear(1.0f), 1.0f);
+  EXPECT_EQ(srgb_to_linear(0.04045f), float(double(0.04045f) / 12.92));
+  EXPECT_EQ(srgb_to_linear(0.5f), float(std::pow(0.555 / 1.055, 2.4)));
+  EXPECT_NEAR(srgb_to_linear(0.5f), 0.21404114f, 1e-7f);
+  EXPECT_NEAR(srgb_to_linear(188 / 255.0f), 0.5028865f, 1e-6f);
+}
+
+TEST(TextureImage, AlbedoFromFileDecodesAndSelects) {
+  test::TempDir dir;
+  const auto data = ramp8();
+  write_png(dir / "a.png", 16, 16, 3, data);
+  TextureDesc d;
+  d.source = TextureSource::File;
+  d.file = dir / "a.png";
+  const LayerDesc layer;
+  const Image srgb = make_texture(d, TexturePurpose::Albedo, layer, nullptr, "t");
+  ASSERT_EQ(srgb.channels, 3);
+  EXPECT_EQ(srgb.at(5, 2, 1), texture_detail::srgb_to_linear(250 / 255.0f));
+  d.srgb = false;
+  d.channel = Channel::B;
+  const Image blue = make_texture(d, TexturePurpose::Albedo, layer, nullptr, "t");
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(blue.at(5, 2, c), 14 / 255.0f);
+  d.channel = Channel::A;
+  EXPECT_THROW(make_texture(d, TexturePurpose::Albedo, layer, nullptr, "t"), Error);
+}
+
+TEST(TextureImage, HeightChannelScaleOffset) {
+  test::TempDir dir;
+  write_png(dir / "a.png", 16, 16, 3, ramp8());
+  LayerDesc layer;
+  layer.height.source = TextureSource::File;
+  layer.height.file = dir / "a.png";
+  layer.height.channel = Channel::R;
+  layer.height_scale = 2.0f;
+  layer.height_offset = -1.0f;
+  const Image h = make_layer_height(layer, "t");
+  ASSERT_EQ(h.channels, 1);
+  EXPECT_EQ(h.at(0, 0, 0), 0.0f);  // 2 * 0 - 1, clamped
+  EXPECT_EQ(h.at(15, 15, 0), 1.0f);
+  EXPECT_EQ(h.at(4, 8, 0), 132 / 255.0f * 2.0f - 1.0f);
+  layer.height.channel = Channel::RGB;
+  EXPECT_THROW(make_layer_height(layer, "t"), Error);
+  // No height: flat at the top.
+  const Image flat = make_layer_height(LayerDesc{}, "t");
+  EXPECT_EQ(flat.width, 1);
+  EXPECT_EQ(flat.texels, std::vector<float>{1.0f});
+}
+
+TEST(TextureImage, NormalsFromFile) {
+  test::TempDir dir;
+  // (128, 64, 255): x = 1/255, y = -127/255 (GL), z = 1, before normalisation.
+  write_png(dir / "n.png", 1, 1, 3, std::vector<std::uint8_t>{128, 64, 255});
+  LayerDesc layer;
+  layer.normal.source = TextureSource::File;
+  layer.normal.file = dir / "n.png";
+  for (NormalConvention convention : {NormalConvention::GL, NormalConvention::DX}) {
+    layer.normal_convention = convention;
+    layer.normal_strength = 2.0f;
+    const Image n = make_texture(layer.normal, TexturePurpose::Normal, layer, nullptr, "t");
+    const double x = (2.0 * 128 / 255.0 - 1) * 2, y = (2.0 * 64 / 255.0 - 1) * 2 * (convention == NormalConvention::DX ? -1 : 1);
+    const double z = 1.0, len = std::sqrt(x * x + y * y + z * z);
+    EXPECT_NEAR(n.at(0, 0, 0), x / len, 1e-6);
+    EXPECT_NEAR(n.at(0, 0, 1), y / len, 1e-6);
+    EXPECT_NEAR(n.at(0, 0, 2), z / len, 1e-6);
+  }
+  const Image flat = make_texture(TextureDesc{}, TexturePurpose::Normal, layer, nullptr, "t");
+  EXPECT_EQ(flat.texels, (std::vector<float>{0, 0, 1}));
+}
+
+TEST(TextureImage, NormalsFromHeight) {
+  // A ramp h = x / 4 on 4 texels wraps: central differences 0.5 except at the wrap.
+  Image h(4, 2, 1);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) h.at(x, y, 0) = x / 4.0f;
+  LayerDesc layer;
+  layer.normal.source = TextureSource::FromHeight;
+  const Image n = make_texture(layer.normal, TexturePurpose::Normal, layer, &h, "t");
+  ASSERT_EQ(n.width, 4);
+  ASSERT_EQ(n.channels, 3);
+  // Strength 1: depth range 1/16 of a repeat. dz/du = 0.5 / 2 * 4 / 16 = 1/16 at x = 1.
+  const double s = 0.5 / 2 * 4 * texture_detail::kFromHeightDepth, len = std::sqrt(s * s + 1);
+  EXPECT_NEAR(n.at(1, 0, 0), -s / len, 1e-7);
+  EXPECT_EQ(n.at(1, 0, 1), 0.0f);
+  EXPECT_NEAR(n.at(1, 0, 2), 1 / len, 1e-7);
+  EXPECT_GT(n.at(0, 1, 0), 0.0f);  // the wrap: h falls from 0.75 to 0
+  EXPECT_THROW(make_texture(layer.normal, TexturePurpose::Normal, layer, nullptr, "t"), Error);
+}
+
+TEST(TextureImage, ProceduralAlbedo) {
+  TextureDesc d;
+  d.source = TextureSource::Procedural;
+  d.procedural.pattern = ProceduralPattern::Bricks;
+  d.procedural.size = 64;
+  const Image a = make_texture(d, TexturePurpose::Albedo, LayerDesc{}, nullptr, "t");
+  const Image b = make_texture(d, TexturePurpose::Albedo, LayerDesc{}, nullptr, "t");
+  ASSERT_EQ(a.channels, 3);
+  EXPECT_EQ(a.texels, b.texels);
+  d.variation = 0.0f;
+  const Image plain = make_texture(d, TexturePurpose::Albedo, LayerDesc{}, nullptr, "t");
+  const Image h = generate_procedural(d.procedural);
+  for (int i = 0; i < 64 * 64; ++i)
+    ASSERT_EQ(plain.texels[3 * std::size_t(i) + 1], d.color_low.g + (d.color_high.g - d.color_low.g) * h.texels[std::size_t(i)]);
+}
+
+}  // namespace
+}  // namespace qdmr

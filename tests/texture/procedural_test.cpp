@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/texture/texture.hpp"
+
+namespace qdmr {
+namespace {
+
+constexpr ProceduralPattern kAll[] = {ProceduralPattern::Bricks, ProceduralPattern::Cobbles, ProceduralPattern::Sine,
+                                      ProceduralPattern::Steps,  ProceduralPattern::Spikes,  ProceduralPattern::Noise,
+                                      ProceduralPattern::Flat,   ProceduralPattern::Checker};
+
+ProceduralDesc desc(ProceduralPattern p, int size, std::uint32_t seed = 7, int cells = 4) {
+  ProceduralDesc d;
+  d.pattern = p;
+  d.size = size;
+  d.seed = seed;
+  d.cells = cells;
+  return d;
+}
+
+TEST(TextureProcedural, DeterministicAndInRange) {
+  for (ProceduralPattern p : kAll)
+    for (int size : {1, 2, 4, 64}) {
+      const Image a = generate_procedural(desc(p, size));
+      const Image b = generate_procedural(desc(p, size));
+      ASSERT_EQ(a.width, size);
+      ASSERT_EQ(a.height, size);
+      ASSERT_EQ(a.channels, 1);
+      EXPECT_EQ(a.texels, b.texels) << int(p) << " size " << size;
+      for (float h : a.texels) ASSERT_TRUE(h >= 0.0f && h <= 1.0f) << int(p) << " size " << size << ": " << h;
+    }
+}
+
+TEST(TextureProcedural, SeedsChangeRandomPatterns) {
+  for (ProceduralPattern p : {ProceduralPattern::Bricks, ProceduralPattern::Cobbles, ProceduralPattern::Noise}) {
+    const Image a = generate_procedural(desc(p, 64, 1));
+    const Image b = generate_procedural(desc(p, 64, 2));
+    EXPECT_NE(a.texels, b.texels) << int(p);
+  }
+}
+
+TEST(TextureProcedural, KnownValues) {
+  EXPECT_EQ(generate_procedural(desc(ProceduralPattern::Flat, 4)).texels, std::vector<float>(16, 1.0f));
+  // Checker: squares of size / cells texels, texel (0, 0) black.
+  const Image checker = generate_procedural(desc(ProceduralPattern::Checker, 8, 1, 4));
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) EXPECT_EQ(checker.at(x, y, 0), float((x / 2 + y / 2) % 2)) << x << "," << y;
+  // Spikes: a cone per cell, highest next to the tip, zero at the cell corners.
+  const Image spikes = generate_procedural(desc(ProceduralPattern::Spikes, 16, 1, 2));
+  EXPECT_NEAR(spikes.at(3, 3, 0), 1.0f - 2.0f * std::sqrt(2.0f) * 0.5f / 8.0f, 1e-6f);
+  EXPECT_EQ(spikes.at(0, 0, 0), 0.0f);
+  // Steps: `cells` levels, 0 and 1 both present.
+  const Image steps = generate_procedural(desc(ProceduralPattern::Steps, 64, 1, 5));
+  std::vector<float> levels = steps.texels;
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  EXPECT_EQ(levels, (std::vector<float>{0.0f, 0.25f, 0.5f, 0.75f, 1.0f}));
+  // Noise spans the full range after normalisation.
+  const Image noise = generate_procedural(desc(ProceduralPattern::Noise, 64));
+  EXPECT_EQ(*std::min_element(noise.texels.begin(), noise.texels.end()), 0.0f);
+  EXPECT_EQ(*std::max_element(noise.texels.begin(), noise.texels.end()), 1.0f);
+}
+
+// Tileable: differences across the wrap edges look like differences between interior neighbours.
+TEST(TextureProcedural, Tileable) {
+  for (ProceduralPattern p : kAll) {
+    if (p == ProceduralPattern::Checker) continue;  // hard edges by design; exact values tested above
+    const int n = 128;
+    const Image img = generate_procedural(desc(p, n, 3, 4));
+    double interior_max = 0, interior_sum = 0, edge_max = 0, edge_sum = 0;
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b + 1 < n; ++b) {
+        const double dx = std::abs(img.at(b + 1, a, 0) - img.at(b, a, 0));
+        const double dy = std::abs(img.at(a, b + 1, 0) - img.at(a, b, 0));
+        interior_max = std::max({interior_max, dx, dy});
+        interior_sum += dx + dy;
+      }
+      const double ex = std::abs(img.at(0, a, 0) - img.at(n - 1, a, 0));
+      const double ey = std::abs(img.at(a, 0, 0) - img.at(a, n - 1, 0));
+      edge_max = std::max({edge_max, ex, ey});
+      edge_sum += ex + ey;
+    }
+    const double interior_mean = interior_sum / (2.0 * n * (n - 1)), edge_mean = edge_sum / (2.0 * n);
+    EXPECT_LE(edge_max, interior_max) << int(p);
+    EXPECT_LE(edge_mean, 3.0 * interior_mean + 1e-6) << int(p);
+  }
+}
+
+TEST(TextureProcedural, RejectsBadParameters) {
+  EXPECT_THROW(generate_procedural(desc(ProceduralPattern::Noise, 3)), Error);
+  EXPECT_THROW(generate_procedural(desc(ProceduralPattern::Noise, 0)), Error);
+  EXPECT_THROW(generate_procedural(desc(ProceduralPattern::Noise, 32768)), Error);
+  EXPECT_THROW(generate_procedural(desc(ProceduralPattern::Bricks, 64, 1, 0)), Error);
+}
+
+TEST(TextureProcedural, Large4096) {
+  const auto start = std::chrono::steady_clock::now();
+  const Image img = generate_procedural(desc(ProceduralPattern::Cobbles, 4096, 5, 16));
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("cobbles 4096^2: %.0f ms\n", ms);
+  ASSERT_EQ(img.texels.size(), 4096u * 4096u);
+  const auto [lo, hi] = std::minmax_element(img.texels.begin(), img.texels.end());
+  EXPECT_EQ(*lo, 0.0f);  // mortar
+  EXPECT_GT(*hi, 0.75f);
+  EXPECT_LE(*hi, 1.0f);
+}
+
+}  // namespace
+}  // namespace qdmr
