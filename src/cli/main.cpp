@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "Render a scene to an image");
   render_cmd->add_option("scene", render_scene.scene, "Scene file (JSON)")->required();
-  render_cmd->add_option("-o,--output", render.output, "Output image: .png (8-bit sRGB), .tif (16-bit sRGB) or .exr (linear half)")
+  render_cmd->add_option("-o,--output", render.output, "Output image: .png (8-bit sRGB), .tif (16-bit sRGB) or .exr (linear float)")
       ->required();
   render_cmd->add_option("--width", render.width, "Override /output/width (pixels)")->check(CLI::PositiveNumber);
   render_cmd->add_option("--height", render.height, "Override /output/height (pixels)")->check(CLI::PositiveNumber);

@@ -67,8 +67,8 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
     bytes16 = quantize<std::uint16_t>(pixels, 65535.0f, true);
     data = bytes16.data();
   }
-  OIIO::ImageSpec spec(width, height, channels, container == Container::Exr ? OIIO::TypeDesc::HALF : format);
-  if (container == Container::Exr && !srgb) spec.set_format(OIIO::TypeDesc::FLOAT);
+  // EXR keeps full float precision, so files can be compared bit for bit.
+  OIIO::ImageSpec spec(width, height, channels, format);
   if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
   auto output = OIIO::ImageOutput::create(temporary.string());
   bool ok = output && output->open(temporary.string(), spec) && output->write_image(format, data) && output->close();

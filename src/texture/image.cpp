@@ -26,8 +26,12 @@ Image read_image(const std::filesystem::path& file, const std::string& where) {
   if (spec.nchannels < 1 || spec.nchannels > 4)
     throw fail(std::to_string(spec.nchannels) + " channels (textures take 1 to 4)");
   Image image(spec.width, spec.height, spec.nchannels);
+  // Rows are stored bottom-up: the file's last row becomes row 0 (v = 0), the OpenGL/OBJ convention, so
+  // UVs from OBJ files and +Y-up (GL) normal maps need no flipping.
   const auto read = [&](OIIO::TypeDesc type, void* data) {
-    if (!in->read_image(0, 0, 0, spec.nchannels, type, data)) {
+    const OIIO::stride_t row = OIIO::stride_t(type.size()) * spec.nchannels * spec.width;
+    char* last_row = static_cast<char*>(data) + row * (spec.height - 1);
+    if (!in->read_image(0, 0, 0, spec.nchannels, type, last_row, OIIO::AutoStride, -row)) {
       const std::string message = in->geterror();
       throw fail(message.empty() ? OIIO::geterror() : message);
     }

@@ -196,8 +196,9 @@ TEST(Mesh, FlatGridMatchesThePlane) {
 
 TEST(Mesh, GridHeightMapDisplacesBilinearly) {
   test::TempDir dir;
-  // 2x2 height map, row 0 at v = 0: h = 0 at (u,v) texel (0,0), 1 elsewhere.
-  test::write_file(dir / "h.pgm", "P2\n2 2\n255\n0 255\n255 255\n");
+  // 2x2 height map: h = 0 at (u,v) texel (0,0), 1 elsewhere. Files are read bottom-up (their last row is
+  // v = 0), so the zero is the first value of the file's second row.
+  test::write_file(dir / "h.pgm", "P2\n2 2\n255\n255 255\n0 255\n");
   MeshDesc d = primitive(MeshKind::Grid);
   d.resolution = 4;
   d.size = {2.0f, 2.0f};

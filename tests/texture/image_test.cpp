@@ -21,7 +21,11 @@ void write_png(const std::filesystem::path& file, int w, int h, int channels, co
   ASSERT_TRUE(out);
   const OIIO::ImageSpec spec(w, h, channels, sizeof(T) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   ASSERT_TRUE(out->open(file.string(), spec));
-  ASSERT_TRUE(out->write_image(spec.format, data.data()));
+  // data holds texel rows (row 0 = v = 0); files store the top row first and qdmr reads them bottom-up,
+  // so the rows are written in reverse.
+  const OIIO::stride_t row = OIIO::stride_t(sizeof(T)) * channels * w;
+  ASSERT_TRUE(out->write_image(spec.format, reinterpret_cast<const char*>(data.data()) + row * (h - 1),
+                               OIIO::AutoStride, -row));
   ASSERT_TRUE(out->close());
 }
 
@@ -42,6 +46,19 @@ TEST(TextureImage, Reads8BitPngExactly) {
   ASSERT_EQ(img.height, 16);
   ASSERT_EQ(img.channels, 3);
   for (std::size_t i = 0; i < data.size(); ++i) ASSERT_EQ(img.texels[i], data[i] / 255.0f) << i;
+}
+
+TEST(TextureImage, LastRowOfTheFileIsRowZero) {
+  test::TempDir dir;
+  const std::vector<std::uint8_t> top_first = {10, 20, 30, 40, 50, 60};  // 2 wide, 3 tall, as stored in the file
+  auto out = OIIO::ImageOutput::create((dir / "rows.png").string());
+  ASSERT_TRUE(out->open((dir / "rows.png").string(), OIIO::ImageSpec(2, 3, 1, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, top_first.data()));
+  ASSERT_TRUE(out->close());
+  const Image img = read_image(dir / "rows.png", "test");
+  EXPECT_EQ(img.at(0, 0, 0), 50 / 255.0f);
+  EXPECT_EQ(img.at(1, 0, 0), 60 / 255.0f);
+  EXPECT_EQ(img.at(0, 2, 0), 10 / 255.0f);
 }
 
 TEST(TextureImage, Reads16BitPngExactly) {

@@ -58,7 +58,7 @@ struct Frame {
 
 Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
 
-// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: half-float linear) through a temporary
+// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear) through a temporary
 // file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file);
 // Writes one AOV (EXR/TIFF: float data; PNG: 8-bit, normals mapped to 0.5 + 0.5 n, depth divided by its maximum).

@@ -1,5 +1,6 @@
 #pragma once
 // Image: a level of texels as 32-bit floats, row-major, interleaved channels, row 0 at v = 0.
+// Files are read bottom-up: the last row of an image file is row 0 (OpenGL convention).
 #include <cstddef>
 #include <filesystem>
 #include <string>
