@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -105,6 +106,13 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 
+  // Progress only on a terminal: logs and CI stay quiet.
+  if (::isatty(STDERR_FILENO))
+    options.progress = [](const char* stage, double fraction) {
+      std::fprintf(stderr, "\r%-8s %3d%%", stage, int(fraction * 100.0 + 0.5));
+      if (fraction >= 1.0 && std::string_view(stage) == "raster") std::fprintf(stderr, "\r%15s\r", "");
+      std::fflush(stderr);
+    };
   qdmr::Frame frame = qdmr::render_frame(scene, options);
   frame.stats.load_ms = load_ms;
 

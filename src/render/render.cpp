@@ -2,8 +2,10 @@
 
 #include <sys/resource.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include <glm/ext/matrix_clip_space.hpp>
@@ -126,11 +128,20 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
   stats.simd_lanes = simd::kLanes;
   stats.simd_arch = simd::Arch::name();
 
+  std::mutex progress_mutex;
+  const auto report = [&](const char* stage, double fraction) {
+    if (!options.progress) return;
+    std::lock_guard lock(progress_mutex);
+    options.progress(stage, fraction);
+  };
+
   arena.execute([&] {
     auto start = Clock::now();
+    report("prepare", 0.0);
     const LightRig lights = LightRig::from_scene(scene);
     const Assets assets = prepare_assets(scene, lights);
     stats.prepare_ms = ms_since(start);
+    report("prepare", 1.0);
     stats.texture_bytes = assets.texture_bytes();
     stats.mesh_bytes = assets.mesh_bytes();
 
@@ -169,10 +180,17 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     context.framebuffer = &fb;
     for (const auto& program : assets.programs) context.programs.push_back(program.get());
     std::vector<TileCounters> tile_counters(std::size_t(grid.count()));
+    std::atomic<int> tiles_done{0};
+    const int report_every = std::max(1, grid.count() / 100);
+    report("raster", 0.0);
     tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
-      for (int tile = range.begin(); tile != range.end(); ++tile)
+      for (int tile = range.begin(); tile != range.end(); ++tile) {
         raster_tile(context, grid.rect(tile), bins[std::size_t(tile)], tile_counters[std::size_t(tile)]);
+        const int done = ++tiles_done;
+        if (done % report_every == 0) report("raster", double(done) / grid.count());
+      }
     });
+    report("raster", 1.0);
     TileCounters total;
     for (const TileCounters& c : tile_counters) total += c;  // in tile order
     stats.raster_shade_ms = ms_since(start);

@@ -6,6 +6,7 @@
 //   qdmr::write_frame(frame, "plane.png");
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,9 @@ struct RenderOptions {
   int threads = 0;     // 0 = every core
   int tile_size = 64;  // pixels, a multiple of 8 in [8, 1024]
   std::vector<Aov> aovs;
+  // Called with a stage name ("prepare", "raster") and the fraction done, from any worker thread,
+  // never concurrently with itself. Optional.
+  std::function<void(const char* stage, double fraction)> progress;
 };
 
 // Throws qdmr::Error("option", ...) when options are out of range.

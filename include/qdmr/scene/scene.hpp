@@ -150,7 +150,7 @@ struct SceneDesc {
   OutputDesc output;
   CameraDesc camera;
   LightsDesc lights;
-  std::vector<MaterialDesc> materials;  // in file order
+  std::vector<MaterialDesc> materials;  // sorted by name (JSON objects are unordered)
   std::vector<ObjectDesc> objects;      // submission order
 
   const MaterialDesc* find_material(const std::string& name) const {
