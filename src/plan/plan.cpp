@@ -27,6 +27,9 @@ const char* filter_name(Filter f) {
     case Filter::Point: return "point";
     case Filter::Bilinear: return "bilinear";
     case Filter::Trilinear: return "trilinear";
+    case Filter::PointMipPoint: return "point_mip_point";
+    case Filter::PointMipLinear: return "point_mip_linear";
+    case Filter::LinearMipPoint: return "linear_mip_point";
   }
   return "?";
 }

@@ -58,8 +58,12 @@ OutputDesc read_output(const Value& value) {
   if (auto v = object.find("height")) output.height = static_cast<int>(v->integer(1, limits::kMaxImageSide));
   if (auto v = object.find("background")) output.background = v->color();
 
-  const std::uint64_t bytes =
-      static_cast<std::uint64_t>(output.width) * static_cast<std::uint64_t>(output.height) * kFrameBytesPerPixel;
+  const std::uint64_t pixels = static_cast<std::uint64_t>(output.width) * static_cast<std::uint64_t>(output.height);
+  if (pixels > limits::kMaxImagePixels)
+    value.fail("an output of " + std::to_string(output.width) + "x" + std::to_string(output.height) + " has " +
+               std::to_string(pixels) + " pixels, more than the limit of " + std::to_string(limits::kMaxImagePixels) +
+               " (16384x8192)");
+  const std::uint64_t bytes = pixels * kFrameBytesPerPixel;
   if (const auto memory = physical_memory_bytes(); memory && bytes > *memory) {
     value.fail("an output of " + std::to_string(output.width) + "x" + std::to_string(output.height) + " needs about " +
                std::to_string(bytes / kMiB) + " MiB of frame buffers, more than this machine's " +
@@ -131,9 +135,24 @@ LightsDesc read_lights(const Value& value) {
 
 enum class Slot { Albedo, Normal, Height };
 
+// Height storage: "format" (auto, r8, r16, r32f) and "compression" (none, bc3).
+void read_height_storage(const Object& object, TextureDesc& texture) {
+  if (auto v = object.find("format"))
+    texture.format = v->choice<TextureFormatChoice>({{"auto", TextureFormatChoice::Auto},
+                                                     {"r8", TextureFormatChoice::R8},
+                                                     {"r16", TextureFormatChoice::R16},
+                                                     {"r32f", TextureFormatChoice::R32F}});
+  if (auto v = object.find("compression")) {
+    texture.compression = v->choice<Compression>({{"none", Compression::None}, {"bc3", Compression::Bc3}});
+    v->require(texture.compression == Compression::None || texture.format == TextureFormatChoice::Auto ||
+                   texture.format == TextureFormatChoice::R8,
+               "bc3 stores 8-bit heights: use format r8 or auto");
+  }
+}
+
 void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
   const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb"})
-                        : slot == Slot::Height ? Object(value, {"file", "channel"})
+                        : slot == Slot::Height ? Object(value, {"file", "channel", "format", "compression"})
                                                : Object(value, {"file"});
   texture.source = TextureSource::File;
   texture.file = object.required("file").existing_file();
@@ -148,13 +167,15 @@ void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
                "a height reads one channel: r, g, b or a");
   }
   if (auto v = object.find("srgb")) texture.srgb = v->boolean();
+  if (slot == Slot::Height) read_height_storage(object, texture);
 }
 
 void read_procedural(const Value& value, Slot slot, TextureDesc& texture) {
   const Object object = slot == Slot::Albedo
                             ? Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar",
                                              "color_low", "color_high", "variation"})
-                            : Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar"});
+                            : Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar",
+                                             "format", "compression"});
   texture.source = TextureSource::Procedural;
   ProceduralDesc& p = texture.procedural;
   p.pattern = object.required("procedural")
@@ -179,6 +200,7 @@ void read_procedural(const Value& value, Slot slot, TextureDesc& texture) {
   if (auto v = object.find("color_low")) texture.color_low = v->color();
   if (auto v = object.find("color_high")) texture.color_high = v->color();
   if (auto v = object.find("variation")) texture.variation = static_cast<float>(v->number_in(0.0, 1.0));
+  if (slot != Slot::Albedo) read_height_storage(object, texture);
 }
 
 void read_constant(const Value& value, Slot slot, TextureDesc& texture) {
@@ -275,14 +297,31 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
     if (auto t = technique.find("depth_scale")) material.technique.depth_scale = static_cast<float>(t->positive());
   }
   if (auto v = object.find("sampling")) {
-    const Object sampling(*v, {"filter", "address", "lod_bias"});
+    const Object sampling(*v, {"filter", "address", "precision", "lod", "lod_bias", "min_lod", "max_lod", "math"});
+    SamplingDesc& d = material.sampling;
     if (auto s = sampling.find("filter"))
-      material.sampling.filter = s->choice<Filter>(
-          {{"point", Filter::Point}, {"bilinear", Filter::Bilinear}, {"trilinear", Filter::Trilinear}});
+      d.filter = s->choice<Filter>({{"point", Filter::Point},
+                                    {"bilinear", Filter::Bilinear},
+                                    {"trilinear", Filter::Trilinear},
+                                    {"point_mip_point", Filter::PointMipPoint},
+                                    {"point_mip_linear", Filter::PointMipLinear},
+                                    {"linear_mip_point", Filter::LinearMipPoint}});
     if (auto s = sampling.find("address"))
-      material.sampling.address = s->choice<AddressMode>(
+      d.address = s->choice<AddressMode>(
           {{"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp}, {"mirror", AddressMode::Mirror}});
-    if (auto s = sampling.find("lod_bias")) material.sampling.lod_bias = static_cast<float>(s->number());
+    if (auto s = sampling.find("precision"))
+      d.precision = s->choice<SamplePrecision>(
+          {{"exact", SamplePrecision::Exact}, {"hw8", SamplePrecision::Hw8}, {"hw6", SamplePrecision::Hw6}});
+    if (auto s = sampling.find("lod"))
+      d.lod = s->choice<LodMode>({{"per_quad", LodMode::PerQuad}, {"per_pixel", LodMode::PerPixel}});
+    if (auto s = sampling.find("lod_bias")) d.lod_bias = static_cast<float>(s->number_in(-16.0, 16.0));
+    if (auto s = sampling.find("min_lod")) d.min_lod = static_cast<float>(s->number_in(0.0, 16.0));
+    if (auto s = sampling.find("max_lod")) {
+      d.max_lod = static_cast<float>(s->number_in(0.0, 16.0));
+      s->require(d.max_lod >= d.min_lod, "must not be below min_lod");
+    }
+    if (auto s = sampling.find("math"))
+      d.math = s->choice<MathMode>({{"sm4", MathMode::Sm4}, {"sm3", MathMode::Sm3}, {"exact", MathMode::Exact}});
   }
   if (auto v = object.find("lighting")) {
     const Object lighting(*v, {"model", "specular", "shininess"});

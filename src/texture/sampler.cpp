@@ -153,8 +153,11 @@ void sample(const MipChain& chain, const SamplerState& state, const Float& u, co
   l = xsimd::select(l == l, l, last);  // NaN: the coarsest level, as for non-finite derivatives
   l = xsimd::min(xsimd::max(l, Float(0.0f)), last);
   switch (state.filter) {
-    case Filter::Point: sample_point(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
-    case Filter::Bilinear: sample_bilinear(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
+    case Filter::Point:
+    case Filter::PointMipPoint: sample_point(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
+    case Filter::Bilinear:
+    case Filter::LinearMipPoint: sample_bilinear(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
+    case Filter::PointMipLinear:
     case Filter::Trilinear: {
       const Float l0 = xsimd::floor(l), f = l - l0;
       Float fine[4], coarse[4];

@@ -63,8 +63,15 @@ enum class Channel { Default, R, G, B, A, RGB, RGBA };
 // One texture slot. For albedo: colour from a file (sRGB decoded unless srgb=false), a constant,
 // or a procedural pattern coloured between color_low and color_high. For normals: a file, or
 // "from_height" (derived from the layer's height by central differences). For heights: one channel.
+enum class TextureFormatChoice { Auto, R8, RG8, RGBA8, R16, R32F };
+enum class Compression { None, Bc3 };
+
 struct TextureDesc {
   TextureSource source = TextureSource::None;
+  // Storage format. Auto: colour and normals RGBA8; heights R8 from 8-bit files, R16 from 16-bit files and
+  // procedural patterns, R32F from float files.
+  TextureFormatChoice format = TextureFormatChoice::Auto;
+  Compression compression = Compression::None;  // heights only: BC3/DXT5 alpha blocks (implies R8)
   std::filesystem::path file;        // absolute after loading (resolved against the scene file)
   Channel channel = Channel::Default;
   bool srgb = true;                  // albedo files only
@@ -94,13 +101,33 @@ struct TechniqueDesc {
   float depth_scale = 0.05f;  // surface depth in UV units of one texture repeat (used by later techniques)
 };
 
-enum class Filter { Point, Bilinear, Trilinear };
+// Texture filters, named as in OpenGL/D3D: texel filter (point = nearest, linear = bilinear) and mip filter
+// (none = level 0 only, point = nearest level, linear = between the two nearest levels).
+enum class Filter {
+  Point,           // nearest texel of level 0 (GL_NEAREST)
+  Bilinear,        // bilinear on level 0 (GL_LINEAR)
+  Trilinear,       // bilinear on two levels, blended (GL_LINEAR_MIPMAP_LINEAR)
+  PointMipPoint,   // nearest texel of the nearest level (GL_NEAREST_MIPMAP_NEAREST; tex2Dlod with point sampling)
+  PointMipLinear,  // nearest texel on two levels, blended (GL_NEAREST_MIPMAP_LINEAR)
+  LinearMipPoint   // bilinear on the nearest level (GL_LINEAR_MIPMAP_NEAREST)
+};
 enum class AddressMode { Wrap, Clamp, Mirror };
+// Filter weights and LOD fraction: exact floats, or quantised to 8 (D3D11 class) or 6 (D3D10 class) bits.
+enum class SamplePrecision { Exact, Hw8, Hw6 };
+// LOD from the derivatives of the 2x2 quad (what hardware does) or of each pixel's own row/column.
+enum class LodMode { PerQuad, PerPixel };
+// Shader arithmetic for texel and cell addressing: 32-bit integers (SM4), fp32 emulation (SM3), fp64.
+enum class MathMode { Sm4, Sm3, Exact };
 
 struct SamplingDesc {
   Filter filter = Filter::Trilinear;
   AddressMode address = AddressMode::Wrap;
+  SamplePrecision precision = SamplePrecision::Exact;
+  LodMode lod = LodMode::PerQuad;
   float lod_bias = 0.0f;
+  float min_lod = 0.0f;    // LOD clamp, in levels
+  float max_lod = 16.0f;
+  MathMode math = MathMode::Sm4;
 };
 
 enum class LightingModel { BlinnPhong };

@@ -1,0 +1,62 @@
+#pragma once
+// Texture: a typed mip chain in one contiguous block (so a SIMD gather can address any level with 32-bit
+// byte offsets), built from a float level 0 with a reduction chosen by purpose:
+//   Box        colour and data: 2x2 average (in linear light for sRGB), re-quantised per level
+//   BoxNormal  normals stored as 0.5 + 0.5 n: averaged, renormalised, re-quantised
+//   Max / Min  heights: each texel of level k+1 is the max (min) of the level-k texels it covers — the
+//              quadtree of QDM (max height = min depth); exact in the stored integers, so conservative.
+// Level k+1 has max(1, floor(n/2)) texels per axis; on an odd axis the last texel also covers the leftover
+// row/column (3 taps), so every texel of level k is covered by exactly one parent and Max/Min stay conservative.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "qdmr/texture/format.hpp"
+#include "qdmr/texture/image.hpp"
+
+namespace qdmr {
+
+enum class MipReduce : std::uint8_t { Box, BoxNormal, Max, Min };
+
+struct TextureLevel {
+  int width = 0, height = 0;
+  std::size_t offset = 0;  // byte offset of texel (0, 0) in Texture::storage
+};
+
+class Texture {
+public:
+  // Gathers read 4 bytes at any texel address: storage keeps this many bytes of zero padding at the end.
+  static constexpr std::size_t kTailPadding = 4;
+
+  TexelFormat format = TexelFormat::R8;
+  bool srgb = false;  // RGBA8/RG8/R8 colour: the rgb channels are sRGB-encoded
+  std::vector<TextureLevel> levels;
+  std::vector<std::uint8_t> storage;
+
+  int width() const { return levels.empty() ? 0 : levels[0].width; }
+  int height() const { return levels.empty() ? 0 : levels[0].height; }
+  int level_count() const { return int(levels.size()); }
+  int channels() const { return channel_count(format); }
+  std::size_t bytes() const { return storage.size(); }
+
+  const std::uint8_t* texel_address(int level, int x, int y) const {
+    const TextureLevel& l = levels[std::size_t(level)];
+    return storage.data() + l.offset + (std::size_t(y) * std::size_t(l.width) + std::size_t(x)) * bytes_per_texel(format);
+  }
+  // Channel c of a texel as a float (UNORM normalised, sRGB decoded for rgb). Scalar; for tests and tools.
+  float texel(int level, int x, int y, int c) const;
+  // A level as a float image (decoded like texel()).
+  Image level_image(int level) const;
+};
+
+// Allocates the chain for a w x h level 0 (all levels, zeroed, with the tail padding).
+Texture allocate_texture(int width, int height, TexelFormat format, bool srgb);
+
+// Quantises level 0 (values in [0,1]; normals as 0.5 + 0.5 n already) into `format` and builds the chain.
+// Channels beyond the image's are filled with 0 (alpha with 1). Rounds to nearest; clamps to [0,1].
+Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, MipReduce reduce);
+
+// Rebuilds levels 1.. from level 0 with the given reduction (level 0 already filled in storage).
+void build_mip_levels(Texture& texture, MipReduce reduce);
+
+}  // namespace qdmr

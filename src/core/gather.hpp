@@ -1,0 +1,63 @@
+#pragma once
+// Per-lane loads for texel fetch. The AVX2 build uses the hardware gathers (xsimd 8.1 never emits them);
+// the portable versions load lane by lane. Both return the same bits; FetchPath picks one at run time so
+// they can be measured side by side.
+#include <cstdint>
+#include <cstring>
+
+#include "core/simd.hpp"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+namespace qdmr::simd {
+
+enum class FetchPath : std::uint8_t { Gather, Portable };
+
+inline constexpr bool kHasHardwareGather =
+#if defined(__AVX2__)
+    true;
+#else
+    false;
+#endif
+
+// 4 bytes at base + byte_offset[lane] (unaligned), as a little-endian int32 per lane.
+inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPath path) {
+#if defined(__AVX2__)
+  static_assert(kLanes == 8, "the AVX2 gather path holds 8 lanes");
+  if (path == FetchPath::Gather)
+    return Int(_mm256_i32gather_epi32(reinterpret_cast<const int*>(base), __m256i(byte_offset), 1));
+#endif
+  (void)path;
+  alignas(64) std::int32_t offset[kLanes], value[kLanes];
+  byte_offset.store_aligned(offset);
+  for (int lane = 0; lane < kLanes; ++lane) std::memcpy(&value[lane], base + offset[lane], 4);
+  return Int::load_aligned(value);
+}
+
+// table[index[lane]] for int32 and float tables.
+inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path) {
+#if defined(__AVX2__)
+  if (path == FetchPath::Gather) return Int(_mm256_i32gather_epi32(table, __m256i(index), 4));
+#endif
+  (void)path;
+  alignas(64) std::int32_t i[kLanes], value[kLanes];
+  index.store_aligned(i);
+  for (int lane = 0; lane < kLanes; ++lane) value[lane] = table[i[lane]];
+  return Int::load_aligned(value);
+}
+
+inline Float load_f32(const float* table, const Int& index, FetchPath path) {
+#if defined(__AVX2__)
+  if (path == FetchPath::Gather) return Float(_mm256_i32gather_ps(table, __m256i(index), 4));
+#endif
+  (void)path;
+  alignas(64) std::int32_t i[kLanes];
+  alignas(64) float value[kLanes];
+  index.store_aligned(i);
+  for (int lane = 0; lane < kLanes; ++lane) value[lane] = table[i[lane]];
+  return Float::load_aligned(value);
+}
+
+}  // namespace qdmr::simd
