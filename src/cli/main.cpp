@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <string_view>
 
@@ -28,7 +29,7 @@ struct SceneArgs {
 
 struct RenderArgs {
   std::string output;
-  int width = 0, height = 0;
+  std::optional<int> width, height;  // absent: the scene's; checked like the scene's values
   int threads = -1;  // absent: every core
   int tile = qdmr::RenderOptions{}.tile_size;
   std::string stats;
@@ -37,8 +38,8 @@ struct RenderArgs {
 std::vector<qdmr::SceneOverride> overrides(const SceneArgs& args, const RenderArgs* render) {
   std::vector<qdmr::SceneOverride> result;
   for (const std::string& s : args.sets) result.push_back(qdmr::parse_override(s));
-  if (render && render->width > 0) result.push_back({"/output/width", std::to_string(render->width)});
-  if (render && render->height > 0) result.push_back({"/output/height", std::to_string(render->height)});
+  if (render && render->width) result.push_back({"/output/width", std::to_string(*render->width)});
+  if (render && render->height) result.push_back({"/output/height", std::to_string(*render->height)});
   return result;
 }
 
@@ -101,6 +102,9 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
                                                                   ? std::filesystem::path(".")
                                                                   : std::filesystem::path(render.stats).parent_path()))
     throw qdmr::Error("--stats " + render.stats, "folder does not exist");
+  std::error_code ec;
+  if (!render.stats.empty() && std::filesystem::equivalent(render.stats, args.scene, ec))
+    throw qdmr::Error("--stats " + render.stats, "refusing to overwrite the scene file");
 
   auto start = Clock::now();
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
@@ -164,8 +168,8 @@ int main(int argc, char** argv) {
   render_cmd->add_option("scene", render_scene.scene, "Scene file (JSON)")->required();
   render_cmd->add_option("-o,--output", render.output, "Output image: .png (8-bit sRGB), .tif (16-bit sRGB) or .exr (linear float)")
       ->required();
-  render_cmd->add_option("--width", render.width, "Override /output/width (pixels)")->check(CLI::PositiveNumber);
-  render_cmd->add_option("--height", render.height, "Override /output/height (pixels)")->check(CLI::PositiveNumber);
+  render_cmd->add_option("--width", render.width, "Override /output/width (pixels)");
+  render_cmd->add_option("--height", render.height, "Override /output/height (pixels)");
   render_cmd->add_option("--threads", render.threads, "Worker threads (default: every core)");
   render_cmd->add_option("--tile", render.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
   render_cmd->add_option("--set", render_scene.sets,
@@ -182,6 +186,14 @@ int main(int argc, char** argv) {
   plan_cmd->add_option("--aov", plan_scene.aovs, "AOV names to plan for (repeatable)");
   plan_cmd->add_flag("--json", plan_json, "Print the plan as JSON");
 
+  // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("qdmr: error: ") + e.what() + " (see qdmr --help)\n";
+  });
+  if (argc < 2) {
+    std::fputs(app.help().c_str(), stderr);
+    return kExitBadInput;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -94,6 +95,24 @@ void check_face_indices(const std::string& text, const std::string& where) {
                std::to_string(count) + " " + kNames[k] + (count == 1 ? "" : "s") +
                (index > 0 ? " in the file)" : " before this line)"));
       }
+    }
+  });
+}
+
+// tinyobjloader reads "nan", "inf" and other words as 0 without a warning: check every number of the v, vt
+// and vn lines first (up to an end-of-line comment). Values too large for float are left to check_finite.
+void check_vertex_numbers(const std::string& text, const std::string& where) {
+  static constexpr const char* kNames[3] = {"position", "texture coordinate", "normal"};
+  for_each_line(text, [&](std::size_t line_no, std::string_view line) {
+    const int kind = line_kind(line);
+    if (kind < 0 || kind > 2) return;
+    std::istringstream tokens{std::string(line.substr(kind == 0 ? 1 : 2))};
+    for (std::string token; tokens >> token && !token.starts_with('#');) {
+      char* end = nullptr;
+      const double value = std::strtod(token.c_str(), &end);
+      if (end != token.c_str() + token.size() || !std::isfinite(value))
+        throw Error(where, "line " + std::to_string(line_no) + ": " + kNames[kind] + " component '" + token +
+                               "' is not a finite number");
     }
   });
 }
@@ -215,6 +234,7 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
   const std::string text = read_text(file, where);
   check_face_indices(text, where);
+  check_vertex_numbers(text, where);
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;

@@ -12,7 +12,10 @@ namespace qdmr {
 
 Image read_image(const std::filesystem::path& file, const std::string& where) {
   const std::string name = file.string();
-  const auto fail = [&](const std::string& message) {
+  // OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line.
+  const auto fail = [&](std::string message) {
+    while (!message.empty() && message.back() == '\n') message.pop_back();
+    for (std::size_t at; (at = message.find('\n')) != std::string::npos;) message.replace(at, 1, "; ");
     return Error(where, "cannot read '" + name + "': " + (message.empty() ? "unknown error" : message));
   };
   auto in = OIIO::ImageInput::open(name);

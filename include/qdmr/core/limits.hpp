@@ -5,6 +5,7 @@
 namespace qdmr::limits {
 
 inline constexpr int kMaxImageSide = 16384;         // output width/height and texture side
+inline constexpr std::uint64_t kMaxImagePixels = 1ull << 27;  // output width x height (16384 x 8192, ~8 GiB of buffers)
 inline constexpr int kMaxTextureSide = 16384;
 inline constexpr int kSubpixelBits = 8;             // fixed-point triangle setup
 inline constexpr int kSubpixelScale = 1 << kSubpixelBits;
