@@ -58,4 +58,29 @@ inline Float quad_ddy(const Float& v) {
   return Float::load_aligned(a);
 }
 
+// Fine derivatives (per pixel): d/dx from the pixel's own row of the quad, d/dy from its own column.
+inline Float pixel_ddx(const Float& v) {
+  alignas(64) float a[kLanes], d[kLanes];
+  v.store_aligned(a);
+  for (int q = 0; q < kQuadsPerBatch; ++q) {
+    const float top = a[4 * q + kQuadTopRight] - a[4 * q + kQuadTopLeft];
+    const float bottom = a[4 * q + kQuadBottomRight] - a[4 * q + kQuadBottomLeft];
+    d[4 * q + kQuadTopLeft] = d[4 * q + kQuadTopRight] = top;
+    d[4 * q + kQuadBottomLeft] = d[4 * q + kQuadBottomRight] = bottom;
+  }
+  return Float::load_aligned(d);
+}
+
+inline Float pixel_ddy(const Float& v) {
+  alignas(64) float a[kLanes], d[kLanes];
+  v.store_aligned(a);
+  for (int q = 0; q < kQuadsPerBatch; ++q) {
+    const float left = a[4 * q + kQuadBottomLeft] - a[4 * q + kQuadTopLeft];
+    const float right = a[4 * q + kQuadBottomRight] - a[4 * q + kQuadTopRight];
+    d[4 * q + kQuadTopLeft] = d[4 * q + kQuadBottomLeft] = left;
+    d[4 * q + kQuadTopRight] = d[4 * q + kQuadBottomRight] = right;
+  }
+  return Float::load_aligned(d);
+}
+
 }  // namespace qdmr::simd

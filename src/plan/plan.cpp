@@ -100,14 +100,25 @@ int mip_levels(int w, int h) {
   return levels;
 }
 
-std::uint64_t chain_bytes(int w, int h, int channels) {
+// Storage of a typed chain: levels at 64-byte aligned offsets plus the gather padding (see mip_texture.hpp).
+std::uint64_t chain_bytes(int w, int h, TexelFormat format) {
   std::uint64_t bytes = 0;
   for (;;) {
-    bytes += std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(channels) * sizeof(float);
-    if (w == 1 && h == 1) return bytes;
+    bytes = (bytes + 63) / 64 * 64 + std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(bytes_per_texel(format));
+    if (w == 1 && h == 1) return bytes + Texture::kTailPadding;
     w = std::max(1, w / 2);
     h = std::max(1, h / 2);
   }
+}
+
+const char* reduce_name(MipReduce r) {
+  switch (r) {
+    case MipReduce::Box: return "box";
+    case MipReduce::BoxNormal: return "box, renormalised";
+    case MipReduce::Max: return "max (quadtree)";
+    case MipReduce::Min: return "min";
+  }
+  return "?";
 }
 
 int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, TexturePurpose purpose,
@@ -128,9 +139,13 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   const auto [w, h] = texture_size(desc, layer, where);
   r.width = w;
   r.height = h;
-  r.channels = purpose == TexturePurpose::Height ? 1 : 3;
+  switch (purpose) {
+    case TexturePurpose::Albedo: r.format = TexelFormat::RGBA8, r.srgb = true, r.reduce = MipReduce::Box; break;
+    case TexturePurpose::Normal: r.format = TexelFormat::RGBA8, r.srgb = false, r.reduce = MipReduce::BoxNormal; break;
+    case TexturePurpose::Height: r.format = TexelFormat::R16, r.srgb = false, r.reduce = MipReduce::Max; break;
+  }
   r.levels = mip_levels(w, h);
-  r.bytes = chain_bytes(w, h, r.channels);
+  r.bytes = chain_bytes(w, h, r.format);
   r.users.push_back(user);
   textures.push_back(std::move(r));
   return int(textures.size() - 1);
@@ -248,8 +263,9 @@ std::string FramePlan::describe() const {
   s << "textures to build (" << textures.size() << "):\n";
   for (std::size_t i = 0; i < textures.size(); ++i) {
     const TextureRequest& t = textures[i];
-    s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << "x" << t.channels
-      << ", box mip chain of " << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
+    s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << " "
+      << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
+      << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
   }
   s << "derived data: none (normal mapping needs no quadtree, cone map, AO or blend maps)\n";
   s << "meshes (" << meshes.size() << "):\n";
@@ -273,8 +289,8 @@ nlohmann::json FramePlan::to_json() const {
     j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal}});
   for (const TextureRequest& t : textures)
     j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
-                             {"channels", t.channels}, {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where},
-                             {"users", t.users}});
+                             {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
+                             {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where}, {"users", t.users}});
   for (const MeshPlan& m : meshes)
     j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
                            {"bytes", m.bytes}, {"estimated", m.estimated}});

@@ -8,13 +8,14 @@
 namespace qdmr {
 namespace {
 
-MipChain build_texture(const TextureRequest& request) {
-  const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight ||
-                            (request.purpose == TexturePurpose::Albedo && request.desc.source == TextureSource::Procedural);
+Texture build_texture(const TextureRequest& request) {
+  const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight;
   Image height;
   if (needs_height) height = make_layer_height(request.layer, request.where);
   Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
-  return build_mip_chain(std::move(level0), request.purpose);
+  if (request.purpose == TexturePurpose::Normal)
+    for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
+  return make_mip_texture(level0, request.format, request.srgb, request.reduce);
 }
 
 }  // namespace
@@ -31,7 +32,7 @@ std::vector<DrawItem> Assets::draw_items() const {
 
 std::uint64_t Assets::texture_bytes() const {
   std::uint64_t bytes = 0;
-  for (const MipChain& t : textures) bytes += t.bytes();
+  for (const Texture& t : textures) bytes += t.bytes();
   return bytes;
 }
 
@@ -87,13 +88,10 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
   tbb::parallel_for(std::size_t(0), assets.requests.size(),
                     [&](std::size_t i) { assets.textures[i] = build_texture(assets.requests[i]); });
 
-  for (const MaterialPlan& m : assets.materials) {
-    SurfaceTextures textures;
-    textures.albedo = &assets.textures[std::size_t(m.albedo)];
-    textures.normal = &assets.textures[std::size_t(m.normal)];
-    textures.sampler = SamplerState{m.sampling.filter, m.sampling.address, m.sampling.lod_bias};
-    assets.programs.push_back(std::make_unique<NormalMappingProgram>(textures, m.lighting, lights));
-  }
+  for (const MaterialPlan& m : assets.materials)
+    assets.programs.push_back(std::make_unique<NormalMappingProgram>(assets.textures[std::size_t(m.albedo)],
+                                                                     assets.textures[std::size_t(m.normal)],
+                                                                     m.sampling, m.lighting, lights));
   return assets;
 }
 

@@ -18,7 +18,7 @@ struct Assets {
   std::vector<std::vector<std::uint32_t>> object_mtl_materials;  // obj: MTL material id -> frame material
   std::vector<MaterialPlan> materials;          // frame materials: the scene's, then those of MTL files
   std::vector<TextureRequest> requests;
-  std::vector<MipChain> textures;               // parallel to requests
+  std::vector<Texture> textures;                // parallel to requests
   std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
 
   std::vector<DrawItem> draw_items() const;     // model matrices left as identity

@@ -29,15 +29,17 @@ Vec3 cross(const Vec3& a, const Vec3& b) {
 void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const Float& u = in.varyings[kU];
   const Float& v = in.varyings[kV];
-  const Float dudx = simd::quad_ddx(u), dvdx = simd::quad_ddx(v);
-  const Float dudy = simd::quad_ddy(u), dvdy = simd::quad_ddy(v);
+  const bool per_quad = lod_mode_ == LodMode::PerQuad;
+  const Float dudx = per_quad ? simd::quad_ddx(u) : simd::pixel_ddx(u);
+  const Float dvdx = per_quad ? simd::quad_ddx(v) : simd::pixel_ddx(v);
+  const Float dudy = per_quad ? simd::quad_ddy(u) : simd::pixel_ddy(u);
+  const Float dvdy = per_quad ? simd::quad_ddy(v) : simd::pixel_ddy(v);
 
-  Float albedo[3];
-  sample(*textures_.albedo, textures_.sampler, u, v,
-         lod_from_derivatives(*textures_.albedo, dudx, dvdx, dudy, dvdy), albedo);
-  Float tangent_normal[3];
-  sample(*textures_.normal, textures_.sampler, u, v,
-         lod_from_derivatives(*textures_.normal, dudx, dvdx, dudy, dvdy), tangent_normal);
+  Float albedo[4];
+  sample(albedo_, sampler_, u, v, lod_from_derivatives(albedo_, dudx, dvdx, dudy, dvdy), albedo);
+  Float tangent_normal[4];
+  sample(normal_, sampler_, u, v, lod_from_derivatives(normal_, dudx, dvdx, dudy, dvdy), tangent_normal);
+  for (int c = 0; c < 3; ++c) tangent_normal[c] = tangent_normal[c] * Float(2.0f) - Float(1.0f);
 
   const Vec3 n = normalize({in.varyings[kNormalX], in.varyings[kNormalY], in.varyings[kNormalZ]});
   Vec3 t{in.varyings[kTangentX], in.varyings[kTangentY], in.varyings[kTangentZ]};

@@ -7,20 +7,19 @@
 
 namespace qdmr {
 
-struct SurfaceTextures {
-  const MipChain* albedo = nullptr;  // 3 channels, linear RGB
-  const MipChain* normal = nullptr;  // 3 channels, tangent-space unit vectors
-  SamplerState sampler;
-};
-
 class NormalMappingProgram final : public ShadingProgram {
 public:
-  NormalMappingProgram(SurfaceTextures textures, const LightingDesc& lighting, const LightRig& lights)
-      : textures_(textures), lighting_(lighting), lights_(lights) {}
+  // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
+  NormalMappingProgram(const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
+                       const LightingDesc& lighting, const LightRig& lights)
+      : albedo_(albedo), normal_(normal), sampler_(SamplerState::from(sampling)), lod_mode_(sampling.lod),
+        lighting_(lighting), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
 
 private:
-  SurfaceTextures textures_;
+  TextureView albedo_, normal_;
+  SamplerState sampler_;
+  LodMode lod_mode_;
   LightingDesc lighting_;
   LightRig lights_;
 };

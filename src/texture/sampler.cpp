@@ -1,14 +1,18 @@
-// The SIMD sampler. Only lane-wise IEEE operations (no FMA, no libm), so 4- and 8-lane builds agree bit for
-// bit. Coordinates are first reduced to one period of the address mode (exactly), so texel indices stay
-// small; texels are then fetched lane by lane.
+// The SIMD sampler. Coordinates are first reduced exactly to one period of the address mode, so texel indices
+// stay small for any finite u; then texel indices and weights come either from exact float arithmetic or from
+// fixed point with 8 or 6 fractional bits, as texture units do.
 #include "texture/sampler.hpp"
 
-#include <cstdint>
-#include <vector>
+#include <algorithm>
+
+#include "core/det_math.hpp"
+#include "qdmr/core/error.hpp"
+#include "texture/internal.hpp"
 
 namespace qdmr {
 namespace {
 
+using simd::FetchPath;
 using simd::Float;
 using simd::Int;
 using simd::kLanes;
@@ -18,30 +22,16 @@ constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 Mask is_finite(const Float& x) { return (x - x) == Float(0.0f); }
 
-// log2(x) for normal x > 0: the exponent bits plus log2 of the mantissa m in [sqrt(1/2), sqrt(2)) by the odd
-// series 2/ln2 * (t + t^3/3 + ... + t^9/9), t = (m-1)/(m+1), |t| <= 0.172: truncation error < 2e-9.
-Float log2_normal(const Float& x) {
-  const Int bits = xsimd::bitwise_cast<Int>(x);
-  Float m = xsimd::bitwise_cast<Float>((bits & Int(0x007FFFFF)) | Int(0x3F800000));
-  Float e = xsimd::to_float((bits >> 23) - Int(127));
-  const Mask high = m > Float(1.41421356f);
-  m = xsimd::select(high, m * Float(0.5f), m);
-  e = xsimd::select(high, e + Float(1.0f), e);
-  const Float t = (m - Float(1.0f)) / (m + Float(1.0f)), t2 = t * t;
-  constexpr float c = 2.88539008177792681f;  // 2 / ln 2
-  Float p = Float(c / 9.0f);
-  p = p * t2 + Float(c / 7.0f);
-  p = p * t2 + Float(c / 5.0f);
-  p = p * t2 + Float(c / 3.0f);
-  p = p * t2 + Float(c);
-  return e + t * p;
+const float* srgb_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int k = 0; k < 256; ++k) t[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
+    return t;
+  }();
+  return table.data();
 }
 
-// Size of each lane's level: max(1, floor(size0 * 2^-level)), exact in float.
-Float level_size(float size0, const Float& level) {
-  const Float scale = xsimd::bitwise_cast<Float>((Int(127) - xsimd::to_int(level)) << 23);
-  return xsimd::max(Float(1.0f), xsimd::floor(Float(size0) * scale));
-}
+int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
 // u reduced to one period of the address mode; exact (no rounding) for finite u.
 Float reduce(const Float& u, AddressMode mode) {
@@ -53,74 +43,97 @@ Float reduce(const Float& u, AddressMode mode) {
   return xsimd::min(xsimd::max(u, Float(-1.0f)), Float(2.0f));  // further out clamps to the same texels
 }
 
-// Integer-valued texel index i (within a period or two of the reduced coordinate) to a texel of [0, n).
-Float address(Float i, const Float& n, AddressMode mode) {
+// Texel index i (within a period or two of the reduced coordinate) to a texel of [0, n).
+Int address(Int i, const Int& n, AddressMode mode) {
   switch (mode) {
     case AddressMode::Wrap:
-      i = xsimd::select(i < Float(0.0f), i + n, i);
+      i = xsimd::select(i < Int(0), i + n, i);
       return xsimd::select(i >= n, i - n, i);
     case AddressMode::Mirror: {
-      const Float period = n + n;
-      i = xsimd::select(i < Float(0.0f), i + period, i);
+      const Int period = n + n;
+      i = xsimd::select(i < Int(0), i + period, i);
       i = xsimd::select(i >= period, i - period, i);
-      return xsimd::select(i >= n, period - Float(1.0f) - i, i);
+      return xsimd::select(i >= n, period - Int(1) - i, i);
     }
     case AddressMode::Clamp: break;
   }
-  return xsimd::min(xsimd::max(i, Float(0.0f)), n - Float(1.0f));
+  return xsimd::min(xsimd::max(i, Int(0)), n - Int(1));
 }
 
-// One mip level per lane with its size and the lane's reduced coordinates.
-struct LevelCoords {
-  alignas(64) std::int32_t level[kLanes];
-  Float width, height;
-  Int row_stride;  // width * channels
+// The level of each lane and its size and storage offset.
+struct LevelInfo {
+  Int width, height, offset;
 };
 
-LevelCoords level_coords(const MipChain& chain, const Float& level) {
-  LevelCoords lc;
-  xsimd::to_int(level).store_aligned(lc.level);
-  lc.width = level_size(float(chain.levels[0].width), level);
-  lc.height = level_size(float(chain.levels[0].height), level);
-  lc.row_stride = xsimd::to_int(lc.width) * Int(chain.levels[0].channels);
-  return lc;
+LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) {
+  return {simd::load_i32(view.widths(), level, path), simd::load_i32(view.heights(), level, path),
+          simd::load_i32(view.offsets(), level, path)};
 }
 
-// out[c] = texel (x, y) of each lane's level, channel c.
-void fetch(const MipChain& chain, const LevelCoords& lc, const Float& x, const Float& y, Float* out) {
-  const int channels = chain.levels[0].channels;
-  alignas(64) std::int32_t index[kLanes];
-  (xsimd::to_int(y) * lc.row_stride + xsimd::to_int(x) * Int(channels)).store_aligned(index);
-  alignas(64) float texel[4][kLanes];
-  for (int lane = 0; lane < kLanes; ++lane) {
-    const float* p = chain.levels[std::size_t(lc.level[lane])].texels.data() + index[lane];
-    for (int c = 0; c < channels; ++c) texel[c][lane] = p[c];
+void decode(const Texture& t, const Int& raw, FetchPath path, Float* out) {
+  const Float inv255(255.0f);
+  const auto unorm8 = [&](const Int& byte, bool srgb) {
+    return srgb ? simd::load_f32(srgb_table(), byte, path) : xsimd::to_float(byte) / inv255;
+  };
+  switch (t.format) {
+    case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), t.srgb); return;
+    case TexelFormat::RG8:
+      out[0] = unorm8(raw & Int(0xFF), t.srgb);
+      out[1] = unorm8((raw >> 8) & Int(0xFF), t.srgb);
+      return;
+    case TexelFormat::RGBA8:
+      for (int c = 0; c < 4; ++c) out[c] = unorm8((raw >> (8 * c)) & Int(0xFF), t.srgb && c < 3);
+      return;
+    case TexelFormat::R16: out[0] = xsimd::to_float(raw & Int(0xFFFF)) / Float(65535.0f); return;
+    case TexelFormat::R32F: out[0] = xsimd::bitwise_cast<Float>(raw); return;
   }
-  for (int c = 0; c < channels; ++c) out[c] = Float::load_aligned(texel[c]);
 }
 
-void sample_point(const MipChain& chain, const SamplerState& s, const Float& u, const Float& v, const Float& level,
-                  Float* out) {
-  const LevelCoords lc = level_coords(chain, level);
-  const Float x = address(xsimd::floor(u * lc.width), lc.width, s.address);
-  const Float y = address(xsimd::floor(v * lc.height), lc.height, s.address);
-  fetch(chain, lc, x, y, out);
+void fetch(const TextureView& view, const LevelInfo& level, const Int& x, const Int& y, FetchPath path, Float* out) {
+  const Texture& t = view.texture();
+  const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(t.format));
+  decode(t, simd::load_bytes4(t.storage.data(), offset, path), path, out);
 }
 
-void sample_bilinear(const MipChain& chain, const SamplerState& s, const Float& u, const Float& v,
-                     const Float& level, Float* out) {
-  const LevelCoords lc = level_coords(chain, level);
-  const Float px = u * lc.width - Float(0.5f), py = v * lc.height - Float(0.5f);
-  const Float fx0 = xsimd::floor(px), fy0 = xsimd::floor(py);
-  const Float wx = px - fx0, wy = py - fy0;
-  const Float x0 = address(fx0, lc.width, s.address), x1 = address(fx0 + Float(1.0f), lc.width, s.address);
-  const Float y0 = address(fy0, lc.height, s.address), y1 = address(fy0 + Float(1.0f), lc.height, s.address);
-  const int channels = chain.levels[0].channels;
+// Texel index and bilinear weight of coordinate p (in texels, centres at integers + 0.5 already removed).
+void split(const Float& p, int bits, Int& index, Float& weight) {
+  if (bits == 0) {
+    const Float f = xsimd::floor(p);
+    index = xsimd::to_int(f);
+    weight = p - f;
+    return;
+  }
+  // Fixed point with `bits` fractional bits, rounded down, as the hardware converts coordinates.
+  const Int fixed = xsimd::to_int(xsimd::floor(p * Float(float(1 << bits))));
+  index = fixed >> bits;
+  weight = xsimd::to_float(fixed & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
+}
+
+void sample_level(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Int& level,
+                  bool linear, Float* out) {
+  const LevelInfo info = level_info(view, level, s.fetch);
+  const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
+  const int bits = fraction_bits(s.precision);
+  const int channels = view.texture().channels();
+  if (!linear) {
+    Int x, y;
+    Float unused;
+    split(u * w, bits, x, unused);
+    split(v * h, bits, y, unused);
+    fetch(view, info, address(x, info.width, s.address), address(y, info.height, s.address), s.fetch, out);
+    return;
+  }
+  Int x0, y0;
+  Float wx, wy;
+  split(u * w - Float(0.5f), bits, x0, wx);
+  split(v * h - Float(0.5f), bits, y0, wy);
+  const Int xa = address(x0, info.width, s.address), xb = address(x0 + Int(1), info.width, s.address);
+  const Int ya = address(y0, info.height, s.address), yb = address(y0 + Int(1), info.height, s.address);
   Float t00[4], t10[4], t01[4], t11[4];
-  fetch(chain, lc, x0, y0, t00);
-  fetch(chain, lc, x1, y0, t10);
-  fetch(chain, lc, x0, y1, t01);
-  fetch(chain, lc, x1, y1, t11);
+  fetch(view, info, xa, ya, s.fetch, t00);
+  fetch(view, info, xb, ya, s.fetch, t10);
+  fetch(view, info, xa, yb, s.fetch, t01);
+  fetch(view, info, xb, yb, s.fetch, t11);
   for (int c = 0; c < channels; ++c) {
     const Float top = t00[c] + (t10[c] - t00[c]) * wx;
     const Float bottom = t01[c] + (t11[c] - t01[c]) * wx;
@@ -130,45 +143,70 @@ void sample_bilinear(const MipChain& chain, const SamplerState& s, const Float& 
 
 }  // namespace
 
-Float lod_from_derivatives(const MipChain& chain, const Float& dudx, const Float& dvdx, const Float& dudy,
+TextureView::TextureView(const Texture& texture) : texture_(&texture), levels_(texture.level_count()) {
+  if (levels_ < 1 || levels_ > kMaxLevels) throw Error("texture", "expected 1 to 16 mip levels");
+  for (int i = 0; i < kMaxLevels; ++i) {
+    const TextureLevel& l = texture.levels[std::size_t(std::min(i, levels_ - 1))];
+    width_[std::size_t(i)] = l.width;
+    height_[std::size_t(i)] = l.height;
+    offset_[std::size_t(i)] = std::int32_t(l.offset);
+  }
+}
+
+Float lod_from_derivatives(const TextureView& view, const Float& dudx, const Float& dvdx, const Float& dudy,
                            const Float& dvdy) {
-  const Float w(float(chain.levels[0].width)), h(float(chain.levels[0].height));
+  const Float w(float(view.texture().width())), h(float(view.texture().height()));
   const Float ax = dudx * w, ay = dvdx * h, bx = dudy * w, by = dvdy * h;
   const Float px = ax * ax + ay * ay, py = bx * bx + by * by;
   const Float rho2 = xsimd::select(px > py, px, py);
   const Mask tiny = rho2 < Float(1.17549435e-38f);  // zero or denormal
   // 0.5 * log2(rho^2) = log2(rho): exact integers for power-of-two footprints.
-  const Float lod = Float(0.5f) * log2_normal(xsimd::select(tiny, Float(1.0f), rho2));
-  const Float last(float(chain.levels.size() - 1));
+  const Float lod = Float(0.5f) * detmath::log2(xsimd::select(tiny, Float(1.0f), rho2));
+  const Float last(float(view.levels() - 1));
   return xsimd::select(is_finite(px) & is_finite(py), xsimd::select(tiny, Float(kMinLod), lod), last);
 }
 
-void sample(const MipChain& chain, const SamplerState& state, const Float& u, const Float& v, const Float& lod,
+void sample(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Float& lod,
             Float* out) {
   const Mask finite = is_finite(u) & is_finite(v);
-  const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), state.address);
-  const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), state.address);
-  const Float last(float(chain.levels.size() - 1));
-  Float l = lod + Float(state.lod_bias);
+  const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), s.address);
+  const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), s.address);
+  const Float last(float(view.levels() - 1));
+  Float l = lod + Float(s.lod_bias);
   l = xsimd::select(l == l, l, last);  // NaN: the coarsest level, as for non-finite derivatives
+  l = xsimd::min(xsimd::max(l, Float(s.min_lod)), Float(s.max_lod));
   l = xsimd::min(xsimd::max(l, Float(0.0f)), last);
-  switch (state.filter) {
+  const int bits = fraction_bits(s.precision);
+  if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
+  const bool linear = s.filter == Filter::Bilinear || s.filter == Filter::Trilinear || s.filter == Filter::LinearMipPoint;
+  switch (s.filter) {
     case Filter::Point:
-    case Filter::PointMipPoint: sample_point(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
-    case Filter::Bilinear:
-    case Filter::LinearMipPoint: sample_bilinear(chain, state, ru, rv, xsimd::floor(l + Float(0.5f)), out); break;
-    case Filter::PointMipLinear:
-    case Filter::Trilinear: {
+    case Filter::Bilinear: sample_level(view, s, ru, rv, Int(0), linear, out); break;
+    case Filter::PointMipPoint:
+    case Filter::LinearMipPoint:
+      sample_level(view, s, ru, rv, xsimd::to_int(xsimd::floor(l + Float(0.5f))), linear, out);
+      break;
+    case Filter::Trilinear:
+    case Filter::PointMipLinear: {
       const Float l0 = xsimd::floor(l), f = l - l0;
+      const Int i0 = xsimd::to_int(l0);
       Float fine[4], coarse[4];
-      sample_bilinear(chain, state, ru, rv, l0, fine);
-      sample_bilinear(chain, state, ru, rv, xsimd::min(l0 + Float(1.0f), last), coarse);
-      for (int c = 0; c < chain.levels[0].channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
+      sample_level(view, s, ru, rv, i0, linear, fine);
+      sample_level(view, s, ru, rv, xsimd::min(i0 + Int(1), Int(view.levels() - 1)), linear, coarse);
+      for (int c = 0; c < view.texture().channels(); ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
       break;
     }
   }
-  const Image& base = chain.levels[0];
-  for (int c = 0; c < base.channels; ++c) out[c] = xsimd::select(finite, out[c], Float(base.at(0, 0, c)));
+  const Texture& t = view.texture();
+  for (int c = 0; c < t.channels(); ++c) out[c] = xsimd::select(finite, out[c], Float(t.texel(0, 0, 0, c)));
+}
+
+void load(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path, Float* out) {
+  const Int l = xsimd::min(xsimd::max(level, Int(0)), Int(view.levels() - 1));
+  const LevelInfo info = level_info(view, l, path);
+  const Int cx = xsimd::min(xsimd::max(x, Int(0)), info.width - Int(1));
+  const Int cy = xsimd::min(xsimd::max(y, Int(0)), info.height - Int(1));
+  fetch(view, info, cx, cy, path, out);
 }
 
 }  // namespace qdmr

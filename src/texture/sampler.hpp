@@ -1,26 +1,69 @@
 #pragma once
-// Sampling a mip chain for a batch of lanes (private: SIMD types of this build).
-// Texel centres at (i + 0.5) / N; row 0 at v = 0. Results are bit-identical between SSE and AVX2 builds.
+// The SIMD sampler: a faithful emulation of a console-era texture unit over a typed mip Texture, for a batch
+// of lanes (private: SIMD types of this build). Texel centres at (i + 0.5) / N; row 0 at v = 0.
+// Every operation is lane-wise IEEE or integer, so SSE4.2 and AVX2 builds, and the gather and portable fetch
+// paths, give the same bits.
+#include <array>
+#include <cstdint>
+
+#include "core/gather.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
+
+// A Texture with the per-level tables the sampler looks up per lane.
+class TextureView {
+public:
+  static constexpr int kMaxLevels = 16;
+  explicit TextureView(const Texture& texture);
+
+  const Texture& texture() const { return *texture_; }
+  int levels() const { return levels_; }
+  const std::int32_t* widths() const { return width_.data(); }
+  const std::int32_t* heights() const { return height_.data(); }
+  const std::int32_t* offsets() const { return offset_.data(); }
+
+private:
+  const Texture* texture_;
+  int levels_;
+  alignas(64) std::array<std::int32_t, kMaxLevels> width_{}, height_{}, offset_{};
+};
 
 struct SamplerState {
   Filter filter = Filter::Trilinear;
   AddressMode address = AddressMode::Wrap;
+  SamplePrecision precision = SamplePrecision::Exact;
   float lod_bias = 0.0f;
+  float min_lod = 0.0f, max_lod = 16.0f;
+  simd::FetchPath fetch = simd::kHasHardwareGather ? simd::FetchPath::Gather : simd::FetchPath::Portable;
+
+  static SamplerState from(const SamplingDesc& d) {
+    SamplerState s;
+    s.filter = d.filter;
+    s.address = d.address;
+    s.precision = d.precision;
+    s.lod_bias = d.lod_bias;
+    s.min_lod = d.min_lod;
+    s.max_lod = d.max_lod;
+    return s;
+  }
 };
 
 // LOD in level-0 texels from UV derivatives, GL formula: log2(max(|d(uv*size)/dx|, |d(uv*size)/dy|)).
-// Computed with IEEE basic operations only (no libm), so every build gives the same bits.
-simd::Float lod_from_derivatives(const MipChain& chain, const simd::Float& dudx, const simd::Float& dvdx,
+// A zero footprint gives -64; non-finite derivatives give the last level.
+simd::Float lod_from_derivatives(const TextureView& texture, const simd::Float& dudx, const simd::Float& dvdx,
                                  const simd::Float& dudy, const simd::Float& dvdy);
 
-// Samples every channel of `chain` (1..4) at (u, v) with one LOD per lane (bias added here);
-// out[c] receives channel c. Lanes with non-finite coordinates return level-0 texel (0,0).
-void sample(const MipChain& chain, const SamplerState& state, const simd::Float& u, const simd::Float& v,
+// Samples every channel (1..4) at (u, v) with one LOD per lane (bias and clamps applied here; ignored by the
+// level-0 filters point and bilinear); out[c] receives channel c. Lanes with non-finite u or v return
+// level-0 texel (0, 0).
+void sample(const TextureView& texture, const SamplerState& state, const simd::Float& u, const simd::Float& v,
             const simd::Float& lod, simd::Float* out);
+
+// Texel fetch without filtering (SM4 Load): level, x, y per lane, clamped into range.
+void load(const TextureView& texture, const simd::Int& level, const simd::Int& x, const simd::Int& y,
+          simd::FetchPath fetch, simd::Float* out);
 
 }  // namespace qdmr

@@ -185,7 +185,7 @@ TEST(SceneLoader, UnknownKeysSuggestTheClosestKey) {
   document = minimal_scene();
   document["materials"]["rock"]["sampling"] = {{"zzzz", 1}};
   EXPECT_EQ(load_error(document),
-            "scene.json: /materials/rock/sampling: unknown key 'zzzz'; valid keys are: filter, address, lod_bias");
+            "scene.json: /materials/rock/sampling: unknown key 'zzzz'; valid keys are: filter, address, precision, lod, lod_bias, min_lod, max_lod, math");
 }
 
 TEST(SceneLoader, KeysDependOnTheMeshType) {
@@ -363,7 +363,7 @@ TEST(SceneLoader, HeightNormalDefaultsAndTextureForms) {
   EXPECT_EQ(
       load_error(document),
       "scene.json: /materials/rock/layers/0/height: unknown key 'color_low'; valid keys are: procedural, size, seed, "
-      "cells, octaves, gain, mortar");
+      "cells, octaves, gain, mortar, format, compression");
 }
 
 TEST(SceneLoader, ProceduralAndMeshRanges) {
@@ -398,6 +398,43 @@ TEST(SceneLoader, ProceduralAndMeshRanges) {
   EXPECT_EQ(load_error(document), "scene.json: /objects/0/transform/scale/1: must not be 0");
   object["transform"] = {{"scale", 0}};
   EXPECT_EQ(load_error(document), "scene.json: /objects/0/transform/scale: must not be 0");
+}
+
+}  // namespace
+}  // namespace qdmr
+
+namespace qdmr {
+namespace {
+
+TEST(SceneLoader, SamplingAndHeightStorageSettings) {
+  nlohmann::json document = nlohmann::json::parse(R"({
+    "materials": {"rock": {"layers": [{"height": {"procedural": "noise", "format": "r8", "compression": "bc3"}}],
+                           "sampling": {"filter": "point_mip_linear", "address": "mirror", "precision": "hw6",
+                                        "lod": "per_pixel", "lod_bias": -0.5, "min_lod": 1, "max_lod": 3, "math": "sm3"}}},
+    "objects": [{"mesh": {"type": "plane"}, "material": "rock"}]})");
+  const SceneDesc scene = load_scene_json(document, "scene.json", ".");
+  const MaterialDesc& m = scene.materials.at(0);
+  EXPECT_EQ(m.sampling.filter, Filter::PointMipLinear);
+  EXPECT_EQ(m.sampling.address, AddressMode::Mirror);
+  EXPECT_EQ(m.sampling.precision, SamplePrecision::Hw6);
+  EXPECT_EQ(m.sampling.lod, LodMode::PerPixel);
+  EXPECT_EQ(m.sampling.lod_bias, -0.5f);
+  EXPECT_EQ(m.sampling.min_lod, 1.0f);
+  EXPECT_EQ(m.sampling.max_lod, 3.0f);
+  EXPECT_EQ(m.sampling.math, MathMode::Sm3);
+  EXPECT_EQ(m.layers.at(0).height.format, TextureFormatChoice::R8);
+  EXPECT_EQ(m.layers.at(0).height.compression, Compression::Bc3);
+
+  document["materials"]["rock"]["sampling"]["max_lod"] = 0.5;
+  EXPECT_THROW(load_scene_json(document, "scene.json", "."), Error);
+  document["materials"]["rock"]["sampling"].erase("max_lod");
+  document["materials"]["rock"]["layers"][0]["height"]["format"] = "r16";
+  try {
+    load_scene_json(document, "scene.json", ".");
+    FAIL() << "bc3 with r16 accepted";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "scene.json: /materials/rock/layers/0/height/compression: bc3 stores 8-bit heights: use format r8 or auto");
+  }
 }
 
 }  // namespace

@@ -27,58 +27,71 @@ std::uint32_t bits(float f) {
   return b;
 }
 
-// t(x, y) = x + w * y.
-MipChain ramp_chain(int w, int h) {
+constexpr Filter kAllFilters[] = {Filter::Point,         Filter::Bilinear,       Filter::Trilinear,
+                                  Filter::PointMipPoint, Filter::PointMipLinear, Filter::LinearMipPoint};
+
+SamplerState state_of(Filter filter, AddressMode address, float bias = 0, SamplePrecision p = SamplePrecision::Exact) {
+  SamplerState s;
+  s.filter = filter;
+  s.address = address;
+  s.lod_bias = bias;
+  s.precision = p;
+  return s;
+}
+
+// t(x, y) = x + w * y, stored as R32F so values are exact; box mips.
+Texture ramp_chain(int w, int h) {
   Image img(w, h, 1);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) img.at(x, y, 0) = float(x + w * y);
-  return build_mip_chain(std::move(img), TexturePurpose::Height);
+  return make_mip_texture(img, TexelFormat::R32F, false, MipReduce::Box);
 }
 
 // One channel sampled with every lane at the same (u, v, lod); checks all lanes agree and returns lane 0.
-float sample1(const MipChain& chain, Filter filter, AddressMode address, float u, float v, float lod, float bias = 0) {
-  const SamplerState state{filter, address, bias};
+float sample1(const Texture& texture, Filter filter, AddressMode address, float u, float v, float lod, float bias = 0,
+              SamplePrecision precision = SamplePrecision::Exact) {
+  const SamplerState state = state_of(filter, address, bias, precision);
   Float out[4];
-  sample(chain, state, Float(u), Float(v), Float(lod), out);
+  sample(TextureView(texture), state, Float(u), Float(v), Float(lod), out);
   const Lanes r = lanes(out[0]);
   for (int i = 1; i < kLanes; ++i) EXPECT_EQ(bits(r[i]), bits(r[0]));
   return r[0];
 }
 
 TEST(TextureSampler, TwoByTwo) {
-  const MipChain c = ramp_chain(2, 2);  // 0 1 / 2 3, then 1.5
+  const Texture c = ramp_chain(2, 2);  // 0 1 / 2 3, then 1.5
   const auto W = AddressMode::Wrap;
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.25f, 0.25f, 0), 0.0f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.75f, 0.25f, 0), 1.0f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.25f, 0.75f, 0), 2.0f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.25f, 0.75f, 0.6f), 1.5f);  // nearest level: 1
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.5f, 0.5f, 0), 1.5f);
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.25f, 0.25f, 0), 0.0f);
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.0f, 0.25f, 0), 0.5f);  // wraps to texel 1
-  EXPECT_EQ(sample1(c, Filter::Bilinear, AddressMode::Clamp, 0.0f, 0.25f, 0), 0.0f);
-  EXPECT_EQ(sample1(c, Filter::Bilinear, AddressMode::Mirror, 0.0f, 0.25f, 0), 0.0f);
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.5f, 0.25f, 0.4f), 0.5f);  // mip point: level 0
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.25f, 0.25f, 0), 0.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.75f, 0.25f, 0), 1.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.25f, 0.75f, 0), 2.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.25f, 0.75f, 0.6f), 1.5f);  // nearest level: 1
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.5f, 0.5f, 0), 1.5f);
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.25f, 0.25f, 0), 0.0f);
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.0f, 0.25f, 0), 0.5f);  // wraps to texel 1
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, AddressMode::Clamp, 0.0f, 0.25f, 0), 0.0f);
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, AddressMode::Mirror, 0.0f, 0.25f, 0), 0.0f);
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.5f, 0.25f, 0.4f), 0.5f);  // mip point: level 0
   EXPECT_EQ(sample1(c, Filter::Trilinear, W, 0.25f, 0.25f, 0.5f), 0.75f);
   EXPECT_EQ(sample1(c, Filter::Trilinear, W, 0.25f, 0.25f, 0.25f), 0.375f);
 }
 
 TEST(TextureSampler, FourByFour) {
-  const MipChain c = ramp_chain(4, 4);  // levels 4x4, (2.5 4.5 / 10.5 12.5), 7.5
+  const Texture c = ramp_chain(4, 4);  // levels 4x4, (2.5 4.5 / 10.5 12.5), 7.5
   const auto W = AddressMode::Wrap;
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.125f, 0.125f, 0.4f), 0.0f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.125f, 0.125f, 0.6f), 2.5f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.125f, 0.125f, 0.0f, 1.0f), 2.5f);  // bias
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.125f, 0.125f, 10.0f), 7.5f);       // clamped to the last level
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.875f, 0.375f, -5.0f), 7.0f);
-  EXPECT_EQ(sample1(c, Filter::Point, W, 0.125f, 0.125f, std::numeric_limits<float>::quiet_NaN()), 7.5f);
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.125f, 0.125f, 1.0f), 5.0f);  // taps wrap on level 1
-  EXPECT_EQ(sample1(c, Filter::Bilinear, W, 0.5f, 0.5f, 0.0f), 7.5f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.125f, 0.125f, 0.4f), 0.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.125f, 0.125f, 0.6f), 2.5f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.125f, 0.125f, 0.0f, 1.0f), 2.5f);  // bias
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.125f, 0.125f, 10.0f), 7.5f);       // clamped to the last level
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.875f, 0.375f, -5.0f), 7.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, W, 0.125f, 0.125f, std::numeric_limits<float>::quiet_NaN()), 7.5f);
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.125f, 0.125f, 1.0f), 5.0f);  // taps wrap on level 1
+  EXPECT_EQ(sample1(c, Filter::LinearMipPoint, W, 0.5f, 0.5f, 0.0f), 7.5f);
   EXPECT_EQ(sample1(c, Filter::Trilinear, W, 0.125f, 0.125f, 1.5f), 6.25f);
   EXPECT_EQ(sample1(c, Filter::Trilinear, W, 0.125f, 0.125f, 2.0f), 7.5f);
 }
 
 TEST(TextureSampler, AddressModes) {
-  const MipChain c = ramp_chain(4, 4);
+  const Texture c = ramp_chain(4, 4);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   struct Case {
     AddressMode mode;
@@ -94,30 +107,30 @@ TEST(TextureSampler, AddressModes) {
       {AddressMode::Mirror, 1e4f, 0, 0},      {AddressMode::Mirror, 1.125f, 3, 3},
   };
   for (const Case& k : cases) {
-    EXPECT_EQ(sample1(c, Filter::Point, k.mode, k.u, 0.125f, 0), k.point) << int(k.mode) << " u=" << k.u;
-    EXPECT_EQ(sample1(c, Filter::Bilinear, k.mode, k.u, 0.125f, 0), k.bilinear) << int(k.mode) << " u=" << k.u;
+    EXPECT_EQ(sample1(c, Filter::PointMipPoint, k.mode, k.u, 0.125f, 0), k.point) << int(k.mode) << " u=" << k.u;
+    EXPECT_EQ(sample1(c, Filter::LinearMipPoint, k.mode, k.u, 0.125f, 0), k.bilinear) << int(k.mode) << " u=" << k.u;
   }
   // Non-finite coordinates give level-0 texel (0, 0) whatever the filter and LOD; v like u.
   Image marked(4, 4, 1);
   marked.at(0, 0, 0) = 42.0f;
-  const MipChain shifted = build_mip_chain(marked, TexturePurpose::Height);
+  const Texture shifted = make_mip_texture(marked, TexelFormat::R32F, false, MipReduce::Box);
   for (AddressMode m : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
-    for (Filter f : {Filter::Point, Filter::Bilinear, Filter::Trilinear})
+    for (Filter f : kAllFilters)
       for (float bad : {nan, inf, -inf}) {
         EXPECT_EQ(sample1(shifted, f, m, bad, 0.6f, 1.3f), 42.0f);
         EXPECT_EQ(sample1(shifted, f, m, 0.6f, bad, 1.3f), 42.0f);
       }
-  EXPECT_EQ(sample1(c, Filter::Point, AddressMode::Wrap, 0.625f, 1e4f + 0.875f, 0), 14.0f);
+  EXPECT_EQ(sample1(c, Filter::PointMipPoint, AddressMode::Wrap, 0.625f, 1e4f + 0.875f, 0), 14.0f);
 }
 
-float lod1(const MipChain& c, float dudx, float dvdx, float dudy, float dvdy) {
-  const Lanes r = lanes(lod_from_derivatives(c, Float(dudx), Float(dvdx), Float(dudy), Float(dvdy)));
+float lod1(const Texture& c, float dudx, float dvdx, float dudy, float dvdy) {
+  const Lanes r = lanes(lod_from_derivatives(TextureView(c), Float(dudx), Float(dvdx), Float(dudy), Float(dvdy)));
   for (int i = 1; i < kLanes; ++i) EXPECT_EQ(bits(r[i]), bits(r[0]));
   return r[0];
 }
 
 TEST(TextureSampler, LodFromDerivatives) {
-  const MipChain c = ramp_chain(4, 4);  // 3 levels
+  const Texture c = ramp_chain(4, 4);  // 3 levels
   EXPECT_EQ(lod1(c, 0.25f, 0, 0, 0.25f), 0.0f);
   EXPECT_EQ(lod1(c, 1.0f, 0, 0, 0.25f), 2.0f);
   EXPECT_EQ(lod1(c, 0, 0, 0, 2.0f), 3.0f);
@@ -131,7 +144,7 @@ TEST(TextureSampler, LodFromDerivatives) {
   EXPECT_EQ(lod1(c, 1e30f, 0, 0, 0), 2.0f);  // overflows
 
   // Against std::log2 in double: |error| <= 4e-6 over 2^-40 .. 2^40 texel footprints.
-  const MipChain big = ramp_chain(256, 128);
+  const Texture big = ramp_chain(256, 128);
   std::mt19937 rng(42);
   std::uniform_real_distribution<float> mantissa(-1.0f, 1.0f);
   std::uniform_int_distribution<int> exponent(-48, 32);
@@ -154,15 +167,16 @@ TEST(TextureSampler, LanesIndependent) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   for (float& t : img.texels) t = unit(rng);
-  const MipChain chain = build_mip_chain(std::move(img), TexturePurpose::Albedo);
+  const Texture texture = make_mip_texture(img, TexelFormat::RGBA8, true, MipReduce::Box);
+  const TextureView chain(texture);
   std::uniform_real_distribution<float> coord(-3.0f, 4.0f), lod(-1.0f, 7.0f), deriv(-0.2f, 0.2f);
-  for (Filter f : {Filter::Point, Filter::Bilinear, Filter::Trilinear})
+  for (Filter f : kAllFilters)
     for (AddressMode m : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
       for (int round = 0; round < 50; ++round) {
         Lanes u, v, l, dx, dy;
         for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng), dx[i] = deriv(rng), dy[i] = deriv(rng);
         u[0] = round % 2 ? std::numeric_limits<float>::quiet_NaN() : u[0];
-        const SamplerState state{f, m, 0.25f};
+        const SamplerState state = state_of(f, m, 0.25f, SamplePrecision(round % 3));
         Float out[4];
         sample(chain, state, load(u), load(v), load(l), out);
         const Lanes lods = lanes(lod_from_derivatives(chain, load(dx), load(dy), load(dy), load(dx)));
@@ -174,6 +188,103 @@ TEST(TextureSampler, LanesIndependent) {
           ASSERT_EQ(bits(lods[i]), bits(lanes(lod_i)[0]));
         }
       }
+}
+
+}  // namespace
+}  // namespace qdmr
+
+namespace qdmr {
+namespace {
+
+TEST(TextureSampler, LevelZeroFiltersIgnoreLod) {
+  const Texture c = ramp_chain(4, 4);
+  for (float lod : {-3.0f, 0.0f, 1.7f, 9.0f}) {
+    EXPECT_EQ(sample1(c, Filter::Point, AddressMode::Wrap, 0.375f, 0.625f, lod), 9.0f);      // texel (1, 2)
+    EXPECT_EQ(sample1(c, Filter::Bilinear, AddressMode::Wrap, 0.5f, 0.625f, lod), 9.5f);     // between (1,2) and (2,2)
+  }
+}
+
+TEST(TextureSampler, PointMipLinearBlendsNearestTexelsOfTwoLevels) {
+  const Texture c = ramp_chain(4, 4);  // level 1 texel (0,0) = 2.5
+  EXPECT_EQ(sample1(c, Filter::PointMipLinear, AddressMode::Wrap, 0.125f, 0.125f, 0.5f), 1.25f);
+  EXPECT_EQ(sample1(c, Filter::PointMipLinear, AddressMode::Wrap, 0.125f, 0.125f, 0.25f), 0.625f);
+}
+
+TEST(TextureSampler, HardwarePrecisionQuantisesWeightsAndLodFraction) {
+  const Texture c = ramp_chain(4, 1);  // 0 1 2 3
+  // u = 0.3 -> p = 0.7 texels past texel 0's centre: exact weight 0.7; hw8 keeps floor(0.7 * 256) / 256.
+  const float u = 0.3f, v = 0.5f;
+  const float exact = sample1(c, Filter::Bilinear, AddressMode::Clamp, u, v, 0);
+  const float hw8 = sample1(c, Filter::Bilinear, AddressMode::Clamp, u, v, 0, 0, SamplePrecision::Hw8);
+  const float hw6 = sample1(c, Filter::Bilinear, AddressMode::Clamp, u, v, 0, 0, SamplePrecision::Hw6);
+  const float p = 0.3f * 4.0f - 0.5f;
+  EXPECT_EQ(exact, p);
+  EXPECT_EQ(hw8, std::floor(p * 256.0f) / 256.0f);
+  EXPECT_EQ(hw6, std::floor(p * 64.0f) / 64.0f);
+  // LOD fraction: 0.3 -> 76/256 (hw8), 19/64 (hw6); a 2x2-texel ramp makes the blend visible.
+  const Texture r = ramp_chain(2, 2);  // level 1: 1.5
+  const float lod = 0.3f;
+  EXPECT_EQ(sample1(r, Filter::Trilinear, AddressMode::Wrap, 0.25f, 0.25f, lod, 0, SamplePrecision::Hw8),
+            0.0f + 1.5f * (std::floor(lod * 256.0f) / 256.0f));
+  EXPECT_EQ(sample1(r, Filter::Trilinear, AddressMode::Wrap, 0.25f, 0.25f, lod, 0, SamplePrecision::Hw6),
+            0.0f + 1.5f * (std::floor(lod * 64.0f) / 64.0f));
+}
+
+TEST(TextureSampler, LodClampsApply) {
+  const Texture c = ramp_chain(4, 4);  // levels: 4x4, 2x2, 1x1 (7.5)
+  SamplerState s = state_of(Filter::PointMipPoint, AddressMode::Wrap);
+  s.min_lod = 2.0f;
+  Float out[4];
+  sample(TextureView(c), s, Float(0.1f), Float(0.1f), Float(0.0f), out);
+  EXPECT_EQ(lanes(out[0])[0], 7.5f);
+  s.min_lod = 0.0f;
+  s.max_lod = 0.0f;
+  sample(TextureView(c), s, Float(0.1f), Float(0.1f), Float(5.0f), out);
+  EXPECT_EQ(lanes(out[0])[0], 0.0f);
+}
+
+TEST(TextureSampler, GatherAndPortableFetchGiveTheSameBits) {
+  if (!simd::kHasHardwareGather) GTEST_SKIP() << "this build has no hardware gather (SSE4.2): only the portable path exists";
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-2.0f, 3.0f), lod(-1.0f, 9.0f);
+  for (TexelFormat format : {TexelFormat::R8, TexelFormat::RG8, TexelFormat::RGBA8, TexelFormat::R16, TexelFormat::R32F}) {
+    Image img(61, 35, channel_count(format));
+    for (float& t : img.texels) t = unit(rng);
+    const Texture texture = make_mip_texture(img, format, format == TexelFormat::RGBA8, MipReduce::Box);
+    const TextureView view(texture);
+    for (Filter f : kAllFilters)
+      for (int round = 0; round < 20; ++round) {
+        Lanes u, v, l;
+        for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+        SamplerState gather = state_of(f, AddressMode(round % 3), 0, SamplePrecision(round % 3));
+        SamplerState portable = gather;
+        gather.fetch = simd::FetchPath::Gather;
+        portable.fetch = simd::FetchPath::Portable;
+        Float a[4], b[4];
+        sample(view, gather, load(u), load(v), load(l), a);
+        sample(view, portable, load(u), load(v), load(l), b);
+        for (int c = 0; c < texture.channels(); ++c)
+          for (int i = 0; i < kLanes; ++i) ASSERT_EQ(bits(lanes(a[c])[i]), bits(lanes(b[c])[i]));
+      }
+  }
+}
+
+TEST(TextureSampler, DecodesEveryFormatLikeTheScalarTexelAccessor) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (TexelFormat format : {TexelFormat::R8, TexelFormat::RG8, TexelFormat::RGBA8, TexelFormat::R16, TexelFormat::R32F})
+    for (bool srgb : {false, true}) {
+      if (srgb && (format == TexelFormat::R16 || format == TexelFormat::R32F)) continue;
+      Image img(5, 3, channel_count(format));
+      for (float& t : img.texels) t = unit(rng);
+      const Texture texture = make_mip_texture(img, format, srgb, MipReduce::Box);
+      for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x) {
+          Float out[4];
+          load(TextureView(texture), simd::Int(0), simd::Int(x), simd::Int(y), simd::FetchPath::Portable, out);
+          for (int c = 0; c < texture.channels(); ++c) ASSERT_EQ(lanes(out[c])[0], texture.texel(0, x, y, c));
+        }
+    }
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 
 #include "qdmr/render/render.hpp"
 #include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/format.hpp"
+#include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
 
 namespace qdmr {
@@ -19,7 +21,10 @@ struct TextureRequest {
   TextureDesc desc;
   LayerDesc layer;           // the layer it belongs to (height for from_height normals, scale/offset)
   std::string where;         // scene field, for messages
-  int width = 0, height = 0, channels = 0, levels = 0;
+  TexelFormat format = TexelFormat::RGBA8;
+  bool srgb = false;
+  MipReduce reduce = MipReduce::Box;
+  int width = 0, height = 0, levels = 0;
   std::uint64_t bytes = 0;   // level 0 and its mip chain
   std::vector<std::string> users;  // material names
 };

@@ -26,12 +26,4 @@ Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerD
 // Level 0 of a layer's height with scale/offset applied; a layer without one is flat at the top (1x1, h = 1).
 Image make_layer_height(const LayerDesc& layer, const std::string& where);
 
-// Mip levels by 2x2 box filter down to 1x1 (odd sizes: the last row/column is folded into the previous
-// one's box; each level is max(1, floor(n/2))). Normal chains are renormalised per texel.
-struct MipChain {
-  std::vector<Image> levels;
-  std::size_t bytes() const;
-};
-MipChain build_mip_chain(Image level0, TexturePurpose purpose);
-
 }  // namespace qdmr
