@@ -1,0 +1,64 @@
+# Run by CTest (test "install.find_package", label "slow"; see tests/CMakeLists.txt): installs the build into
+# a fresh prefix, then configures, builds and runs docs/example against it with the build's generator and
+# compiler, as a user of find_package(qdmr) would. Everything stays in WORK_DIR for inspection.
+foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER BUILD_TYPE)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "install_test.cmake needs -D${var}=...")
+  endif()
+endforeach()
+
+function(run)
+  string(JOIN " " command ${ARGN})
+  message(STATUS "${command}")
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE output ERROR_VARIABLE output)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "failed (${code}): ${command}\n${output}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(prefix "${WORK_DIR}/prefix")
+run("${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${prefix}" --config "${BUILD_TYPE}")
+
+# The installed package must stand alone: no path into the source or build tree.
+file(GLOB_RECURSE package_files "${prefix}/lib*/cmake/qdmr/*.cmake")
+if(NOT package_files)
+  message(FATAL_ERROR "no CMake package files installed under ${prefix}")
+endif()
+foreach(file IN LISTS package_files)
+  file(READ "${file}" text)
+  foreach(tree "${SOURCE_DIR}" "${BUILD_DIR}")
+    string(FIND "${text}" "${tree}" at)
+    if(NOT at EQUAL -1)
+      message(FATAL_ERROR "${file} refers to ${tree}")
+    endif()
+  endforeach()
+endforeach()
+
+set(example_build "${WORK_DIR}/build")
+set(configure "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/docs/example" -B "${example_build}" -G "${GENERATOR}"
+    "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}" "-DCMAKE_PREFIX_PATH=${prefix}"
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF)
+if(MAKE_PROGRAM)
+  list(APPEND configure "-DCMAKE_MAKE_PROGRAM=${MAKE_PROGRAM}")
+endif()
+run(${configure})
+file(STRINGS "${example_build}/CMakeCache.txt" found REGEX "^qdmr_DIR:")
+if(NOT found MATCHES "=${prefix}/")
+  message(FATAL_ERROR "the example found another qdmr: ${found}")
+endif()
+run("${CMAKE_COMMAND}" --build "${example_build}" --config "${BUILD_TYPE}")
+
+set(program "${example_build}/render_plane")
+if(NOT EXISTS "${program}")
+  set(program "${example_build}/${BUILD_TYPE}/render_plane")  # multi-config generators
+endif()
+set(image "${WORK_DIR}/plane.png")
+run("${program}" "${SOURCE_DIR}/scenes/plane.json" "${image}")
+
+# The PNG header holds the size: 160x90 as the example asks.
+file(READ "${image}" header OFFSET 16 LIMIT 8 HEX)
+if(NOT header STREQUAL "000000a00000005a")
+  message(FATAL_ERROR "${image}: expected a 160x90 PNG, header size bytes are ${header}")
+endif()
+message(STATUS "installed qdmr works: ${image}")
