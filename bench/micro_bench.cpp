@@ -92,7 +92,7 @@ void BM_SetupBinning(benchmark::State& state, int which) {
     arena.execute([&] {
       const std::vector<TriangleSetup> setups = setup_all(geometry, w.viewport);
       TileBins bins = bin_triangles(setups, grid);
-      benchmark::DoNotOptimize(bins.data());
+      benchmark::DoNotOptimize(bins.bins.data());
     });
   }
   report(state, w, threads);
@@ -114,8 +114,8 @@ void BM_RasterShade(benchmark::State& state, int which) {
     Framebuffer fb;
     fb.width = w.viewport.width;
     fb.height = w.viewport.height;
-    fb.color.assign(pixels * 3, 0.0f);
-    fb.depth.assign(pixels, 1.0f);
+    fb.color.resize(pixels * 3);
+    fb.depth.resize(pixels);
     RasterContext context;
     context.geometry = &geometry;
     context.setups = &setups;
@@ -125,7 +125,7 @@ void BM_RasterShade(benchmark::State& state, int which) {
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
         for (int tile = range.begin(); tile != range.end(); ++tile)
-          raster_tile(context, grid.rect(tile), bins[std::size_t(tile)], counters[std::size_t(tile)]);
+          raster_tile(context, tile, grid.rect(tile), bins, counters[std::size_t(tile)]);
       });
     });
     for (const TileCounters& c : counters) shaded += c.pixels_shaded;

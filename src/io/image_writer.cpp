@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include <OpenImageIO/imageio.h>
 
@@ -33,18 +37,20 @@ float linear_to_srgb(float v) {
 }
 
 template <typename T>
-std::vector<T> quantize(const std::vector<float>& values, float max_code, bool srgb) {
+std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb) {
   std::vector<T> out(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    float v = srgb ? linear_to_srgb(values[i]) : values[i];
-    v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
-    out[i] = T(std::floor(v * max_code + 0.5f));
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      float v = srgb ? linear_to_srgb(values[i]) : values[i];
+      v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+      out[i] = T(std::floor(v * max_code + 0.5f));
+    }
+  });
   return out;
 }
 
 // Writes pixels (float, `channels` per pixel) through a temporary file in the target folder, then renames.
-void write_pixels(const std::filesystem::path& file, int width, int height, int channels, const std::vector<float>& pixels,
+void write_pixels(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
                   bool srgb) {
   const Container container = container_of(file);
   const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
@@ -70,6 +76,8 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
   // EXR keeps full float precision, so files can be compared bit for bit.
   OIIO::ImageSpec spec(width, height, channels, format);
   if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
+  // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
+  if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
   auto output = OIIO::ImageOutput::create(temporary.string());
   bool ok = output && output->open(temporary.string(), spec) && output->write_image(format, data) && output->close();
   std::string message = output ? output->geterror() : OIIO::geterror();
@@ -102,7 +110,7 @@ void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {
     return;
   }
   // 8-bit PNG: map the values into [0, 1] so the picture is readable.
-  std::vector<float> mapped = image->pixels;
+  std::vector<float> mapped(image->pixels.begin(), image->pixels.end());
   if (aov == Aov::Normal)
     for (float& v : mapped) v = 0.5f + 0.5f * v;
   if (aov == Aov::UV)

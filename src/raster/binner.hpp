@@ -25,8 +25,18 @@ struct TileGrid {
   }
 };
 
-// bins[tile] lists triangle indices (into the setups) in submission order.
-using TileBins = std::vector<std::vector<std::uint32_t>>;
+// Triangle indices (into the setups) per chunk of consecutive triangles and per tile: bins[chunk][tile].
+// Chunks are binned in parallel; a tile reads its lists chunk by chunk, which is submission order.
+struct TileBins {
+  static constexpr std::size_t kTrianglesPerChunk = 32768;
+  std::vector<std::vector<std::vector<std::uint32_t>>> bins;
+
+  template <class F>
+  void for_each_in_tile(int tile, F&& f) const {
+    for (const auto& chunk : bins)
+      for (std::uint32_t index : chunk[std::size_t(tile)]) f(index);
+  }
+};
 
 TileBins bin_triangles(const std::vector<TriangleSetup>& setups, const TileGrid& grid);
 

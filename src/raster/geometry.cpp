@@ -11,6 +11,12 @@
 namespace qdmr {
 namespace {
 
+// Triangles are assembled in chunks of this many, in parallel; the chunking depends only on the mesh,
+// so the output order (and every bit of it) is the same for any thread count.
+constexpr std::size_t kTrianglesPerChunk = 16384;
+// Vertices made by clipping are numbered per chunk with this bit set until the chunks are merged.
+constexpr std::uint32_t kLocalVertex = 1u << 31;
+
 // Planes as (a, b, c, d): inside when a*x + b*y + c*z + d*w >= 0 in clip space.
 struct ClipPlane {
   glm::vec4 coefficients;
@@ -47,147 +53,166 @@ std::int64_t orient2d(const ScreenTriangle& t) {
   return std::int64_t(t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - std::int64_t(t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
 }
 
-class GeometryBuilder {
+// Bits: near, far, left, right, bottom, top; x/y tested against +-g*w (g = 1: the frustum, g > 1: the band).
+unsigned outcode(const glm::vec4& c, float gx, float gy) {
+  unsigned code = 0;
+  if (!(c.z >= -c.w)) code |= 1u;
+  if (!(c.z <= c.w)) code |= 2u;
+  if (!(c.x >= -gx * c.w)) code |= 4u;
+  if (!(c.x <= gx * c.w)) code |= 8u;
+  if (!(c.y >= -gy * c.w)) code |= 16u;
+  if (!(c.y <= gy * c.w)) code |= 32u;
+  return code;
+}
+
+struct Projected {
+  ScreenVertex vertex;
+  std::int32_t x = 0, y = 0;  // fixed point
+};
+
+class Projection {
 public:
-  GeometryBuilder(const glm::mat4& view_projection, const Viewport& viewport, GeometryResult& result)
-      : view_projection_(view_projection), viewport_(viewport), result_(result) {
+  Projection(const Viewport& viewport) : viewport_(viewport) {
     // Guard band: in NDC the viewport spans [-1, 1]; the band extends it by kGuardBandPixels on each side.
-    const float gx = 1.0f + 2.0f * float(limits::kGuardBandPixels) / float(viewport.width);
-    const float gy = 1.0f + 2.0f * float(limits::kGuardBandPixels) / float(viewport.height);
-    clip_planes_ = {{
-        {{0, 0, 1, 1}},     // near: z >= -w
-        {{0, 0, -1, 1}},    // far:  z <= w
-        {{1, 0, 0, gx}},    // guard band left
-        {{-1, 0, 0, gx}},   // guard band right
-        {{0, 1, 0, gy}},    // guard band bottom
-        {{0, -1, 0, gy}},   // guard band top
+    gx_ = 1.0f + 2.0f * float(limits::kGuardBandPixels) / float(viewport.width);
+    gy_ = 1.0f + 2.0f * float(limits::kGuardBandPixels) / float(viewport.height);
+    planes_ = {{
+        {{0, 0, 1, 1}},      // near: z >= -w
+        {{0, 0, -1, 1}},     // far:  z <= w
+        {{1, 0, 0, gx_}},    // guard band left
+        {{-1, 0, 0, gx_}},   // guard band right
+        {{0, 1, 0, gy_}},    // guard band bottom
+        {{0, -1, 0, gy_}},   // guard band top
     }};
   }
 
-  void add(const DrawItem& item) {
-    const MeshData& mesh = *item.mesh;
-    const glm::mat3 linear(item.model);
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
-    const bool mirrored = glm::determinant(linear) < 0.0f;
-    const std::size_t vertex_count = mesh.vertex_count();
+  float gx() const { return gx_; }
+  float gy() const { return gy_; }
+  const std::array<ClipPlane, 6>& planes() const { return planes_; }
 
-    std::vector<ClipVertex> clip(vertex_count);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertex_count, 4096), [&](const auto& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        const glm::vec4 world = item.model * glm::vec4(mesh.positions[i], 1.0f);
-        const glm::vec3 n = glm::normalize(normal_matrix * mesh.normals[i]);
-        const glm::vec4& t4 = mesh.tangents[i];
-        const glm::vec3 t = glm::normalize(linear * glm::vec3(t4));
-        ClipVertex& v = clip[i];
-        v.clip = view_projection_ * world;
-        v.varyings = {world.x, world.y, world.z, n.x, n.y, n.z, t.x, t.y, t.z, mirrored ? -t4.w : t4.w,
-                      mesh.uvs[i].x, mesh.uvs[i].y};
-      }
-    });
-
-    std::vector<std::uint32_t> screen_index(vertex_count, kUnmapped);
-    const std::size_t triangles = mesh.triangle_count();
-    result_.counters.triangles_in += triangles;
-    for (std::size_t t = 0; t < triangles; ++t) {
-      const std::uint32_t material =
-          mesh.triangle_materials.empty() ? item.material : item.mesh_materials[mesh.triangle_materials[t]];
-      const std::uint32_t i0 = mesh.indices[3 * t], i1 = mesh.indices[3 * t + 1], i2 = mesh.indices[3 * t + 2];
-      const ClipVertex* v[3] = {&clip[i0], &clip[i1], &clip[i2]};
-
-      unsigned outside_all = ~0u, outside_any = 0;
-      for (const ClipVertex* cv : v) {
-        const unsigned frustum = outcode(cv->clip, 1.0f, 1.0f);
-        const unsigned band = outcode(cv->clip, guard_x(), guard_y());
-        outside_all &= frustum;
-        outside_any |= band;
-      }
-      if (outside_all != 0) {
-        ++result_.counters.culled_outside;
-        continue;
-      }
-      if (outside_any == 0) {
-        const std::uint32_t s0 = map_vertex(screen_index, i0, *v[0]);
-        const std::uint32_t s1 = map_vertex(screen_index, i1, *v[1]);
-        const std::uint32_t s2 = map_vertex(screen_index, i2, *v[2]);
-        emit(s0, s1, s2, material, mirrored);
-        continue;
-      }
-      ++result_.counters.clipped;
-      ClipVertex polygon_a[kMaxPolygon], polygon_b[kMaxPolygon];
-      polygon_a[0] = *v[0];
-      polygon_a[1] = *v[1];
-      polygon_a[2] = *v[2];
-      int count = 3;
-      ClipVertex* in = polygon_a;
-      ClipVertex* out = polygon_b;
-      for (const ClipPlane& plane : clip_planes_) {
-        count = clip_polygon(in, count, out, plane);
-        std::swap(in, out);
-        if (count < 3) break;
-      }
-      if (count < 3) {
-        ++result_.counters.culled_outside;
-        continue;
-      }
-      std::uint32_t first = add_vertex(in[0]);
-      std::uint32_t previous = add_vertex(in[1]);
-      for (int k = 2; k < count; ++k) {
-        const std::uint32_t current = add_vertex(in[k]);
-        emit(first, previous, current, material, mirrored);
-        previous = current;
-      }
-    }
-  }
-
-private:
-  static constexpr std::uint32_t kUnmapped = ~0u;
-  float guard_x() const { return clip_planes_[2].coefficients.w; }
-  float guard_y() const { return clip_planes_[4].coefficients.w; }
-
-  // Bits: near, far, left, right, bottom, top; x/y tested against the band +-g*w.
-  static unsigned outcode(const glm::vec4& c, float gx, float gy) {
-    unsigned code = 0;
-    if (!(c.z >= -c.w)) code |= 1u;
-    if (!(c.z <= c.w)) code |= 2u;
-    if (!(c.x >= -gx * c.w)) code |= 4u;
-    if (!(c.x <= gx * c.w)) code |= 8u;
-    if (!(c.y >= -gy * c.w)) code |= 16u;
-    if (!(c.y <= gy * c.w)) code |= 32u;
-    return code;
-  }
-
-  std::uint32_t map_vertex(std::vector<std::uint32_t>& screen_index, std::uint32_t i, const ClipVertex& v) {
-    if (screen_index[i] == kUnmapped) screen_index[i] = add_vertex(v);
-    return screen_index[i];
-  }
-
-  std::uint32_t add_vertex(const ClipVertex& v) {
+  Projected project(const ClipVertex& v) const {
     const double inv_w = 1.0 / double(v.clip.w);
     const double ndc_x = v.clip.x * inv_w, ndc_y = v.clip.y * inv_w, ndc_z = v.clip.z * inv_w;
     const double sx = (ndc_x * 0.5 + 0.5) * viewport_.width;
     const double sy = (0.5 - ndc_y * 0.5) * viewport_.height;
-    ScreenVertex s;
-    s.inv_w = float(inv_w);
-    s.z = float(ndc_z * 0.5 + 0.5);
-    s.varyings = v.varyings;
-    result_.vertices.push_back(s);
-    fixed_x_.push_back(std::int32_t(std::floor(sx * limits::kSubpixelScale + 0.5)));
-    fixed_y_.push_back(std::int32_t(std::floor(sy * limits::kSubpixelScale + 0.5)));
-    return std::uint32_t(result_.vertices.size() - 1);
+    Projected p;
+    p.vertex.inv_w = float(inv_w);
+    p.vertex.z = float(ndc_z * 0.5 + 0.5);
+    p.vertex.varyings = v.varyings;
+    p.x = std::int32_t(std::floor(sx * limits::kSubpixelScale + 0.5));
+    p.y = std::int32_t(std::floor(sy * limits::kSubpixelScale + 0.5));
+    return p;
   }
 
-  void emit(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t material, bool mirrored) {
-    ScreenTriangle t;
-    t.vertex = {a, b, c};
-    t.x = {fixed_x_[a], fixed_x_[b], fixed_x_[c]};
-    t.y = {fixed_y_[a], fixed_y_[b], fixed_y_[c]};
-    t.material = material;
+private:
+  Viewport viewport_;
+  float gx_, gy_;
+  std::array<ClipPlane, 6> planes_;
+};
+
+// The vertices of one draw item after the vertex stage.
+struct ItemVertices {
+  std::vector<ClipVertex> clip;
+  std::vector<unsigned> frustum_code, band_code;
+  std::vector<Projected> projected;  // valid where band_code == 0
+};
+
+ItemVertices transform_vertices(const DrawItem& item, const glm::mat4& view_projection, const Projection& projection) {
+  const MeshData& mesh = *item.mesh;
+  const glm::mat3 linear(item.model);
+  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  const bool mirrored = glm::determinant(linear) < 0.0f;
+  const std::size_t n = mesh.vertex_count();
+  ItemVertices out;
+  out.clip.resize(n);
+  out.frustum_code.resize(n);
+  out.band_code.resize(n);
+  out.projected.resize(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const glm::vec4 world = item.model * glm::vec4(mesh.positions[i], 1.0f);
+      const glm::vec3 nrm = glm::normalize(normal_matrix * mesh.normals[i]);
+      const glm::vec4& t4 = mesh.tangents[i];
+      const glm::vec3 t = glm::normalize(linear * glm::vec3(t4));
+      ClipVertex& v = out.clip[i];
+      v.clip = view_projection * world;
+      v.varyings = {world.x, world.y, world.z, nrm.x, nrm.y, nrm.z, t.x, t.y, t.z, mirrored ? -t4.w : t4.w,
+                    mesh.uvs[i].x, mesh.uvs[i].y};
+      out.frustum_code[i] = outcode(v.clip, 1.0f, 1.0f);
+      out.band_code[i] = outcode(v.clip, projection.gx(), projection.gy());
+      if (out.band_code[i] == 0) out.projected[i] = projection.project(v);
+    }
+  });
+  return out;
+}
+
+// The triangles of one chunk, with the vertices its clipping made (numbered kLocalVertex | k).
+struct Chunk {
+  std::vector<ScreenTriangle> triangles;
+  std::vector<ScreenVertex> clipped_vertices;
+  GeometryCounters counters;
+};
+
+class ChunkAssembler {
+public:
+  ChunkAssembler(const DrawItem& item, const ItemVertices& vertices, const Projection& projection,
+                 std::uint32_t vertex_base, Chunk& chunk)
+      : item_(item), vertices_(vertices), projection_(projection), vertex_base_(vertex_base), chunk_(chunk),
+        mirrored_(glm::determinant(glm::mat3(item.model)) < 0.0f) {}
+
+  void triangle(std::size_t t) {
+    const MeshData& mesh = *item_.mesh;
+    const std::uint32_t material =
+        mesh.triangle_materials.empty() ? item_.material : item_.mesh_materials[mesh.triangle_materials[t]];
+    const std::uint32_t idx[3] = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
+    ++chunk_.counters.triangles_in;
+    if ((vertices_.frustum_code[idx[0]] & vertices_.frustum_code[idx[1]] & vertices_.frustum_code[idx[2]]) != 0) {
+      ++chunk_.counters.culled_outside;
+      return;
+    }
+    if ((vertices_.band_code[idx[0]] | vertices_.band_code[idx[1]] | vertices_.band_code[idx[2]]) == 0) {
+      const Projected* p[3] = {&vertices_.projected[idx[0]], &vertices_.projected[idx[1]], &vertices_.projected[idx[2]]};
+      emit({vertex_base_ + idx[0], vertex_base_ + idx[1], vertex_base_ + idx[2]}, {p[0]->x, p[1]->x, p[2]->x},
+           {p[0]->y, p[1]->y, p[2]->y}, material);
+      return;
+    }
+    ++chunk_.counters.clipped;
+    ClipVertex polygon_a[kMaxPolygon], polygon_b[kMaxPolygon];
+    for (int k = 0; k < 3; ++k) polygon_a[k] = vertices_.clip[idx[k]];
+    int count = 3;
+    ClipVertex* in = polygon_a;
+    ClipVertex* out = polygon_b;
+    for (const ClipPlane& plane : projection_.planes()) {
+      count = clip_polygon(in, count, out, plane);
+      std::swap(in, out);
+      if (count < 3) break;
+    }
+    if (count < 3) {
+      ++chunk_.counters.culled_outside;
+      return;
+    }
+    Projected projected[kMaxPolygon];
+    std::uint32_t local[kMaxPolygon];
+    for (int k = 0; k < count; ++k) {
+      projected[k] = projection_.project(in[k]);
+      local[k] = kLocalVertex | std::uint32_t(chunk_.clipped_vertices.size());
+      chunk_.clipped_vertices.push_back(projected[k].vertex);
+    }
+    for (int k = 2; k < count; ++k)
+      emit({local[0], local[k - 1], local[k]}, {projected[0].x, projected[k - 1].x, projected[k].x},
+           {projected[0].y, projected[k - 1].y, projected[k].y}, material);
+  }
+
+private:
+  void emit(std::array<std::uint32_t, 3> vertex, std::array<std::int32_t, 3> x, std::array<std::int32_t, 3> y,
+            std::uint32_t material) {
+    ScreenTriangle t{x, y, vertex, material};
     // Front faces are counter-clockwise as seen on screen, which is negative orient2d in y-down screen
     // space; a mirroring model matrix flips that. Setup wants positive orientation, so front faces are swapped.
     const std::int64_t area = orient2d(t);
-    const std::int64_t front_area = mirrored ? area : -area;
+    const std::int64_t front_area = mirrored_ ? area : -area;
     if (front_area <= 0) {
-      ++result_.counters.culled_backface;
+      ++chunk_.counters.culled_backface;
       return;
     }
     if (area < 0) {
@@ -195,24 +220,70 @@ private:
       std::swap(t.x[1], t.x[2]);
       std::swap(t.y[1], t.y[2]);
     }
-    result_.triangles.push_back(t);
-    ++result_.counters.triangles_out;
+    chunk_.triangles.push_back(t);
+    ++chunk_.counters.triangles_out;
   }
 
-  glm::mat4 view_projection_;
-  Viewport viewport_;
-  GeometryResult& result_;
-  std::array<ClipPlane, 6> clip_planes_;
-  std::vector<std::int32_t> fixed_x_, fixed_y_;
+  const DrawItem& item_;
+  const ItemVertices& vertices_;
+  const Projection& projection_;
+  std::uint32_t vertex_base_;
+  Chunk& chunk_;
+  bool mirrored_;
 };
 
 }  // namespace
 
-GeometryResult run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, const glm::mat4& projection,
+GeometryResult run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, const glm::mat4& projection_matrix,
                             const Viewport& viewport) {
+  const glm::mat4 view_projection = projection_matrix * view;
+  const Projection projection(viewport);
   GeometryResult result;
-  GeometryBuilder builder(projection * view, viewport, result);
-  for (const DrawItem& item : items) builder.add(item);
+
+  // Vertices of every item first (their global indices are fixed), then each chunk's clipped vertices.
+  std::vector<Chunk> chunks;
+  for (const DrawItem& item : items) {
+    const ItemVertices vertices = transform_vertices(item, view_projection, projection);
+    const std::uint32_t base = std::uint32_t(result.vertices.size());
+    result.vertices.resize(result.vertices.size() + vertices.projected.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.projected.size(), 8192), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) result.vertices[base + i] = vertices.projected[i].vertex;
+    });
+    const std::size_t triangles = item.mesh->triangle_count();
+    const std::size_t first_chunk = chunks.size();
+    chunks.resize(first_chunk + (triangles + kTrianglesPerChunk - 1) / kTrianglesPerChunk);
+    tbb::parallel_for(first_chunk, chunks.size(), [&](std::size_t c) {
+      ChunkAssembler assembler(item, vertices, projection, base, chunks[c]);
+      const std::size_t begin = (c - first_chunk) * kTrianglesPerChunk;
+      const std::size_t end = std::min(triangles, begin + kTrianglesPerChunk);
+      for (std::size_t t = begin; t < end; ++t) assembler.triangle(t);
+    });
+  }
+
+  // Merge the chunks in order: prefix sums, then parallel copies with local vertex numbers made global.
+  std::vector<std::size_t> triangle_offset(chunks.size() + 1, 0), vertex_offset(chunks.size() + 1, result.vertices.size());
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    triangle_offset[c + 1] = triangle_offset[c] + chunks[c].triangles.size();
+    vertex_offset[c + 1] = vertex_offset[c] + chunks[c].clipped_vertices.size();
+    const GeometryCounters& k = chunks[c].counters;
+    result.counters.triangles_in += k.triangles_in;
+    result.counters.culled_backface += k.culled_backface;
+    result.counters.culled_outside += k.culled_outside;
+    result.counters.clipped += k.clipped;
+    result.counters.triangles_out += k.triangles_out;
+  }
+  result.vertices.resize(vertex_offset.back());
+  result.triangles.resize(triangle_offset.back());
+  tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
+    const Chunk& chunk = chunks[c];
+    std::copy(chunk.clipped_vertices.begin(), chunk.clipped_vertices.end(), result.vertices.begin() + std::ptrdiff_t(vertex_offset[c]));
+    for (std::size_t i = 0; i < chunk.triangles.size(); ++i) {
+      ScreenTriangle t = chunk.triangles[i];
+      for (std::uint32_t& v : t.vertex)
+        if (v & kLocalVertex) v = std::uint32_t(vertex_offset[c]) + (v & ~kLocalVertex);
+      result.triangles[triangle_offset[c] + i] = t;
+    }
+  });
   return result;
 }
 

@@ -193,10 +193,11 @@ TileCounters& TileCounters::operator+=(const TileCounters& o) {
   return *this;
 }
 
-void raster_tile(const RasterContext& context, const PixelRect& tile, const std::vector<std::uint32_t>& bin,
+void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters) {
+  context.framebuffer->clear_rect(tile.x0, tile.y0, tile.x1, tile.y1);
   TileRasterizer rasterizer(context, tile, counters);
-  for (std::uint32_t index : bin) rasterizer.triangle((*context.setups)[index]);
+  bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
 }
 
 }  // namespace qdmr

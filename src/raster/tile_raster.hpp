@@ -30,7 +30,8 @@ struct RasterContext {
   Framebuffer* framebuffer = nullptr;
 };
 
-void raster_tile(const RasterContext& context, const PixelRect& tile, const std::vector<std::uint32_t>& bin,
+// Clears the tile's pixels, then draws every triangle binned to it, in submission order.
+void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters);
 
 }  // namespace qdmr

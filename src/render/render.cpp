@@ -51,18 +51,14 @@ Framebuffer make_framebuffer(const SceneDesc& scene, const RenderOptions& option
   Framebuffer fb;
   fb.width = scene.output.width;
   fb.height = scene.output.height;
+  fb.background = scene.output.background;
   const std::size_t pixels = std::size_t(fb.width) * std::size_t(fb.height);
   fb.color.resize(pixels * 3);
-  for (std::size_t i = 0; i < pixels; ++i) {
-    fb.color[3 * i] = scene.output.background.x;
-    fb.color[3 * i + 1] = scene.output.background.y;
-    fb.color[3 * i + 2] = scene.output.background.z;
-  }
-  fb.depth.assign(pixels, 1.0f);
+  fb.depth.resize(pixels);
   for (Aov aov : options.aovs) {
-    if (aov == Aov::Depth) fb.view_depth.assign(pixels, 0.0f);
-    if (aov == Aov::Normal) fb.normal.assign(pixels * 3, 0.0f);
-    if (aov == Aov::UV) fb.uv.assign(pixels * 2, 0.0f);
+    if (aov == Aov::Depth) fb.view_depth.resize(pixels);
+    if (aov == Aov::Normal) fb.normal.resize(pixels * 3);
+    if (aov == Aov::UV) fb.uv.resize(pixels * 2);
   }
   return fb;
 }
@@ -185,7 +181,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     report("raster", 0.0);
     tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
       for (int tile = range.begin(); tile != range.end(); ++tile) {
-        raster_tile(context, grid.rect(tile), bins[std::size_t(tile)], tile_counters[std::size_t(tile)]);
+        raster_tile(context, tile, grid.rect(tile), bins, tile_counters[std::size_t(tile)]);
         const int done = ++tiles_done;
         if (done % report_every == 0) report("raster", double(done) / grid.count());
       }

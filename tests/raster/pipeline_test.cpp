@@ -168,7 +168,7 @@ TEST(Pipeline, IntersectingPlanesKeepTheNearerSurfacePerPixel) {
   EXPECT_EQ(wrong, 0);
 }
 
-std::vector<float> color_of(const std::string& scene_name, int threads, int tile) {
+PixelBuffer color_of(const std::string& scene_name, int threads, int tile) {
   const SceneDesc scene = load_scene(source_dir() / "scenes" / scene_name, {{"/output/width", "320"}, {"/output/height", "180"}});
   RenderOptions options;
   options.threads = threads;
@@ -178,7 +178,7 @@ std::vector<float> color_of(const std::string& scene_name, int threads, int tile
 
 TEST(Determinism, SameBitsForAnyThreadCountAndTileSize) {
   for (const char* name : {"objects.json", "terrain.json"}) {
-    const std::vector<float> reference = color_of(name, 1, 64);
+    const PixelBuffer reference = color_of(name, 1, 64);
     for (int threads : {2, 8})
       EXPECT_EQ(0, std::memcmp(color_of(name, threads, 64).data(), reference.data(), reference.size() * sizeof(float)))
           << name << " threads " << threads;

@@ -74,8 +74,8 @@ struct ScreenScene {
     Framebuffer fb;
     fb.width = width;
     fb.height = height;
-    fb.color.assign(std::size_t(width) * height * 3, 0.0f);
-    fb.depth.assign(std::size_t(width) * height, 1.0f);
+    fb.color.resize(std::size_t(width) * height * 3);
+    fb.depth.resize(std::size_t(width) * height);
     CountingProgram program(width, height);
     RasterContext context;
     context.geometry = &geometry;
@@ -84,7 +84,7 @@ struct ScreenScene {
     context.programs = {&program};
     for (int tile = 0; tile < grid.count(); ++tile) {
       TileCounters counters;
-      raster_tile(context, grid.rect(tile), bins[std::size_t(tile)], counters);
+      raster_tile(context, tile, grid.rect(tile), bins, counters);
     }
     return program.counts;
   }

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "qdmr/render/pixel_buffer.hpp"
 #include "qdmr/scene/scene.hpp"
 
 namespace qdmr {
@@ -50,12 +51,12 @@ struct RenderStats {
 struct AovImage {
   Aov aov;
   int channels = 0;
-  std::vector<float> pixels;  // width * height * channels
+  PixelBuffer pixels;  // width * height * channels
 };
 
 struct Frame {
   int width = 0, height = 0;
-  std::vector<float> color;  // linear RGB, row 0 at the top
+  PixelBuffer color;  // linear RGB, row 0 at the top
   std::vector<AovImage> aovs;
   RenderStats stats;
 };
