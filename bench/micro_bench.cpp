@@ -54,8 +54,8 @@ const Workload& workload(int which) {
   return which == 0 ? grid : plane;
 }
 
-std::vector<TriangleSetup> setup_all(const GeometryResult& geometry, const Viewport& viewport) {
-  std::vector<TriangleSetup> setups(geometry.triangles.size());
+TriangleSetups setup_all(const GeometryResult& geometry, const Viewport& viewport) {
+  TriangleSetups setups(geometry.triangles.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
   });
@@ -90,7 +90,7 @@ void BM_SetupBinning(benchmark::State& state, int which) {
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
   for (auto _ : state) {
     arena.execute([&] {
-      const std::vector<TriangleSetup> setups = setup_all(geometry, w.viewport);
+      const TriangleSetups setups = setup_all(geometry, w.viewport);
       TileBins bins = bin_triangles(setups, grid);
       benchmark::DoNotOptimize(bins.bins.data());
     });
@@ -105,7 +105,7 @@ void BM_RasterShade(benchmark::State& state, int which) {
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
   const GeometryResult geometry = arena.execute([&] { return run_geometry(w.draws, w.view, w.projection, w.viewport); });
-  const std::vector<TriangleSetup> setups = arena.execute([&] { return setup_all(geometry, w.viewport); });
+  const TriangleSetups setups = arena.execute([&] { return setup_all(geometry, w.viewport); });
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
   const TileBins bins = bin_triangles(setups, grid);
   const std::size_t pixels = std::size_t(w.viewport.width) * std::size_t(w.viewport.height);

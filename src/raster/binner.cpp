@@ -6,7 +6,7 @@
 
 namespace qdmr {
 
-TileBins bin_triangles(const std::vector<TriangleSetup>& setups, const TileGrid& grid) {
+TileBins bin_triangles(const TriangleSetups& setups, const TileGrid& grid) {
   TileBins result;
   const std::size_t chunks = (setups.size() + TileBins::kTrianglesPerChunk - 1) / TileBins::kTrianglesPerChunk;
   result.bins.resize(chunks);

@@ -38,6 +38,6 @@ struct TileBins {
   }
 };
 
-TileBins bin_triangles(const std::vector<TriangleSetup>& setups, const TileGrid& grid);
+TileBins bin_triangles(const TriangleSetups& setups, const TileGrid& grid);
 
 }  // namespace qdmr

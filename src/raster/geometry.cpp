@@ -112,9 +112,9 @@ private:
 
 // The vertices of one draw item after the vertex stage.
 struct ItemVertices {
-  std::vector<ClipVertex> clip;
-  std::vector<unsigned> frustum_code, band_code;
-  std::vector<Projected> projected;  // valid where band_code == 0
+  UninitVector<ClipVertex> clip;
+  UninitVector<unsigned> frustum_code, band_code;
+  UninitVector<Projected> projected;  // valid where band_code == 0
 };
 
 ItemVertices transform_vertices(const DrawItem& item, const glm::mat4& view_projection, const Projection& projection) {

@@ -9,6 +9,7 @@
 #include <glm/vec4.hpp>
 
 #include "qdmr/mesh/mesh.hpp"
+#include "qdmr/render/pixel_buffer.hpp"
 
 namespace qdmr {
 
@@ -51,9 +52,13 @@ struct GeometryCounters {
   std::uint64_t triangles_out = 0;
 };
 
+// Large per-vertex and per-triangle arrays are filled in parallel: allocating them must not zero them serially.
+template <class T>
+using UninitVector = std::vector<T, DefaultInitAllocator<T>>;
+
 struct GeometryResult {
-  std::vector<ScreenVertex> vertices;
-  std::vector<ScreenTriangle> triangles;
+  UninitVector<ScreenVertex> vertices;
+  UninitVector<ScreenTriangle> triangles;
   GeometryCounters counters;
 };
 

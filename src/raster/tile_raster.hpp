@@ -25,7 +25,7 @@ struct TileCounters {
 
 struct RasterContext {
   const GeometryResult* geometry = nullptr;
-  const std::vector<TriangleSetup>* setups = nullptr;
+  const TriangleSetups* setups = nullptr;
   std::vector<const ShadingProgram*> programs;  // indexed by TriangleSetup::material
   Framebuffer* framebuffer = nullptr;
 };

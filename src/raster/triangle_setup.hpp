@@ -29,6 +29,8 @@ struct TriangleSetup {
   std::int64_t edge(int i, std::int64_t X, std::int64_t Y) const { return std::int64_t(dx[i]) * Y - std::int64_t(dy[i]) * X + c[i]; }
 };
 
+using TriangleSetups = UninitVector<TriangleSetup>;
+
 TriangleSetup setup_triangle(const ScreenTriangle& t, const GeometryResult& geometry, const Viewport& viewport);
 
 // Fixed-point coordinate of the centre of pixel p.

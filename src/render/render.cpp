@@ -157,7 +157,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     stats.triangles_rasterized = geometry.counters.triangles_out;
 
     start = Clock::now();
-    std::vector<TriangleSetup> setups(geometry.triangles.size());
+    TriangleSetups setups(geometry.triangles.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
       for (std::size_t i = range.begin(); i != range.end(); ++i)
         setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);

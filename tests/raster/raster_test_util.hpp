@@ -67,7 +67,7 @@ struct ScreenScene {
   // Rasterizes every triangle with the counting program; returns the per-pixel shade counts.
   std::vector<int> raster_counts(int tile_size = 64) const {
     const Viewport viewport{width, height};
-    std::vector<TriangleSetup> setups;
+    TriangleSetups setups;
     for (const ScreenTriangle& t : geometry.triangles) setups.push_back(setup_triangle(t, geometry, viewport));
     const TileGrid grid(width, height, tile_size);
     const TileBins bins = bin_triangles(setups, grid);
