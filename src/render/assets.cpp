@@ -3,19 +3,49 @@
 #include <tbb/parallel_for.h>
 
 #include "qdmr/core/error.hpp"
+#include "qdmr/texture/height_texture.hpp"
 #include "shade/normal_mapping.hpp"
 
 namespace qdmr {
 namespace {
 
-Texture build_texture(const TextureRequest& request) {
+const char* purpose_name(TexturePurpose p) {
+  switch (p) {
+    case TexturePurpose::Albedo: return "albedo";
+    case TexturePurpose::Normal: return "normal";
+    case TexturePurpose::Height: return "height";
+  }
+  return "?";
+}
+
+// Builds one requested texture. Heights (and the heights behind from_height normals) go through the storage
+// the scene asks for — quantisation, BC3 — so what is rendered is what a GPU would sample.
+Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight;
   Image height;
-  if (needs_height) height = make_layer_height(request.layer, request.where);
+  if (needs_height) {
+    const HeightTexture stored =
+        make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, MipReduce::Max);
+    height = stored.texture.level_image(0);
+    stat.height_format = format_name(stored.texture.format);
+    if (stored.bc3) {
+      stat.bc3 = true;
+      stat.bc3_max_error = stored.bc3->max_error;
+      stat.bc3_rms_error = stored.bc3->rms_error;
+    }
+  }
   Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
   if (request.purpose == TexturePurpose::Normal)
     for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
-  return make_mip_texture(level0, request.format, request.srgb, request.reduce);
+  Texture texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+  stat.where = request.where;
+  stat.purpose = purpose_name(request.purpose);
+  stat.format = format_name(texture.format) + (texture.srgb ? " srgb" : "");
+  stat.width = texture.width();
+  stat.height = texture.height();
+  stat.levels = texture.level_count();
+  stat.bytes = texture.bytes();
+  return texture;
 }
 
 }  // namespace
@@ -85,8 +115,10 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
   }
 
   assets.textures.resize(assets.requests.size());
-  tbb::parallel_for(std::size_t(0), assets.requests.size(),
-                    [&](std::size_t i) { assets.textures[i] = build_texture(assets.requests[i]); });
+  assets.texture_stats.resize(assets.requests.size());
+  tbb::parallel_for(std::size_t(0), assets.requests.size(), [&](std::size_t i) {
+    assets.textures[i] = build_texture(assets.requests[i], assets.texture_stats[i]);
+  });
 
   for (const MaterialPlan& m : assets.materials)
     assets.programs.push_back(std::make_unique<NormalMappingProgram>(assets.textures[std::size_t(m.albedo)],

@@ -19,6 +19,7 @@ struct Assets {
   std::vector<MaterialPlan> materials;          // frame materials: the scene's, then those of MTL files
   std::vector<TextureRequest> requests;
   std::vector<Texture> textures;                // parallel to requests
+  std::vector<TextureStat> texture_stats;       // parallel to requests
   std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
 
   std::vector<DrawItem> draw_items() const;     // model matrices left as identity

@@ -107,6 +107,14 @@ nlohmann::json RenderStats::to_json() const {
   j["threads"] = threads;
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes},
                  {"mesh_bytes", mesh_bytes}, {"peak_rss_bytes", peak_rss_bytes}};
+  j["textures"] = nlohmann::json::array();
+  for (const TextureStat& t : textures) {
+    nlohmann::json entry = {{"where", t.where},   {"purpose", t.purpose}, {"format", t.format}, {"width", t.width},
+                            {"height", t.height}, {"levels", t.levels},   {"bytes", t.bytes}};
+    if (!t.height_format.empty()) entry["height_format"] = t.height_format;
+    if (t.bc3) entry["bc3"] = {{"max_error", t.bc3_max_error}, {"rms_error", t.bc3_rms_error}};
+    j["textures"].push_back(entry);
+  }
   return j;
 }
 
@@ -139,6 +147,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     stats.prepare_ms = ms_since(start);
     report("prepare", 1.0);
     stats.texture_bytes = assets.texture_bytes();
+    stats.textures = assets.texture_stats;
     stats.mesh_bytes = assets.mesh_bytes();
 
     start = Clock::now();

@@ -47,10 +47,13 @@ Image read_image(const std::filesystem::path& file, const std::string& where) {
     for (std::size_t i = 0; i < raw.size(); ++i) image.texels[i] = float(raw[i]) / max;
   };
   const bool uniform = spec.channelformats.empty();
-  if (uniform && spec.format == OIIO::TypeDesc::UINT8)
+  if (uniform && spec.format == OIIO::TypeDesc::UINT8) {
     convert(std::uint8_t{}, 255.0f);
-  else if (uniform && spec.format == OIIO::TypeDesc::UINT16)
+    image.source_bits = 8;
+  } else if (uniform && spec.format == OIIO::TypeDesc::UINT16) {
     convert(std::uint16_t{}, 65535.0f);
+    image.source_bits = 16;
+  }
   else
     read(OIIO::TypeDesc::FLOAT, image.texels.data());
   return image;

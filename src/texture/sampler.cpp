@@ -70,7 +70,8 @@ LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) 
           simd::load_i32(view.offsets(), level, path)};
 }
 
-void decode(const Texture& t, const Int& raw, FetchPath path, Float* out) {
+// Inlined into the filters: the format switch and fetch are uniform per call and cheap to specialise.
+[[gnu::always_inline]] inline void decode(const Texture& t, const Int& raw, FetchPath path, Float* out) {
   const Float inv255(255.0f);
   const auto unorm8 = [&](const Int& byte, bool srgb) {
     return srgb ? simd::load_f32(srgb_table(), byte, path) : xsimd::to_float(byte) / inv255;
@@ -89,7 +90,8 @@ void decode(const Texture& t, const Int& raw, FetchPath path, Float* out) {
   }
 }
 
-void fetch(const TextureView& view, const LevelInfo& level, const Int& x, const Int& y, FetchPath path, Float* out) {
+[[gnu::always_inline]] inline void fetch(const TextureView& view, const LevelInfo& level, const Int& x, const Int& y,
+                                         FetchPath path, Float* out) {
   const Texture& t = view.texture();
   const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(t.format));
   decode(t, simd::load_bytes4(t.storage.data(), offset, path), path, out);
@@ -151,6 +153,7 @@ TextureView::TextureView(const Texture& texture) : texture_(&texture), levels_(t
     height_[std::size_t(i)] = l.height;
     offset_[std::size_t(i)] = std::int32_t(l.offset);
   }
+  for (int c = 0; c < texture.channels(); ++c) first_texel_[std::size_t(c)] = texture.texel(0, 0, 0, c);
 }
 
 Float lod_from_derivatives(const TextureView& view, const Float& dudx, const Float& dvdx, const Float& dudy,
@@ -197,8 +200,8 @@ void sample(const TextureView& view, const SamplerState& s, const Float& u, cons
       break;
     }
   }
-  const Texture& t = view.texture();
-  for (int c = 0; c < t.channels(); ++c) out[c] = xsimd::select(finite, out[c], Float(t.texel(0, 0, 0, c)));
+  for (int c = 0; c < view.texture().channels(); ++c)
+    out[c] = xsimd::select(finite, out[c], Float(view.first_texel()[std::size_t(c)]));
 }
 
 void load(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path, Float* out) {

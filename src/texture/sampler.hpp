@@ -24,11 +24,14 @@ public:
   const std::int32_t* widths() const { return width_.data(); }
   const std::int32_t* heights() const { return height_.data(); }
   const std::int32_t* offsets() const { return offset_.data(); }
+  // Level-0 texel (0, 0), decoded: what lanes with non-finite coordinates return.
+  const std::array<float, 4>& first_texel() const { return first_texel_; }
 
 private:
   const Texture* texture_;
   int levels_;
   alignas(64) std::array<std::int32_t, kMaxLevels> width_{}, height_{}, offset_{};
+  std::array<float, 4> first_texel_{};
 };
 
 struct SamplerState {

@@ -62,6 +62,7 @@ std::vector<int> select_channels(const Image& image, Channel channel, int count,
 
 Image pick(const Image& src, const std::vector<int>& channels) {
   Image out(src.width, src.height, int(channels.size()));
+  out.source_bits = src.source_bits;
   for_rows(src.height, [&](int y) {
     for (int x = 0; x < src.width; ++x)
       for (int c = 0; c < out.channels; ++c) out.at(x, y, c) = src.at(x, y, channels[std::size_t(c)]);
@@ -199,13 +200,19 @@ Image height_texture(const TextureDesc& desc, const LayerDesc& layer, const std:
   Image out;
   switch (desc.source) {
     case TextureSource::None: return constant({1.0f});  // flat at the top, whatever the scale and offset
-    case TextureSource::Constant: out = constant({desc.constant.x}); break;
+    case TextureSource::Constant:
+      out = constant({desc.constant.x});
+      out.source_bits = 8;
+      break;
     case TextureSource::File: {
       const Image file = read_image(desc.file, where);
       out = pick(file, select_channels(file, desc.channel, 1, desc, where));
       break;
     }
-    case TextureSource::Procedural: out = generate_procedural(desc.procedural); break;
+    case TextureSource::Procedural:
+      out = generate_procedural(desc.procedural);
+      out.source_bits = 16;  // stored as R16 unless the scene asks otherwise
+      break;
     case TextureSource::FromHeight: throw Error(where, "a height texture cannot be 'from_height'");
   }
   apply_height_transform(out, layer);

@@ -35,6 +35,18 @@ struct RenderOptions {
 // Throws qdmr::Error("option", ...) when options are out of range.
 void validate_options(const RenderOptions& options);
 
+// What was built for one texture of the frame.
+struct TextureStat {
+  std::string where;    // the scene field it came from
+  std::string purpose;  // albedo, normal, height
+  std::string format;   // storage format of the chain, e.g. "rgba8 srgb"
+  int width = 0, height = 0, levels = 0;
+  std::uint64_t bytes = 0;
+  std::string height_format;  // heights behind it (from_height normals, heights): storage format, else empty
+  bool bc3 = false;           // the height was BC3-compressed; errors in 8-bit steps
+  double bc3_max_error = 0, bc3_rms_error = 0;
+};
+
 struct RenderStats {
   // Milliseconds per stage; load and write are filled in by whoever loads and writes.
   double load_ms = 0, prepare_ms = 0, geometry_ms = 0, binning_ms = 0, raster_shade_ms = 0, write_ms = 0;
@@ -44,6 +56,7 @@ struct RenderStats {
   int threads = 0, tile_size = 0, simd_lanes = 0;
   std::string simd_arch;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
+  std::vector<TextureStat> textures;
 
   nlohmann::json to_json() const;
 };

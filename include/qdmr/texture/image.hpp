@@ -12,6 +12,7 @@ struct Image {
   int width = 0;
   int height = 0;
   int channels = 0;
+  int source_bits = 32;  // bits per channel of the data it came from: 8 or 16 for integer files, 32 otherwise
   std::vector<float> texels;
 
   Image() = default;
