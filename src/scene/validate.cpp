@@ -291,10 +291,49 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
   for (const Value& item : items) material.layers.push_back(read_layer(item));
 
   if (auto v = object.find("technique")) {
-    const Object technique(*v, {"name", "depth_scale"});
+    const Object technique(*v, {"name", "depth_scale", "write_depth", "linear_steps", "binary_steps", "min_steps",
+                                "max_steps", "lod_threshold", "lod_fade", "max_iterations", "min_iterations", "level_up",
+                                "refinement", "height_fetch", "lod_stop", "fade_start", "fade_end"});
+    TechniqueDesc& d = material.technique;
     if (auto t = technique.find("name"))
-      material.technique.kind = t->choice<TechniqueKind>({{"normal", TechniqueKind::Normal}});
-    if (auto t = technique.find("depth_scale")) material.technique.depth_scale = static_cast<float>(t->positive());
+      d.kind = t->choice<TechniqueKind>({{"normal", TechniqueKind::Normal},
+                                         {"relief", TechniqueKind::Relief},
+                                         {"pom", TechniqueKind::Pom},
+                                         {"csm", TechniqueKind::Csm},
+                                         {"rcsm", TechniqueKind::Rcsm},
+                                         {"qdm", TechniqueKind::Qdm}});
+    if (auto t = technique.find("depth_scale")) d.depth_scale = static_cast<float>(t->number_in(0.0, 100.0));
+    if (auto t = technique.find("write_depth")) d.write_depth = t->boolean();
+    if (auto t = technique.find("linear_steps")) d.linear_steps = static_cast<int>(t->integer(1, 4096));
+    if (auto t = technique.find("binary_steps")) d.binary_steps = static_cast<int>(t->integer(0, 64));
+    if (auto t = technique.find("min_steps")) d.min_steps = static_cast<int>(t->integer(1, 4096));
+    if (auto t = technique.find("max_steps")) {
+      d.max_steps = static_cast<int>(t->integer(1, 4096));
+      t->require(d.max_steps >= d.min_steps, "must not be below min_steps");
+    }
+    if (auto t = technique.find("lod_threshold")) d.lod_threshold = static_cast<float>(t->number_in(-16.0, 16.0));
+    if (auto t = technique.find("lod_fade")) d.lod_fade = static_cast<float>(t->number_in(0.0, 16.0));
+    if (auto t = technique.find("max_iterations")) d.max_iterations = static_cast<int>(t->integer(1, 1 << 20));
+    if (auto t = technique.find("min_iterations")) {
+      d.min_iterations = static_cast<int>(t->integer(0, 1 << 20));
+      t->require(d.min_iterations <= d.max_iterations, "must not exceed max_iterations");
+    }
+    if (auto t = technique.find("level_up"))
+      d.level_up = t->choice<QdmLevelUp>(
+          {{"stay", QdmLevelUp::Stay}, {"one", QdmLevelUp::One}, {"aligned", QdmLevelUp::Aligned}});
+    if (auto t = technique.find("refinement"))
+      d.refinement = t->choice<QdmRefinement>({{"none", QdmRefinement::None},
+                                               {"linear", QdmRefinement::Linear},
+                                               {"binary", QdmRefinement::Binary},
+                                               {"bilinear_patch", QdmRefinement::BilinearPatch}});
+    if (auto t = technique.find("height_fetch"))
+      d.height_fetch = t->choice<HeightFetch>({{"point", HeightFetch::Point}, {"trilinear", HeightFetch::Trilinear}});
+    if (auto t = technique.find("lod_stop")) d.lod_stop = t->boolean();
+    if (auto t = technique.find("fade_start")) d.fade_start = static_cast<float>(t->non_negative());
+    if (auto t = technique.find("fade_end")) {
+      d.fade_end = static_cast<float>(t->non_negative());
+      t->require(d.fade_end >= d.fade_start, "must not be below fade_start");
+    }
   }
   if (auto v = object.find("sampling")) {
     const Object sampling(*v, {"filter", "address", "precision", "lod", "lod_bias", "min_lod", "max_lod", "math"});

@@ -301,7 +301,7 @@ TEST(SceneLoader, MaterialChecks) {
   document = minimal_scene();
   document["materials"]["rock"]["technique"] = {{"depth_scale", -0.1}};
   EXPECT_EQ(load_error(document),
-            "scene.json: /materials/rock/technique/depth_scale: must be greater than 0, got -0.1");
+            "scene.json: /materials/rock/technique/depth_scale: must be from 0 to 100, got -0.1");
   document = minimal_scene();
   document["materials"]["a/b"] = document["materials"]["rock"];
   document["materials"]["a/b"]["lighting"] = {{"shininess", 0}};

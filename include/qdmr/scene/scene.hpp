@@ -94,11 +94,38 @@ struct LayerDesc {
   float height_offset = 0.0f;
 };
 
-enum class TechniqueKind { Normal };
+enum class TechniqueKind { Normal, Relief, Pom, Csm, Rcsm, Qdm };
+// QDM: where to continue after the ray crosses into a neighbouring cell.
+enum class QdmLevelUp { Stay, One, Aligned };
+// QDM: how the level-0 hit is refined between texels.
+enum class QdmRefinement { None, Linear, Binary, BilinearPatch };
+// QDM: how the max-quadtree is fetched (the talk: point; LinearMipMapLinear "possible but may introduce artifacts").
+enum class HeightFetch { Point, Trilinear };
 
+// The intersection technique and its speed/accuracy knobs. Depth is in UV units of one texture repeat:
+// the surface lies between depth 0 (the polygon) and depth_scale.
 struct TechniqueDesc {
   TechniqueKind kind = TechniqueKind::Normal;
-  float depth_scale = 0.05f;  // surface depth in UV units of one texture repeat (used by later techniques)
+  float depth_scale = 0.05f;
+  bool write_depth = false;       // displaced depth into the depth buffer
+  // relief: linear search then binary search
+  int linear_steps = 32;
+  int binary_steps = 6;
+  // pom: step count lerped by view angle, linear intersection of the last two samples, LOD fade
+  int min_steps = 8;
+  int max_steps = 48;
+  float lod_threshold = 4.0f;     // mip LOD where POM starts fading to normal mapping
+  float lod_fade = 1.0f;          // LOD range of the fade
+  // csm, rcsm and qdm: iteration cap
+  int max_iterations = 128;
+  // qdm
+  QdmLevelUp level_up = QdmLevelUp::One;
+  QdmRefinement refinement = QdmRefinement::Linear;
+  HeightFetch height_fetch = HeightFetch::Point;
+  bool lod_stop = false;          // stop descending at the level given by the pixel's mip LOD
+  int min_iterations = 0;         // > 0: the cap grows linearly from this (view along the normal) to max_iterations (grazing)
+  float fade_start = 0.0f;        // > 0: depth scale fades linearly to 0 between these view distances
+  float fade_end = 0.0f;
 };
 
 // Texture filters, named as in OpenGL/D3D: texel filter (point = nearest, linear = bilinear) and mip filter

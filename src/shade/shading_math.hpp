@@ -1,0 +1,84 @@
+#pragma once
+// Vector algebra on batches and the steps every shading program shares: the tangent frame from the
+// varyings, UV derivatives, and Blinn-Phong lighting. Lane-wise IEEE only, so SSE and AVX2 agree.
+#include "core/det_math.hpp"
+#include "core/simd.hpp"
+#include "qdmr/scene/scene.hpp"
+#include "shade/lighting.hpp"
+#include "shade/program.hpp"
+
+namespace qdmr::shading {
+
+using simd::Float;
+
+struct Vec3 {
+  Float x, y, z;
+};
+
+inline Float dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline Vec3 scale(const Vec3& a, const Float& s) { return {a.x * s, a.y * s, a.z * s}; }
+inline Vec3 add(const Vec3& a, const Vec3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 normalize(const Vec3& v) {
+  // Zero vectors (possible only in degenerate helper lanes) stay finite.
+  const Float len2 = xsimd::max(dot(v, v), Float(1e-30f));
+  return scale(v, Float(1.0f) / xsimd::sqrt(len2));
+}
+
+// Orthonormal tangent frame from the interpolated varyings: t along +u, b along +v, n the geometric normal.
+struct TangentFrame {
+  Vec3 t, b, n;
+
+  static TangentFrame from(const Fragments& in) {
+    TangentFrame f;
+    f.n = normalize({in.varyings[kNormalX], in.varyings[kNormalY], in.varyings[kNormalZ]});
+    const Vec3 t{in.varyings[kTangentX], in.varyings[kTangentY], in.varyings[kTangentZ]};
+    f.t = normalize(add(t, scale(f.n, Float(0.0f) - dot(t, f.n))));
+    const Float sign = xsimd::select(in.varyings[kTangentW] < Float(0.0f), Float(-1.0f), Float(1.0f));
+    f.b = scale(cross(f.n, f.t), sign);
+    return f;
+  }
+  Vec3 to_world(const Vec3& v) const { return add(add(scale(t, v.x), scale(b, v.y)), scale(n, v.z)); }
+  Vec3 to_tangent(const Vec3& v) const { return {dot(v, t), dot(v, b), dot(v, n)}; }
+};
+
+struct UvDerivatives {
+  Float dudx, dvdx, dudy, dvdy;
+
+  static UvDerivatives from(const Float& u, const Float& v, LodMode mode) {
+    if (mode == LodMode::PerQuad) return {simd::quad_ddx(u), simd::quad_ddx(v), simd::quad_ddy(u), simd::quad_ddy(v)};
+    return {simd::pixel_ddx(u), simd::pixel_ddx(v), simd::pixel_ddy(u), simd::pixel_ddy(v)};
+  }
+};
+
+inline Vec3 view_vector(const Fragments& in, const LightRig& lights) {
+  return normalize({Float(lights.camera_position.x) - in.varyings[kWorldX],
+                    Float(lights.camera_position.y) - in.varyings[kWorldY],
+                    Float(lights.camera_position.z) - in.varyings[kWorldZ]});
+}
+
+// Blinn-Phong from the rig's directional lights plus ambient; `geometric` gates highlights below the polygon.
+inline void blinn_phong(const Vec3& shading_normal, const Vec3& geometric, const Vec3& view, const Float* albedo,
+                        const LightingDesc& lighting, const LightRig& lights, Float* color) {
+  Float diffuse[3] = {Float(lights.ambient.x), Float(lights.ambient.y), Float(lights.ambient.z)};
+  Float specular[3] = {Float(0.0f), Float(0.0f), Float(0.0f)};
+  const Float zero(0.0f);
+  for (const auto& light : lights.directional) {
+    const Vec3 l{Float(light.direction.x), Float(light.direction.y), Float(light.direction.z)};
+    const Float n_dot_l = xsimd::max(dot(shading_normal, l), zero);
+    const Vec3 h = normalize(add(l, view));
+    const Float facing = xsimd::select(dot(geometric, l) > zero, Float(1.0f), zero);
+    const Float spec = detmath::pow(xsimd::max(dot(shading_normal, h), zero), Float(lighting.shininess)) *
+                       Float(lighting.specular) * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
+    const float radiance[3] = {light.radiance.x, light.radiance.y, light.radiance.z};
+    for (int c = 0; c < 3; ++c) {
+      diffuse[c] += n_dot_l * Float(radiance[c]);
+      specular[c] += spec * Float(radiance[c]);
+    }
+  }
+  for (int c = 0; c < 3; ++c) color[c] = albedo[c] * diffuse[c] + specular[c];
+}
+
+}  // namespace qdmr::shading
