@@ -1,0 +1,56 @@
+#pragma once
+// The displaced surface as the techniques and the exact reference see it, in tangent/UV space:
+// u, v in texture repeats; depth measured down from the polygon (depth 0) to depth_scale; a texel of height
+// h in [0,1] lies at depth depth_scale * (1 - h). Level-0 texel (i, j) covers [i/W, (i+1)/W) x [j/H, (j+1)/H)
+// and its centre is ((i + 0.5)/W, (j + 0.5)/H).
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "qdmr/scene/scene.hpp"
+
+namespace qdmr {
+
+struct HeightField {
+  int width = 0, height = 0;
+  std::vector<double> h;                   // row-major, row 0 at v = 0; values in [0, 1]
+  AddressMode address = AddressMode::Wrap;  // wrap repeats the map; clamp extends the edge texels; mirror reflects
+
+  // Texel (i, j) with the address mode applied: wrap i mod W; clamp to [0, W); mirror with period 2W
+  // (i = -1 reads texel 0, i = W reads texel W - 1). Any int64 index is valid.
+  double at(std::int64_t i, std::int64_t j) const;
+};
+
+// A ray in UV/depth space: p(t) = origin + t * direction, t >= 0. Rays of interest enter at depth 0 and go
+// down (direction.z > 0); direction.z == 0 is a ray parallel to the polygon.
+struct SurfaceRay {
+  glm::dvec3 origin;     // (u, v, depth)
+  glm::dvec3 direction;  // (du, dv, ddepth)
+};
+
+enum class ReferenceSurface {
+  Box,      // each level-0 texel a flat cell at its depth (what point sampling sees)
+  Bilinear  // the bilinear patch through the texel centres (what bilinear filtering sees)
+};
+
+// Depth of the surface at (u, v), what a ray must reach there to hit it:
+// - Box: the depth of texel (floor(u W), floor(v H)). The columns are closed boxes, so on a texel edge or corner
+//   the highest (least deep) of the texels touching it counts; the exact reference uses the same rule.
+// - Bilinear: the bilinear interpolation of the four texel centres around (u, v).
+double surface_depth(const HeightField& field, double depth_scale, double u, double v, ReferenceSurface surface);
+
+struct ReferenceHit {
+  bool hit = false;  // false: the ray left the [0, depth_scale] slab or exceeded max_cells without a hit
+  double t = 0;
+  glm::dvec3 point{0.0};  // (u, v, depth) of the first intersection: origin + t * direction, except that the
+                          // coordinate on the surface is pinned to it (the depth of a top face or of the bilinear
+                          // patch, the u or v of a box wall); the origin itself when inside_at_start
+  bool inside_at_start = false;  // the origin lies strictly below the surface (t = 0 is the answer); an origin
+                                 // exactly on the surface also hits at t = 0, with inside_at_start = false
+  std::int64_t cells_visited = 0;  // grid cells solved (texels for Box, centre-to-centre cells for Bilinear),
+                                   // including the one holding the hit; 0 when settled at the origin
+};
+
+}  // namespace qdmr
