@@ -1,6 +1,7 @@
 // The qdmr command: a thin layer over the library (scene loading, planning, rendering, writing).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -12,10 +13,12 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
 #include "qdmr/scene/load.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace {
 
@@ -150,6 +153,51 @@ int run_plan(const SceneArgs& args, bool as_json) {
   return 0;
 }
 
+struct ConeArgs {
+  std::string height, output, kind = "conservative", channel = "r", address = "wrap";
+};
+
+// qdmr bake cone: the cone map of one channel of a height image, as a 32-bit float EXR.
+int run_bake_cone(const ConeArgs& args) {
+  if (args.kind != "conservative" && args.kind != "relaxed")
+    throw qdmr::Error("--kind " + args.kind, "unknown cone kind (valid: conservative, relaxed)");
+  const std::string addresses[] = {"wrap", "clamp", "mirror"};
+  const auto address = std::find(std::begin(addresses), std::end(addresses), args.address);
+  if (address == std::end(addresses))
+    throw qdmr::Error("--address " + args.address, "unknown address mode (valid: wrap, clamp, mirror)");
+  const std::string channels = "rgba";
+  if (args.channel.size() != 1 || channels.find(args.channel[0]) == std::string::npos)
+    throw qdmr::Error("--channel " + args.channel, "unknown channel (valid: r, g, b, a)");
+  const std::filesystem::path out = args.output;
+  if (out.extension() != ".exr") throw qdmr::Error("-o " + args.output, "the cone map is written as .exr");
+  check_output_path("-o", out, args.height);
+  const qdmr::Image image = qdmr::read_image(args.height, args.height);
+  const int channel = int(channels.find(args.channel[0]));
+  if (channel >= image.channels)
+    throw qdmr::Error(args.height,
+                      "has " + std::to_string(image.channels) + " channel(s), no channel '" + args.channel + "'");
+  qdmr::HeightField field;
+  field.width = image.width;
+  field.height = image.height;
+  field.address = qdmr::AddressMode(address - std::begin(addresses));
+  field.h.resize(std::size_t(image.width) * std::size_t(image.height));
+  for (std::size_t k = 0; k < field.h.size(); ++k)
+    field.h[k] = image.texels[k * std::size_t(image.channels) + std::size_t(channel)];
+  const qdmr::ConeKind kind = args.kind == "relaxed" ? qdmr::ConeKind::Relaxed : qdmr::ConeKind::Conservative;
+  const auto start = std::chrono::steady_clock::now();
+  qdmr::ConeMap map;
+  try {
+    map = qdmr::bake_cone_map(field, kind);
+  } catch (const qdmr::Error& e) {
+    throw qdmr::Error(args.height, e.what());
+  }
+  const double bake_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  qdmr::write_cone_map_exr(map, out);
+  std::printf("%s: %dx%d %s cone map, %.1f ms\n", args.output.c_str(), map.width, map.height,
+              qdmr::cone_kind_name(kind), bake_ms);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -186,6 +234,18 @@ int main(int argc, char** argv) {
   plan_cmd->add_option("--aov", plan_scene.aovs, "AOV names to plan for (repeatable)");
   plan_cmd->add_flag("--json", plan_json, "Print the plan as JSON");
 
+  ConeArgs cone;
+  CLI::App* bake_cmd = app.add_subcommand("bake", "Bake derived data of a height map");
+  bake_cmd->require_subcommand(1);
+  CLI::App* cone_cmd =
+      bake_cmd->add_subcommand("cone", "Bake a cone map for cone step mapping (csm, rcsm) to a 32-bit float EXR");
+  cone_cmd->add_option("height", cone.height, "Height image (h in [0,1], 1 = top)")->required();
+  cone_cmd->add_option("-o,--output", cone.output, "Output cone map (.exr, one float channel: the cone ratio)")
+      ->required();
+  cone_cmd->add_option("--kind", cone.kind, "conservative (csm, default) or relaxed (rcsm)");
+  cone_cmd->add_option("--channel", cone.channel, "Channel holding the heights: r (default), g, b or a");
+  cone_cmd->add_option("--address", cone.address, "Address mode of the map: wrap (default), clamp or mirror");
+
   // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
     return std::string("qdmr: error: ") + e.what() + " (see qdmr --help)\n";
@@ -203,6 +263,7 @@ int main(int argc, char** argv) {
   try {
     if (render_cmd->parsed()) return run_render(render_scene, render);
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);
+    if (cone_cmd->parsed()) return run_bake_cone(cone);
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());
     return kExitBadInput;
