@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--set", render_scene.sets,
                          "Override a scene value before validation: /json/pointer=VALUE (VALUE is JSON; a bare word is a "
                          "string). Repeatable, e.g. --set /camera/fov_deg=30");
-  render_cmd->add_option("--aov", render_scene.aovs, "Also write an AOV: NAME=FILE with NAME one of depth, normal, uv. Repeatable");
+  render_cmd->add_option("--aov", render_scene.aovs, "Also write an AOV: NAME=FILE with NAME one of depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed. Repeatable");
   render_cmd->add_option("--stats", render.stats, "Write timings and counters as JSON to this file");
 
   SceneArgs plan_scene;

@@ -113,9 +113,9 @@ void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {
   std::vector<float> mapped(image->pixels.begin(), image->pixels.end());
   if (aov == Aov::Normal)
     for (float& v : mapped) v = 0.5f + 0.5f * v;
-  if (aov == Aov::UV)
+  if (aov == Aov::UV || aov == Aov::HitUV)
     for (float& v : mapped) v -= std::floor(v);
-  if (aov == Aov::Depth) {
+  if (aov == Aov::Depth || aov == Aov::Iterations || aov == Aov::HitDepth || aov == Aov::ErrorTexels) {
     float max_depth = 0.0f;
     for (float v : mapped) max_depth = std::max(max_depth, v);
     if (max_depth > 0.0f)

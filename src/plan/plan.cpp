@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/core/error.hpp"
+#include "qdmr/texture/height_texture.hpp"
 
 namespace qdmr {
 namespace {
@@ -71,23 +72,32 @@ std::string request_key(const TextureDesc& d, TexturePurpose purpose, const Laye
   return k.str();
 }
 
-// Level-0 size of a texture without building it (file headers are read).
-std::pair<int, int> texture_size(const TextureDesc& d, const LayerDesc& layer, const std::string& where) {
+struct SourceInfo {
+  int width = 1, height = 1;
+  int bits = 8;  // per channel: 8 or 16 for integer files, 32 otherwise (as Image::source_bits)
+};
+
+// Level-0 size and bit depth of a texture without building it (file headers are read).
+SourceInfo texture_source(const TextureDesc& d, const LayerDesc& layer, const std::string& where) {
   switch (d.source) {
     case TextureSource::None:
-    case TextureSource::Constant: return {1, 1};
-    case TextureSource::Procedural: return {d.procedural.size, d.procedural.size};
+    case TextureSource::Constant: return {};
+    case TextureSource::Procedural: return {d.procedural.size, d.procedural.size, 16};
     case TextureSource::FromHeight:
-      if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {1, 1};
-      return texture_size(layer.height, layer, where);
+      if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {};
+      return texture_source(layer.height, layer, where);
     case TextureSource::File: {
       auto input = OIIO::ImageInput::open(d.file.string());
       if (!input) throw Error(where + "/file", "cannot read '" + d.file.string() + "': " + OIIO::geterror());
       const OIIO::ImageSpec& spec = input->spec();
-      return {spec.width, spec.height};
+      const bool uniform = spec.channelformats.empty();
+      const int bits = uniform && spec.format == OIIO::TypeDesc::UINT8    ? 8
+                       : uniform && spec.format == OIIO::TypeDesc::UINT16 ? 16
+                                                                         : 32;
+      return {spec.width, spec.height, bits};
     }
   }
-  return {1, 1};
+  return {};
 }
 
 int mip_levels(int w, int h) {
@@ -122,8 +132,8 @@ const char* reduce_name(MipReduce r) {
 }
 
 int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, TexturePurpose purpose,
-                const LayerDesc& layer, const std::string& where, const std::string& user) {
-  const std::string key = request_key(desc, purpose, layer);
+                MipReduce reduce, const LayerDesc& layer, const std::string& where, const std::string& user) {
+  const std::string key = request_key(desc, purpose, layer) + "|mip" + std::to_string(int(reduce));
   for (std::size_t i = 0; i < textures.size(); ++i) {
     if (textures[i].key != key) continue;
     if (std::find(textures[i].users.begin(), textures[i].users.end(), user) == textures[i].users.end())
@@ -136,16 +146,14 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.desc = desc;
   r.layer = layer;
   r.where = where;
-  const auto [w, h] = texture_size(desc, layer, where);
-  r.width = w;
-  r.height = h;
-  switch (purpose) {
-    case TexturePurpose::Albedo: r.format = TexelFormat::RGBA8, r.srgb = true, r.reduce = MipReduce::Box; break;
-    case TexturePurpose::Normal: r.format = TexelFormat::RGBA8, r.srgb = false, r.reduce = MipReduce::BoxNormal; break;
-    case TexturePurpose::Height: r.format = TexelFormat::R16, r.srgb = false, r.reduce = MipReduce::Max; break;
-  }
-  r.levels = mip_levels(w, h);
-  r.bytes = chain_bytes(w, h, r.format);
+  const SourceInfo source = texture_source(desc, layer, where);
+  r.width = source.width;
+  r.height = source.height;
+  r.reduce = reduce;
+  r.srgb = purpose == TexturePurpose::Albedo;
+  r.format = purpose == TexturePurpose::Height ? height_format(desc, source.bits) : TexelFormat::RGBA8;
+  r.levels = mip_levels(r.width, r.height);
+  r.bytes = chain_bytes(r.width, r.height, r.format);
   r.users.push_back(user);
   textures.push_back(std::move(r));
   return int(textures.size() - 1);
@@ -204,28 +212,56 @@ std::string mib(std::uint64_t bytes) {
   return s.str();
 }
 
-std::uint64_t aov_channels(Aov aov) {
-  switch (aov) {
-    case Aov::Depth: return 1;
-    case Aov::Normal: return 3;
-    case Aov::UV: return 2;
-  }
-  return 0;
-}
-
 }  // namespace
+
+const char* technique_name(TechniqueKind k) {
+  switch (k) {
+    case TechniqueKind::Normal: return "normal";
+    case TechniqueKind::Relief: return "relief";
+    case TechniqueKind::Pom: return "pom";
+    case TechniqueKind::Csm: return "csm";
+    case TechniqueKind::Rcsm: return "rcsm";
+    case TechniqueKind::Qdm: return "qdm";
+  }
+  return "?";
+}
 
 MaterialPlan plan_material(const MaterialDesc& material, const std::string& where,
                            std::vector<TextureRequest>& textures) {
   MaterialPlan plan;
   plan.name = material.name;
+  plan.technique = material.technique.kind;
   plan.sampling = material.sampling;
   plan.lighting = material.lighting;
-  plan.program = std::string("normal_mapping | blinn_phong | ") + filter_name(material.sampling.filter);
+  const TechniqueKind kind = material.technique.kind;
+  plan.program = (kind == TechniqueKind::Normal ? std::string("normal_mapping")
+                                                : std::string("displacement:") + technique_name(kind)) +
+                 " | blinn_phong | " + filter_name(material.sampling.filter);
   const LayerDesc& layer = material.layers.at(0);
   const std::string layer_where = where + "/layers/0";
-  plan.albedo = add_request(textures, layer.albedo, TexturePurpose::Albedo, layer, layer_where + "/albedo", material.name);
-  plan.normal = add_request(textures, layer.normal, TexturePurpose::Normal, layer, layer_where + "/normal", material.name);
+  plan.albedo = add_request(textures, layer.albedo, TexturePurpose::Albedo, MipReduce::Box, layer,
+                            layer_where + "/albedo", material.name);
+  plan.normal = add_request(textures, layer.normal, TexturePurpose::Normal, MipReduce::BoxNormal, layer,
+                            layer_where + "/normal", material.name);
+  if (kind == TechniqueKind::Normal) return plan;  // normal mapping pays for no height data
+
+  if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm)
+    throw Error(where + "/technique/name", std::string("'") + technique_name(kind) +
+                                               "' is not available yet (cone maps are baked but not rendered): use "
+                                               "relief, pom or qdm");
+  if (layer.height.source == TextureSource::None)
+    throw Error(layer_where + "/height", std::string("technique '") + technique_name(kind) + "' needs a height map");
+  plan.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
+                            layer_where + "/height", material.name);
+  if (kind == TechniqueKind::Qdm) {
+    const TextureRequest& h = textures[std::size_t(plan.height)];
+    const bool pot = (h.width & (h.width - 1)) == 0 && (h.height & (h.height - 1)) == 0;
+    if (!pot)
+      throw Error(layer_where + "/height", "qdm needs a power-of-two height map, got " + std::to_string(h.width) + "x" +
+                                               std::to_string(h.height));
+    plan.height_max = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Max, layer,
+                                  layer_where + "/height", material.name);
+  }
   return plan;
 }
 
@@ -247,7 +283,7 @@ FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
   }
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
-  for (Aov aov : plan.aovs) per_pixel += aov_channels(aov);
+  for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
   return plan;
 }
@@ -258,7 +294,10 @@ std::string FramePlan::describe() const {
   s << "materials (" << materials.size() << "):\n";
   for (const MaterialPlan& m : materials) {
     s << "  " << m.name << ": " << m.program << "\n";
-    s << "    albedo: texture " << m.albedo << ", normal: texture " << m.normal << "\n";
+    s << "    albedo: texture " << m.albedo << ", normal: texture " << m.normal;
+    if (m.height >= 0) s << ", height: texture " << m.height;
+    if (m.height_max >= 0) s << ", max-quadtree: texture " << m.height_max;
+    s << "\n";
   }
   s << "textures to build (" << textures.size() << "):\n";
   for (std::size_t i = 0; i < textures.size(); ++i) {
@@ -267,7 +306,8 @@ std::string FramePlan::describe() const {
       << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
       << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
   }
-  s << "derived data: none (normal mapping needs no quadtree, cone map, AO or blend maps)\n";
+  const bool quadtree = std::any_of(materials.begin(), materials.end(), [](const MaterialPlan& m) { return m.height_max >= 0; });
+  s << "derived data: " << (quadtree ? "max-quadtree (above); " : "") << "no cone map, AO or blend maps\n";
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes)
     s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles"
@@ -286,7 +326,8 @@ nlohmann::json FramePlan::to_json() const {
   j["width"] = width;
   j["height"] = height;
   for (const MaterialPlan& m : materials)
-    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal}});
+    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal},
+                              {"height", m.height}, {"height_max", m.height_max}});
   for (const TextureRequest& t : textures)
     j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                              {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},

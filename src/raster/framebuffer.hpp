@@ -1,11 +1,13 @@
 #pragma once
 // The render targets of one frame: colour and depth always, AOV planes only when asked for. Allocated
 // uninitialised; each tile clears its own pixels before drawing (clear_rect), so clearing runs in parallel.
+#include <array>
 #include <cstddef>
 
 #include <glm/vec3.hpp>
 
 #include "qdmr/render/pixel_buffer.hpp"
+#include "qdmr/render/render.hpp"
 
 namespace qdmr {
 
@@ -14,9 +16,7 @@ struct Framebuffer {
   glm::vec3 background{0.0f};
   PixelBuffer color;       // linear RGB, 3 per pixel, cleared to the background
   PixelBuffer depth;       // window depth in [0, 1], cleared to 1
-  PixelBuffer view_depth;  // AOV "depth": distance along the view axis, 0 where empty (may be empty)
-  PixelBuffer normal;      // AOV "normal": world-space shading normal, 3 per pixel (may be empty)
-  PixelBuffer uv;          // AOV "uv": 2 per pixel (may be empty)
+  std::array<PixelBuffer, kAovCount> aov;  // indexed by Aov; aov_channels() per pixel; empty when not asked for
 
   std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
   void clear_rect(int x0, int y0, int x1, int y1) {  // inclusive bounds
@@ -27,13 +27,17 @@ struct Framebuffer {
         color[3 * i + 1] = background.y;
         color[3 * i + 2] = background.z;
         depth[i] = 1.0f;
-        if (!view_depth.empty()) view_depth[i] = 0.0f;
-        if (!normal.empty()) normal[3 * i] = normal[3 * i + 1] = normal[3 * i + 2] = 0.0f;
-        if (!uv.empty()) uv[2 * i] = uv[2 * i + 1] = 0.0f;
+        for (int a = 0; a < kAovCount; ++a) {
+          if (aov[std::size_t(a)].empty()) continue;
+          const std::size_t n = std::size_t(aov_channels(Aov(a)));
+          for (std::size_t c = 0; c < n; ++c) aov[std::size_t(a)][n * i + c] = 0.0f;
+        }
       }
   }
   std::size_t bytes() const {
-    return (color.size() + depth.size() + view_depth.size() + normal.size() + uv.size()) * sizeof(float);
+    std::size_t floats = color.size() + depth.size();
+    for (const PixelBuffer& a : aov) floats += a.size();
+    return floats * sizeof(float);
   }
 };
 

@@ -140,29 +140,36 @@ private:
   }
 
   void write(int x, int y, std::uint32_t pass, const Float& z, const Fragments& in, const ShadeOutput& out) {
-    alignas(64) float zs[kLanes], color[3][kLanes], normal[3][kLanes], uv[2][kLanes], view_depth[kLanes];
+    alignas(64) float zs[kLanes], color[3][kLanes];
     z.store_aligned(zs);
     for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
-    const bool want_normal = !fb_.normal.empty(), want_uv = !fb_.uv.empty(), want_depth = !fb_.view_depth.empty();
-    if (want_normal)
-      for (int c = 0; c < 3; ++c) out.normal[c].store_aligned(normal[c]);
-    if (want_uv) {
-      in.varyings[kU].store_aligned(uv[0]);
-      in.varyings[kV].store_aligned(uv[1]);
-    }
-    if (want_depth) in.view_depth.store_aligned(view_depth);
     for (int l = 0; l < kLanes; ++l) {
       if (!((pass >> l) & 1u)) continue;
       const std::size_t i = fb_.index(x + lane_dx(l), y + lane_dy(l));
       fb_.depth[i] = zs[l];
       for (int c = 0; c < 3; ++c) fb_.color[3 * i + c] = color[c][l];
-      if (want_normal)
-        for (int c = 0; c < 3; ++c) fb_.normal[3 * i + c] = normal[c][l];
-      if (want_uv) {
-        fb_.uv[2 * i] = uv[0][l];
-        fb_.uv[2 * i + 1] = uv[1][l];
+    }
+    // AOVs: each requested plane gets its channels, in the order aov_channels() documents.
+    const Float* sources[kAovCount][3] = {
+        {&in.view_depth},
+        {&out.normal[0], &out.normal[1], &out.normal[2]},
+        {&in.varyings[kU], &in.varyings[kV]},
+        {&out.iterations},
+        {&out.hit_u, &out.hit_v},
+        {&out.hit_depth},
+        {&out.error_texels},
+        {&out.missed}};
+    for (int a = 0; a < kAovCount; ++a) {
+      PixelBuffer& plane = fb_.aov[std::size_t(a)];
+      if (plane.empty()) continue;
+      const int channels = aov_channels(Aov(a));
+      alignas(64) float values[3][kLanes];
+      for (int c = 0; c < channels; ++c) sources[a][c]->store_aligned(values[c]);
+      for (int l = 0; l < kLanes; ++l) {
+        if (!((pass >> l) & 1u)) continue;
+        const std::size_t i = fb_.index(x + lane_dx(l), y + lane_dy(l));
+        for (int c = 0; c < channels; ++c) plane[std::size_t(channels) * i + std::size_t(c)] = values[c][l];
       }
-      if (want_depth) fb_.view_depth[i] = view_depth[l];
     }
     ++counters_.batches_shaded;
     counters_.pixels_shaded += std::popcount(pass);

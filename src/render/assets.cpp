@@ -4,6 +4,7 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/height_texture.hpp"
+#include "shade/displacement.hpp"
 #include "shade/normal_mapping.hpp"
 
 namespace qdmr {
@@ -22,22 +23,29 @@ const char* purpose_name(TexturePurpose p) {
 // the scene asks for — quantisation, BC3 — so what is rendered is what a GPU would sample.
 Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight;
+  Texture texture;
   Image height;
   if (needs_height) {
-    const HeightTexture stored =
-        make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, MipReduce::Max);
-    height = stored.texture.level_image(0);
+    // Behind a from_height normal map only level 0 is used: any reduction will do.
+    const MipReduce reduce = request.purpose == TexturePurpose::Height ? request.reduce : MipReduce::Box;
+    HeightTexture stored = make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce);
     stat.height_format = format_name(stored.texture.format);
     if (stored.bc3) {
       stat.bc3 = true;
       stat.bc3_max_error = stored.bc3->max_error;
       stat.bc3_rms_error = stored.bc3->rms_error;
     }
+    if (request.purpose == TexturePurpose::Height)
+      texture = std::move(stored.texture);
+    else
+      height = stored.texture.level_image(0);
   }
-  Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
-  if (request.purpose == TexturePurpose::Normal)
-    for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
-  Texture texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+  if (request.purpose != TexturePurpose::Height) {
+    Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
+    if (request.purpose == TexturePurpose::Normal)
+      for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
+    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+  }
   stat.where = request.where;
   stat.purpose = purpose_name(request.purpose);
   stat.format = format_name(texture.format) + (texture.srgb ? " srgb" : "");
@@ -74,7 +82,7 @@ std::uint64_t Assets::mesh_bytes() const {
   return bytes;
 }
 
-Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
+Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const RenderOptions& options) {
   Assets assets;
   const std::string file = scene.file.string();
   const std::size_t objects = scene.objects.size();
@@ -84,6 +92,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
   });
 
   // Frame materials: the scene's materials that some object uses, then each obj's MTL materials.
+  std::vector<MaterialDesc> material_descs;  // parallel to assets.materials
   std::vector<int> scene_material_index(scene.materials.size(), -1);
   assets.object_material.assign(objects, 0);
   assets.object_mtl_materials.resize(objects);
@@ -96,6 +105,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
         throw Error(file + ": /objects/" + std::to_string(i) + "/material", "unknown material '" + object.material + "'");
       if (scene_material_index[m] < 0) {
         scene_material_index[m] = int(assets.materials.size());
+        material_descs.push_back(scene.materials[m]);
         assets.materials.push_back(plan_material(scene.materials[m], file + ": /materials/" + scene.materials[m].name,
                                                  assets.requests));
       }
@@ -109,6 +119,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
       mtl.name = object.name + "/" + mtl.name;
       assets.object_mtl_materials[i].push_back(std::uint32_t(assets.materials.size()));
       assets.materials.push_back(plan_material(mtl, file + ": /objects/" + std::to_string(i) + "/mesh/file", assets.requests));
+      material_descs.push_back(std::move(mtl));
     }
     if (assets.meshes[i].materials.empty())
       throw Error(file + ": /objects/" + std::to_string(i) + "/material", "required (the mesh has no MTL materials)");
@@ -120,10 +131,36 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights) {
     assets.textures[i] = build_texture(assets.requests[i], assets.texture_stats[i]);
   });
 
-  for (const MaterialPlan& m : assets.materials)
-    assets.programs.push_back(std::make_unique<NormalMappingProgram>(assets.textures[std::size_t(m.albedo)],
-                                                                     assets.textures[std::size_t(m.normal)],
-                                                                     m.sampling, m.lighting, lights));
+  const bool reference_aovs = std::any_of(options.aovs.begin(), options.aovs.end(),
+                                          [](Aov a) { return a == Aov::ErrorTexels || a == Aov::Missed; });
+  for (std::size_t i = 0; i < assets.materials.size(); ++i) {
+    const MaterialPlan& m = assets.materials[i];
+    const Texture& albedo = assets.textures[std::size_t(m.albedo)];
+    const Texture& normal = assets.textures[std::size_t(m.normal)];
+    if (m.technique == TechniqueKind::Normal) {
+      assets.programs.push_back(std::make_unique<NormalMappingProgram>(albedo, normal, m.sampling, m.lighting, lights));
+      continue;
+    }
+    DisplacementInputs inputs;
+    inputs.albedo = &albedo;
+    inputs.normal = &normal;
+    inputs.height = &assets.textures[std::size_t(m.height)];
+    if (m.height_max >= 0) inputs.height_max = &assets.textures[std::size_t(m.height_max)];
+    if (reference_aovs) {
+      // The exact reference traces the stored heights, in fp64.
+      auto field = std::make_unique<HeightField>();
+      const Texture& h = *inputs.height;
+      field->width = h.width();
+      field->height = h.height();
+      field->address = m.sampling.address;
+      field->h.resize(std::size_t(h.width()) * std::size_t(h.height()));
+      for (int y = 0; y < h.height(); ++y)
+        for (int x = 0; x < h.width(); ++x) field->h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
+      inputs.reference = field.get();
+      assets.reference_fields.push_back(std::move(field));
+    }
+    assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, material_descs[i], lights));
+  }
   return assets;
 }
 

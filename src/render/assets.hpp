@@ -6,6 +6,7 @@
 
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/plan/plan.hpp"
+#include "qdmr/study/heightfield.hpp"
 #include "raster/geometry.hpp"
 #include "shade/lighting.hpp"
 #include "shade/program.hpp"
@@ -21,6 +22,7 @@ struct Assets {
   std::vector<Texture> textures;                // parallel to requests
   std::vector<TextureStat> texture_stats;       // parallel to requests
   std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
+  std::vector<std::unique_ptr<HeightField>> reference_fields;  // fp64 heights for the error AOVs
 
   std::vector<DrawItem> draw_items() const;     // model matrices left as identity
   std::uint64_t texture_bytes() const;
@@ -28,6 +30,6 @@ struct Assets {
 };
 
 // Builds meshes and textures in parallel (in the caller's task arena). Throws qdmr::Error on bad input.
-Assets prepare_assets(const SceneDesc& scene, const LightRig& lights);
+Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const RenderOptions& options);
 
 }  // namespace qdmr

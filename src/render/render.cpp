@@ -55,33 +55,38 @@ Framebuffer make_framebuffer(const SceneDesc& scene, const RenderOptions& option
   const std::size_t pixels = std::size_t(fb.width) * std::size_t(fb.height);
   fb.color.resize(pixels * 3);
   fb.depth.resize(pixels);
-  for (Aov aov : options.aovs) {
-    if (aov == Aov::Depth) fb.view_depth.resize(pixels);
-    if (aov == Aov::Normal) fb.normal.resize(pixels * 3);
-    if (aov == Aov::UV) fb.uv.resize(pixels * 2);
-  }
+  for (Aov aov : options.aovs) fb.aov[std::size_t(aov)].resize(pixels * std::size_t(aov_channels(aov)));
   return fb;
 }
 
 }  // namespace
 
+namespace {
+struct AovInfo {
+  Aov aov;
+  const char* name;
+  int channels;
+};
+constexpr AovInfo kAovs[kAovCount] = {
+    {Aov::Depth, "depth", 1},          {Aov::Normal, "normal", 3},        {Aov::UV, "uv", 2},
+    {Aov::Iterations, "iterations", 1}, {Aov::HitUV, "hit_uv", 2},         {Aov::HitDepth, "hit_depth", 1},
+    {Aov::ErrorTexels, "error_texels", 1}, {Aov::Missed, "missed", 1}};
+}  // namespace
+
 std::optional<Aov> parse_aov(const std::string& name) {
-  if (name == "depth") return Aov::Depth;
-  if (name == "normal") return Aov::Normal;
-  if (name == "uv") return Aov::UV;
+  for (const AovInfo& a : kAovs)
+    if (name == a.name) return a.aov;
   return std::nullopt;
 }
 
-std::string aov_name(Aov aov) {
-  switch (aov) {
-    case Aov::Depth: return "depth";
-    case Aov::Normal: return "normal";
-    case Aov::UV: return "uv";
-  }
-  return "?";
-}
+std::string aov_name(Aov aov) { return kAovs[int(aov)].name; }
+int aov_channels(Aov aov) { return kAovs[int(aov)].channels; }
 
-std::vector<std::string> aov_names() { return {"depth", "normal", "uv"}; }
+std::vector<std::string> aov_names() {
+  std::vector<std::string> names;
+  for (const AovInfo& a : kAovs) names.push_back(a.name);
+  return names;
+}
 
 void validate_options(const RenderOptions& options) {
   if (options.threads < 0 || options.threads > limits::kMaxThreads)
@@ -143,7 +148,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     auto start = Clock::now();
     report("prepare", 0.0);
     const LightRig lights = LightRig::from_scene(scene);
-    const Assets assets = prepare_assets(scene, lights);
+    const Assets assets = prepare_assets(scene, lights, options);
     stats.prepare_ms = ms_since(start);
     report("prepare", 1.0);
     stats.texture_bytes = assets.texture_bytes();
@@ -211,13 +216,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     frame.width = fb.width;
     frame.height = fb.height;
     frame.color = std::move(fb.color);
-    for (Aov aov : options.aovs) {
-      AovImage image{aov, 0, {}};
-      if (aov == Aov::Depth) image = {aov, 1, std::move(fb.view_depth)};
-      if (aov == Aov::Normal) image = {aov, 3, std::move(fb.normal)};
-      if (aov == Aov::UV) image = {aov, 2, std::move(fb.uv)};
-      frame.aovs.push_back(std::move(image));
-    }
+    for (Aov aov : options.aovs) frame.aovs.push_back({aov, aov_channels(aov), std::move(fb.aov[std::size_t(aov)])});
   });
   stats.peak_rss_bytes = peak_rss_bytes();
   return frame;

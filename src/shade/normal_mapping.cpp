@@ -23,6 +23,9 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
+  out.iterations = out.hit_depth = out.error_texels = out.missed = Float(0.0f);
+  out.hit_u = u;
+  out.hit_v = v;
 }
 
 }  // namespace qdmr

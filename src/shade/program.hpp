@@ -17,6 +17,8 @@ struct Fragments {
 struct ShadeOutput {
   simd::Float color[3];   // linear RGB
   simd::Float normal[3];  // world-space shading normal (for the "normal" AOV)
+  // Displacement AOVs (see Aov in qdmr/render/render.hpp); every program sets them.
+  simd::Float iterations, hit_u, hit_v, hit_depth, error_texels, missed;
 };
 
 class ShadingProgram {

@@ -25,6 +25,7 @@ public:
       if ((bits >> l) & 1u) ++counts[std::size_t(int(y[l]) * width_ + int(x[l]))];
     for (auto& c : out.color) c = simd::Float(1.0f);
     for (auto& n : out.normal) n = simd::Float(0.0f);
+    out.iterations = out.hit_u = out.hit_v = out.hit_depth = out.error_texels = out.missed = simd::Float(0.0f);
   }
   int width_;
   mutable std::vector<int> counts;

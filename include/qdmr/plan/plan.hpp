@@ -32,7 +32,10 @@ struct TextureRequest {
 struct MaterialPlan {
   std::string name;
   std::string program;       // the shading program variant
+  TechniqueKind technique = TechniqueKind::Normal;
   int albedo = -1, normal = -1;  // indices into FramePlan::textures
+  int height = -1;           // box-filtered heights (displacement techniques)
+  int height_max = -1;       // max-quadtree (qdm)
   SamplingDesc sampling;
   LightingDesc lighting;
 };

@@ -18,9 +18,15 @@
 
 namespace qdmr {
 
-enum class Aov { Depth, Normal, UV };
+// Per-pixel outputs besides colour. Displacement AOVs: `iterations` of the intersection loop, `hit_uv` and
+// `hit_depth` (UV units) of the hit; against the exact reference: `error_texels` (distance from the reference
+// hit, in level-0 texels) and `missed` (1 where the technique hit more than a texel away from the reference,
+// i.e. another feature or layer). Normal mapping reports 0 iterations and the hit at the polygon.
+enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed };
+inline constexpr int kAovCount = 8;
 std::optional<Aov> parse_aov(const std::string& name);
 std::string aov_name(Aov aov);
+int aov_channels(Aov aov);
 std::vector<std::string> aov_names();
 
 struct RenderOptions {
@@ -79,7 +85,8 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear) through a temporary
 // file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file);
-// Writes one AOV (EXR/TIFF: float data; PNG: 8-bit, normals mapped to 0.5 + 0.5 n, depth divided by its maximum).
+// Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
+// fractional part, depth, iterations, hit depth and errors divided by their maximum).
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
 
 }  // namespace qdmr

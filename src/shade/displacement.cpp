@@ -1,0 +1,369 @@
+#include "shade/displacement.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "qdmr/study/reference.hpp"
+#include "shade/shading_math.hpp"
+
+namespace qdmr {
+namespace {
+
+using namespace shading;
+using simd::Int;
+using simd::IntMask;
+using simd::kLanes;
+using simd::Mask;
+
+IntMask int_mask(const Mask& m) { return xsimd::to_int(xsimd::select(m, Float(1.0f), Float(0.0f))) != Int(0); }
+Mask float_mask(const IntMask& m) { return xsimd::to_float(xsimd::select(m, Int(1), Int(0))) != Float(0.0f); }
+Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
+
+// Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
+Float texel_step(const DisplacementProgram::Ray& ray, float width, float height) {
+  const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));
+  return Float(1.0f) / xsimd::max(reach, Float(1e-6f));
+}
+
+}  // namespace
+
+DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
+                                         const LightRig& lights)
+    : albedo_(*inputs.albedo), normal_(*inputs.normal), reference_(inputs.reference),
+      sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
+      technique_(material.technique), lighting_(material.lighting), lights_(lights) {
+  if (inputs.height) height_.emplace(*inputs.height);
+  if (inputs.height_max) height_max_.emplace(*inputs.height_max);
+}
+
+Float DisplacementProgram::height_at(const Float& u, const Float& v, const Float& lod) const {
+  Float h[4];
+  sample(*height_, sampler_, u, v, lod, h);
+  return h[0];
+}
+
+// Relief mapping (Policarpo 2005): fixed linear steps from the top, then a binary search in the last step.
+DisplacementProgram::Hit DisplacementProgram::relief(const Ray& ray, const Float& ds, const Float& lod,
+                                                    Mask active) const {
+  const int steps = technique_.linear_steps;
+  const Float step = ds / Float(float(steps));
+  Float lo(0.0f), hi = ds, iterations(0.0f);
+  for (int i = 0; i <= steps && xsimd::any(active); ++i) {
+    const Float s = step * Float(float(i));
+    const Float h = height_at(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
+    const Mask found = active & (s >= ds * (Float(1.0f) - h));
+    iterations += count(active);
+    hi = xsimd::select(found, s, hi);
+    lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
+    active = active & !found;
+  }
+  lo = xsimd::select(active, ds - step, lo);  // never below: the bottom (h >= 0 everywhere) is the hit
+  Mask searching = lo < hi;
+  for (int i = 0; i < technique_.binary_steps && xsimd::any(searching); ++i) {
+    const Float mid = (lo + hi) * Float(0.5f);
+    const Float h = height_at(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
+    const Mask below = mid >= ds * (Float(1.0f) - h);
+    iterations += count(searching);
+    hi = xsimd::select(searching & below, mid, hi);
+    lo = xsimd::select(searching & !below, mid, lo);
+  }
+  return {hi, iterations};
+}
+
+// Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
+// the ray with the line through the last two height samples.
+DisplacementProgram::Hit DisplacementProgram::pom(const Ray& ray, const Float& ds, const Float& lod,
+                                                 const Float& cos_view, Mask active) const {
+  const Float lerp = xsimd::min(xsimd::max(cos_view, Float(0.0f)), Float(1.0f));
+  const Float n = xsimd::floor(Float(float(technique_.max_steps)) +
+                               (Float(float(technique_.min_steps)) - Float(float(technique_.max_steps))) * lerp +
+                               Float(0.5f));
+  const Float step = ds / n;
+  Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
+  // gap = surface depth - ray depth: > 0 while the ray is above the surface.
+  {
+    const Float gap0 = ds * (Float(1.0f) - height_at(ray.u0, ray.v0, lod));
+    iterations += count(active);
+    const Mask at_top = active & (gap0 <= Float(0.0f));
+    s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
+    active = active & !at_top;
+    prev_gap = gap0;
+  }
+  for (int i = 1; i <= technique_.max_steps && xsimd::any(active); ++i) {
+    const Float fi = Float(static_cast<float>(i));
+    const Mask in_range = active & (fi <= n);
+    const Float s = step * fi;
+    const Float gap = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
+    iterations += count(in_range);
+    const Mask found = in_range & (gap <= Float(0.0f));
+    const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
+    s_hit = xsimd::select(found, prev_s + (s - prev_s) * t, s_hit);
+    active = in_range & !found;
+    prev_s = s;
+    prev_gap = gap;
+  }
+  return {s_hit, iterations};
+}
+
+// Quadtree displacement mapping (Drobot 2009) over the max-quadtree: from the root, advance to the nearer of
+// the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
+// level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped
+// exactly across walls, or recomputed from the fp32 position (SM3 emulation).
+DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& ds, const Float& stop_level,
+                                                 const Int& cap, Mask active) const {
+  const TextureView& quadtree = *height_max_;
+  const int top = quadtree.levels() - 1;
+  const float width = float(quadtree.texture().width()), height = float(quadtree.texture().height());
+  const bool sm3 = math_ == MathMode::Sm3;
+  const IntMask none = Int(0) != Int(0);
+  const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
+  const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
+  const IntMask step_x_pos = int_mask(dx > Float(0.0f)), step_y_pos = int_mask(dy > Float(0.0f));
+  const Float inf(std::numeric_limits<float>::infinity());
+
+  Int level(top);
+  Int cx = xsimd::to_int(xsimd::floor(x0)) >> top, cy = xsimd::to_int(xsimd::floor(y0)) >> top;
+  Float s(0.0f), iterations(0.0f);
+  Int done_iterations(0);
+  const Int stop = xsimd::to_int(stop_level);
+  for (;;) {
+    const IntMask running = int_mask(active) & (done_iterations < cap);
+    active = float_mask(running);
+    if (!xsimd::any(active)) break;
+    iterations += count(active);
+    done_iterations += xsimd::select(running, Int(1), Int(0));
+
+    // The cell's highest point (wrap addressing: power-of-two level sizes).
+    const Int size_x = simd::load_i32(quadtree.widths(), level, sampler_.fetch);
+    const Int size_y = simd::load_i32(quadtree.heights(), level, sampler_.fetch);
+    Float hmax;
+    if (technique_.height_fetch == HeightFetch::Point) {
+      Float texel[4];
+      load(quadtree, level, cx & (size_x - Int(1)), cy & (size_y - Int(1)), sampler_.fetch, texel);
+      hmax = texel[0];
+    } else {
+      // LinearMipMapLinear at the ray's position on this level: smooths the maxima, so it can miss features.
+      SamplerState trilinear = sampler_;
+      trilinear.filter = Filter::Trilinear;
+      trilinear.address = AddressMode::Wrap;
+      trilinear.lod_bias = 0.0f;
+      trilinear.min_lod = 0.0f;
+      trilinear.max_lod = 16.0f;
+      Float texel[4];
+      sample(quadtree, trilinear, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level), texel);
+      hmax = texel[0];
+    }
+    const Float top_depth = ds * (Float(1.0f) - hmax);
+    const Mask below = active & (s >= top_depth);
+    const IntMask at_stop = level <= stop;
+    const Mask hit = below & float_mask(at_stop);
+    active = active & !hit;
+    // Below the cell's top but not at the last level: descend into the child that holds the ray. The child is
+    // chosen by comparing s with the depth where the ray crosses the parent's mid line, computed exactly as wall
+    // crossings are, so a ray standing on a wall is never put back into the cell it just left.
+    const IntMask descend = int_mask(below & !hit);
+    if (xsimd::any(descend)) {
+      const Int child_level = xsimd::max(level - Int(1), Int(0));
+      const Float child_cell = xsimd::to_float(Int(1) << child_level);
+      const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
+      const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
+      const Float zero(0.0f);
+      const Mask high_x = ((dx > zero) & (s >= (mid_x - x0) / dx)) | ((dx < zero) & (s < (mid_x - x0) / dx)) |
+                          ((dx == zero) & (x0 >= mid_x));
+      const Mask high_y = ((dy > zero) & (s >= (mid_y - y0) / dy)) | ((dy < zero) & (s < (mid_y - y0) / dy)) |
+                          ((dy == zero) & (y0 >= mid_y));
+      cx = xsimd::select(descend, cx * Int(2) + xsimd::select(int_mask(high_x), Int(1), Int(0)), cx);
+      cy = xsimd::select(descend, cy * Int(2) + xsimd::select(int_mask(high_y), Int(1), Int(0)), cy);
+      level = xsimd::select(descend, child_level, level);
+    }
+    // Above the cell's top: advance to its top plane or its wall, whichever comes first.
+    const Mask above = active & !below;
+    if (!xsimd::any(above)) continue;
+    const Float cell = xsimd::to_float(Int(1) << level);
+    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
+    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
+    const Float tx = xsimd::select(dx != Float(0.0f), (wall_x - x0) / dx, inf);
+    const Float ty = xsimd::select(dy != Float(0.0f), (wall_y - y0) / dy, inf);
+    const Float t_wall = xsimd::max(xsimd::min(tx, ty), s);
+    const Mask to_plane = above & (top_depth <= t_wall);
+    s = xsimd::select(to_plane, top_depth, s);
+    const Mask cross = above & !to_plane;
+    s = xsimd::select(cross, t_wall, s);
+    const IntMask cross_i = int_mask(cross);
+    const IntMask cross_x = cross_i & int_mask(tx <= ty);
+    const IntMask cross_y = cross_i & int_mask(ty <= tx);
+    if (sm3) {
+      // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
+      const Float nudge = Float(1.0f / 64.0f);
+      const Float px = x0 + dx * s + xsimd::select(dx > Float(0.0f), nudge, Float(0.0f) - nudge);
+      const Float py = y0 + dy * s + xsimd::select(dy > Float(0.0f), nudge, Float(0.0f) - nudge);
+      cx = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx);
+      cy = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy);
+    } else {
+      cx = xsimd::select(cross_x, xsimd::select(step_x_pos, cx + Int(1), cx - Int(1)), cx);
+      cy = xsimd::select(cross_y, xsimd::select(step_y_pos, cy + Int(1), cy - Int(1)), cy);
+    }
+    // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
+    // while the wall just crossed is also a wall of the parent.
+    IntMask up = cross_i & (level < Int(top));
+    switch (technique_.level_up) {
+      case QdmLevelUp::Stay: up = none; break;
+      case QdmLevelUp::One: break;
+      case QdmLevelUp::Aligned: {
+        // Entering a cell through its low wall (+ direction) that wall is the parent's iff the index is even;
+        // through its high wall (- direction) iff the index is odd.
+        IntMask climbing = up;
+        for (int k = 0; k < top && xsimd::any(climbing); ++k) {
+          const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
+          const IntMask aligned_x = step_x_pos ^ odd_x, aligned_y = step_y_pos ^ odd_y;
+          const IntMask ok = climbing & ((!cross_x) | aligned_x) & ((!cross_y) | aligned_y);
+          level = xsimd::select(ok, level + Int(1), level);
+          cx = xsimd::select(ok, cx >> 1, cx);
+          cy = xsimd::select(ok, cy >> 1, cy);
+          climbing = ok & (level < Int(top));
+        }
+        up = none;
+        break;
+      }
+    }
+    level = xsimd::select(up, level + Int(1), level);
+    cx = xsimd::select(up, cx >> 1, cx);
+    cy = xsimd::select(up, cy >> 1, cy);
+  }
+  return {xsimd::min(s, ds), iterations};
+}
+
+// Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
+Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
+                                  Mask active) const {
+  if (technique_.refinement == QdmRefinement::None) return s_hit;
+  const Float lod0(0.0f);
+  const Float step = texel_step(ray, float(height_->texture().width()), float(height_->texture().height()));
+  Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
+  const Float gap_lo = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * lo, ray.v0 + ray.dv * lo, lod0)) - lo;
+  const Float gap_hi = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * hi, ray.v0 + ray.dv * hi, lod0)) - hi;
+  iterations += count(active) * Float(2.0f);
+  if (technique_.refinement == QdmRefinement::Linear) {
+    const Mask bracket = active & (gap_lo > Float(0.0f)) & (gap_hi <= Float(0.0f));
+    const Float t = gap_lo / (gap_lo - gap_hi);
+    return xsimd::select(bracket, lo + (hi - lo) * t, xsimd::select(gap_lo <= Float(0.0f), lo, hi));
+  }
+  // Binary (and, for now, the bilinear patch): bisection on the filtered surface.
+  const int steps = technique_.refinement == QdmRefinement::Binary ? 8 : 24;
+  Mask searching = active & (gap_lo > Float(0.0f));
+  hi = xsimd::select(gap_lo > Float(0.0f), hi, lo);
+  for (int i = 0; i < steps && xsimd::any(searching); ++i) {
+    const Float mid = (lo + hi) * Float(0.5f);
+    const Float gap = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
+    iterations += count(searching);
+    const Mask below = gap <= Float(0.0f);
+    hi = xsimd::select(searching & below, mid, hi);
+    lo = xsimd::select(searching & !below, mid, lo);
+  }
+  return hi;
+}
+
+void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, const Hit& hit, const Mask& covered,
+                                           ShadeOutput& out) const {
+  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes], s[kLanes], error[kLanes],
+      missed[kLanes];
+  ray.u0.store_aligned(u0);
+  ray.v0.store_aligned(v0);
+  ray.du.store_aligned(du);
+  ray.dv.store_aligned(dv);
+  ds.store_aligned(depth);
+  hit.s.store_aligned(s);
+  const std::uint32_t lanes = simd::to_bits(covered);
+  // Point-sampled QDM without refinement sees the box surface; everything else the filtered surface.
+  const bool box = technique_.kind == TechniqueKind::Qdm && technique_.refinement == QdmRefinement::None;
+  const ReferenceSurface surface = box ? ReferenceSurface::Box : ReferenceSurface::Bilinear;
+  for (int l = 0; l < kLanes; ++l) {
+    error[l] = missed[l] = 0.0f;
+    if (!((lanes >> l) & 1u)) continue;
+    const SurfaceRay r{{u0[l], v0[l], 0.0}, {du[l], dv[l], 1.0}};
+    const ReferenceHit ref = intersect_reference(*reference_, depth[l], r, surface, 1 << 16);
+    if (!ref.hit) continue;
+    const double eu = (double(u0[l]) + double(du[l]) * s[l] - ref.point.x) * reference_->width;
+    const double ev = (double(v0[l]) + double(dv[l]) * s[l] - ref.point.y) * reference_->height;
+    error[l] = float(std::sqrt(eu * eu + ev * ev));
+    missed[l] = error[l] > 1.0f ? 1.0f : 0.0f;
+  }
+  out.error_texels = Float::load_aligned(error);
+  out.missed = Float::load_aligned(missed);
+}
+
+void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
+  const Float& u = in.varyings[kU];
+  const Float& v = in.varyings[kV];
+  const UvDerivatives d = UvDerivatives::from(u, v, lod_mode_);
+  const TangentFrame frame = TangentFrame::from(in);
+  const Vec3 view = view_vector(in, lights_);
+  const Vec3 view_tangent = frame.to_tangent(view);
+
+  // Depth scale, faded with camera distance when asked; the ray leaves the polygon along -view.
+  Float ds(technique_.depth_scale);
+  if (technique_.fade_end > 0.0f) {
+    const Float range(std::max(technique_.fade_end - technique_.fade_start, 1e-6f));
+    const Float fade = xsimd::min(xsimd::max((in.view_depth - Float(technique_.fade_start)) / range, Float(0.0f)), Float(1.0f));
+    ds = ds * (Float(1.0f) - fade);
+  }
+  const Float vz = xsimd::max(view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
+  const Ray ray{u, v, (Float(0.0f) - view_tangent.x) / vz, (Float(0.0f) - view_tangent.y) / vz};
+  const Mask active = in.covered;
+
+  Hit hit{Float(0.0f), Float(0.0f)};
+  switch (technique_.kind) {
+    case TechniqueKind::Normal: break;
+    case TechniqueKind::Relief:
+      hit = relief(ray, ds, lod_from_derivatives(*height_, d.dudx, d.dvdx, d.dudy, d.dvdy), active);
+      break;
+    case TechniqueKind::Pom: {
+      const Float lod = lod_from_derivatives(*height_, d.dudx, d.dvdx, d.dudy, d.dvdy);
+      // Far away (high LOD) POM fades to normal mapping.
+      const Float fade = xsimd::min(
+          xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
+          Float(1.0f));
+      const Float pom_ds = ds * (Float(1.0f) - fade);
+      hit = pom(ray, pom_ds, lod, view_tangent.z, active);
+      ds = pom_ds;
+      break;
+    }
+    case TechniqueKind::Csm:
+    case TechniqueKind::Rcsm: break;  // cone step mapping arrives with the cone maps
+    case TechniqueKind::Qdm: {
+      Float stop(0.0f);
+      if (technique_.lod_stop)
+        stop = xsimd::max(xsimd::floor(lod_from_derivatives(*height_max_, d.dudx, d.dvdx, d.dudy, d.dvdy)), Float(0.0f));
+      Int cap(technique_.max_iterations);
+      if (technique_.min_iterations > 0) {
+        const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(view_tangent.z, Float(0.0f)), Float(1.0f));
+        cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
+                            Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
+      }
+      hit = qdm(ray, ds, stop, cap, active);
+      hit.s = refine(ray, ds, hit.s, hit.iterations, active);
+      break;
+    }
+  }
+
+  const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
+  Float albedo[4];
+  sample(albedo_, sampler_, hu, hv, lod_from_derivatives(albedo_, d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+  Float tangent_normal[4];
+  sample(normal_, sampler_, hu, hv, lod_from_derivatives(normal_, d.dudx, d.dvdx, d.dudy, d.dvdy), tangent_normal);
+  const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),
+                                                        tangent_normal[1] * Float(2.0f) - Float(1.0f),
+                                                        tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
+  blinn_phong(shading_normal, frame.n, view, albedo, lighting_, lights_, out.color);
+  out.normal[0] = shading_normal.x;
+  out.normal[1] = shading_normal.y;
+  out.normal[2] = shading_normal.z;
+  out.iterations = hit.iterations;
+  out.hit_u = hu;
+  out.hit_v = hv;
+  out.hit_depth = hit.s;
+  out.error_texels = out.missed = Float(0.0f);
+  if (reference_ && technique_.kind != TechniqueKind::Normal) reference_errors(ray, ds, hit, in.covered, out);
+}
+
+}  // namespace qdmr

@@ -1,0 +1,246 @@
+// Displacement techniques against the exact reference, and their termination at the extremes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "qdmr/render/render.hpp"
+#include "qdmr/scene/load.hpp"
+#include "qdmr/texture/texture.hpp"
+#include "shade/displacement_test_util.hpp"
+#include "support/test_support.hpp"
+
+namespace qdmr::test {
+namespace {
+
+Image pattern(ProceduralPattern kind, int size, int cells) {
+  ProceduralDesc p;
+  p.pattern = kind;
+  p.size = size;
+  p.cells = cells;
+  return generate_procedural(p);
+}
+
+Image filled(int size, float value) {
+  Image img(size, size, 1);
+  for (float& t : img.texels) t = value;
+  return img;
+}
+
+// One-texel features: a pillar (one texel at 1 on a floor at 0) and a slit (one texel column at 0 in a plateau at 1).
+Image pillar(int size) {
+  Image img = filled(size, 0.0f);
+  img.at(size / 2, size / 2, 0) = 1.0f;
+  return img;
+}
+Image slit(int size) {
+  Image img = filled(size, 1.0f);
+  for (int y = 0; y < size; ++y) img.at(size / 2, y, 0) = 0.0f;
+  return img;
+}
+
+struct Field {
+  const char* name;
+  Image heights;
+};
+
+std::vector<Field> fields() {
+  return {{"flat", filled(32, 0.5f)},
+          {"steps", pattern(ProceduralPattern::Steps, 64, 8)},
+          {"sine", pattern(ProceduralPattern::Sine, 64, 3)},
+          {"spikes", pattern(ProceduralPattern::Spikes, 64, 4)},
+          {"checker", pattern(ProceduralPattern::Checker, 32, 32)},  // alternates at the finest level
+          {"pillar", pillar(32)},
+          {"slit", slit(32)}};
+}
+
+// Rays from 90 down to 1 degree above the surface, all around, from deterministic random origins.
+std::vector<TechniqueRay> rays(int per_angle, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<TechniqueRay> out;
+  for (double elevation : {90.0, 60.0, 30.0, 10.0, 3.0, 1.0})
+    for (int i = 0; i < per_angle; ++i) {
+      const double azimuth = 2.0 * std::numbers::pi * unit(rng);
+      const double reach = elevation == 90.0 ? 0.0 : 1.0 / std::tan(elevation * std::numbers::pi / 180.0);
+      out.push_back({unit(rng), unit(rng), reach * std::cos(azimuth), reach * std::sin(azimuth)});
+    }
+  return out;
+}
+
+// Distance in level-0 texels between a technique's hit and the reference's.
+double error_texels(const HeightField& f, const TechniqueResult& r, const ReferenceHit& ref) {
+  return std::hypot((r.hit_u - ref.point.x) * f.width, (r.hit_v - ref.point.y) * f.height);
+}
+
+TEST(Qdm, HitsTheBoxSurfaceExactlyWithEveryLevelUpPolicy) {
+  for (QdmLevelUp policy : {QdmLevelUp::Stay, QdmLevelUp::One, QdmLevelUp::Aligned}) {
+    TechniqueDesc t;
+    t.kind = TechniqueKind::Qdm;
+    t.refinement = QdmRefinement::None;
+    t.level_up = policy;
+    t.depth_scale = 0.1f;
+    t.max_iterations = 100000;  // sufficient: the cap must never be what ends a ray here
+    for (const Field& field : fields()) {
+      const TechniqueHarness harness(field.heights, t);
+      const std::vector<TechniqueRay> rs = rays(24, 7);
+      const std::vector<TechniqueResult> results = harness.run(rs);
+      double worst = 0.0;
+      for (std::size_t i = 0; i < rs.size(); ++i) {
+        const ReferenceHit ref = intersect_reference(harness.field(), t.depth_scale,
+                                                     {{rs[i].u0, rs[i].v0, 0.0}, {rs[i].du, rs[i].dv, 1.0}},
+                                                     ReferenceSurface::Box);
+        ASSERT_TRUE(ref.hit);
+        ASSERT_LT(results[i].iterations, t.max_iterations);
+        worst = std::max(worst, error_texels(harness.field(), results[i], ref));
+      }
+      // The bound. The fp32 ray itself (direction from a normalised fp32 view vector, positions
+      // uv0 + d * s) is good to ~1e-5 texel here, so 1e-3 leaves room without hiding a wrong cell.
+      EXPECT_LE(worst, 1e-3) << field.name << " level_up " << int(policy);
+    }
+  }
+}
+
+TEST(Qdm, Sm3AgreesWithSm4OnSmallMaps) {
+  // Up to 64 texels, fp32 cell positions are exact enough that the emulation finds the same cells.
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::None;
+  t.depth_scale = 0.1f;
+  t.max_iterations = 100000;
+  for (const Field& field : fields()) {
+    TechniqueHarness sm4(field.heights, t);
+    TechniqueHarness sm3(field.heights, t);
+    sm3.set_math(MathMode::Sm3);
+    const std::vector<TechniqueRay> rs = rays(16, 3);
+    const auto a = sm4.run(rs), b = sm3.run(rs);
+    for (std::size_t i = 0; i < rs.size(); ++i)
+      EXPECT_LE(std::hypot((a[i].hit_u - b[i].hit_u) * 64, (a[i].hit_v - b[i].hit_v) * 64), 1e-3) << field.name << " " << i;
+  }
+}
+
+TEST(Qdm, LevelUpAfterCrossingsAvoidsDegeneratingIntoLinearSearch) {
+  // The talk's failure case: a ray that descended next to a tall feature and then travels far over low ground
+  // keeps stepping cell by cell at the fine level unless it goes up after crossings. One pillar on a floor,
+  // grazing rays leaving the pillar's neighbourhood.
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::None;
+  t.depth_scale = 0.05f;
+  t.max_iterations = 100000;
+  const Image heights = pillar(128);
+  std::vector<TechniqueRay> rs;
+  for (int i = 0; i < 16; ++i) {
+    const double azimuth = 2.0 * std::numbers::pi * (i + 0.5) / 16.0, reach = 1.0 / std::tan(2.0 * std::numbers::pi / 180.0);
+    rs.push_back({(64.5 + 1.5 * std::cos(azimuth)) / 128.0, (64.5 + 1.5 * std::sin(azimuth)) / 128.0,
+                  reach * std::cos(azimuth), reach * std::sin(azimuth)});
+  }
+  auto mean_iterations = [&](QdmLevelUp policy) {
+    t.level_up = policy;
+    double total = 0;
+    for (const TechniqueResult& r : TechniqueHarness(heights, t).run(rs)) total += r.iterations;
+    return total / double(rs.size());
+  };
+  const double stay = mean_iterations(QdmLevelUp::Stay), one = mean_iterations(QdmLevelUp::One),
+               aligned = mean_iterations(QdmLevelUp::Aligned);
+  EXPECT_LT(one, stay / 2) << "stay " << stay << ", one " << one;
+  EXPECT_LT(aligned, stay / 2) << "stay " << stay << ", aligned " << aligned;
+}
+
+TEST(Relief, FindsTheFilteredSurfaceWithinItsSearchResolution) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Relief;
+  t.depth_scale = 0.1f;
+  t.linear_steps = 64;
+  t.binary_steps = 8;
+  const Image heights = pattern(ProceduralPattern::Sine, 64, 2);  // smooth: no feature thinner than a step
+  const TechniqueHarness harness(heights, t);
+  std::vector<TechniqueRay> rs;
+  for (const TechniqueRay& r : rays(24, 5))
+    if (std::hypot(r.du, r.dv) <= 1.0 / std::tan(30.0 * std::numbers::pi / 180.0) + 1e-9) rs.push_back(r);
+  const auto results = harness.run(rs);
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    const ReferenceHit ref = intersect_reference(harness.field(), t.depth_scale,
+                                                 {{rs[i].u0, rs[i].v0, 0.0}, {rs[i].du, rs[i].dv, 1.0}},
+                                                 ReferenceSurface::Bilinear);
+    // The binary search ends in a depth bracket of depth_scale / linear_steps / 2^binary_steps; its
+    // horizontal extent, in texels, bounds the error (plus 1e-3 texel of fp32 sampling).
+    const double bracket = t.depth_scale / t.linear_steps / std::pow(2.0, t.binary_steps) * std::hypot(rs[i].du, rs[i].dv) * 64;
+    EXPECT_LE(error_texels(harness.field(), results[i], ref), bracket + 1e-3) << i;
+    EXPECT_LE(results[i].iterations, t.linear_steps + 1 + t.binary_steps);
+  }
+}
+
+TEST(Pom, StaysWithinOneStepOnSmoothFieldsAndCountsItsSteps) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Pom;
+  t.depth_scale = 0.1f;
+  t.min_steps = 16;
+  t.max_steps = 64;
+  t.lod_threshold = 16.0f;  // no fade in this test
+  const Image heights = pattern(ProceduralPattern::Sine, 64, 2);
+  const TechniqueHarness harness(heights, t);
+  // Down to 10 degrees: below that a step spans more than half a sine period and POM can jump over a crest
+  // (its known failure at grazing angles, shown in docs/techniques.md).
+  std::vector<TechniqueRay> rs;
+  for (const TechniqueRay& r : rays(24, 9))
+    if (std::hypot(r.du, r.dv) <= 1.0 / std::tan(10.0 * std::numbers::pi / 180.0) + 1e-9) rs.push_back(r);
+  const auto results = harness.run(rs);
+  for (std::size_t i = 0; i < rs.size(); ++i) {
+    const ReferenceHit ref = intersect_reference(harness.field(), t.depth_scale,
+                                                 {{rs[i].u0, rs[i].v0, 0.0}, {rs[i].du, rs[i].dv, 1.0}},
+                                                 ReferenceSurface::Bilinear);
+    // POM's linear intersection lies within the last step, whose horizontal extent is
+    // depth_scale / min_steps * |d| at worst (fewer steps are taken at steep views, where |d| is small).
+    const double step = t.depth_scale / t.min_steps * std::hypot(rs[i].du, rs[i].dv) * 64;
+    EXPECT_LE(error_texels(harness.field(), results[i], ref), step + 1e-3) << i;
+    EXPECT_LE(results[i].iterations, t.max_steps + 1);
+  }
+}
+
+TEST(Techniques, TerminateWithinTheirCapsAtTheExtremes) {
+  std::vector<Field> extremes = {{"all0", filled(16, 0.0f)}, {"all1", filled(16, 1.0f)}, {"1x1", filled(1, 0.3f)},
+                                 {"spikes", pattern(ProceduralPattern::Spikes, 64, 8)}};
+  std::vector<TechniqueRay> rs = rays(8, 1);
+  rs.push_back({0.5, 0.5, 1e6, 0.0});    // parallel to the surface, in effect
+  rs.push_back({-1e4, 1e4, 0.3, -0.2});  // far outside [0,1]
+  for (TechniqueKind kind : {TechniqueKind::Relief, TechniqueKind::Pom, TechniqueKind::Qdm})
+    for (float depth_scale : {0.0f, 1e-3f, 1.0f, 100.0f})
+      for (const Field& field : extremes) {
+        TechniqueDesc t;
+        t.kind = kind;
+        t.depth_scale = depth_scale;
+        t.max_iterations = 256;
+        const double cap = kind == TechniqueKind::Relief ? t.linear_steps + 1 + t.binary_steps
+                           : kind == TechniqueKind::Pom  ? t.max_steps + 1
+                                                         : t.max_iterations + 8;  // + refinement samples
+        for (const TechniqueResult& r : TechniqueHarness(field.heights, t).run(rs)) {
+          ASSERT_TRUE(std::isfinite(r.hit_u) && std::isfinite(r.hit_v) && std::isfinite(r.hit_depth)) << field.name;
+          ASSERT_LE(r.iterations, cap) << field.name << " kind " << int(kind);
+          ASSERT_GE(r.hit_depth, 0.0);
+          ASSERT_LE(r.hit_depth, depth_scale * (1.0 + 1e-6));
+        }
+      }
+}
+
+TEST(Techniques, DepthScaleZeroGivesExactlyTheNormalMappingImage) {
+  const auto render_with = [](const std::string& technique) {
+    std::vector<SceneOverride> sets = {{"/output/width", "160"}, {"/output/height", "90"},
+                                       {"/materials/bricks/technique/name", technique}};
+    if (technique != "normal") sets.push_back({"/materials/bricks/technique/depth_scale", "0"});
+    return render_frame(load_scene(source_dir() / "scenes" / "plane.json", sets), RenderOptions{}).color;
+  };
+  const PixelBuffer normal = render_with("normal");
+  for (const char* technique : {"relief", "pom", "qdm"}) {
+    const PixelBuffer displaced = render_with(technique);
+    ASSERT_EQ(displaced.size(), normal.size());
+    EXPECT_EQ(0, std::memcmp(displaced.data(), normal.data(), normal.size() * sizeof(float))) << technique;
+  }
+}
+
+}  // namespace
+}  // namespace qdmr::test
