@@ -1,6 +1,7 @@
 #pragma once
 // Shared by the end-to-end tests of the qdmr command: the shipped scenes, rendering one through a given
 // binary, and reading back the float pixels it wrote.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
@@ -28,11 +29,25 @@ struct ShippedScene {
   bool needs_data;   // references the real CC0 maps of QDMR_DATA_DIR
 };
 
+// Every scenes/*.json, sorted; scenes named real_* use the maps in QDMR_DATA_DIR.
 inline std::vector<ShippedScene> shipped_scenes() {
-  return {{"plane", false}, {"terrain", false}, {"objects", false}, {"real_rocks", true}};
+  std::vector<ShippedScene> scenes;
+  for (const auto& entry : std::filesystem::directory_iterator(source_dir() / "scenes"))
+    if (entry.path().extension() == ".json") {
+      const std::string name = entry.path().stem().string();
+      scenes.push_back({name, name.rfind("real_", 0) == 0});
+    }
+  std::sort(scenes.begin(), scenes.end(), [](const ShippedScene& a, const ShippedScene& b) { return a.name < b.name; });
+  return scenes;
 }
 
-inline std::string scene_name(const testing::TestParamInfo<ShippedScene>& info) { return info.param.name; }
+// Test names allow only letters, digits and '_': "pom_vs_qdm_depth_1.0" becomes "pom_vs_qdm_depth_1_0".
+inline std::string scene_name(const testing::TestParamInfo<ShippedScene>& info) {
+  std::string name = info.param.name;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
+}
 inline void PrintTo(const ShippedScene& scene, std::ostream* out) { *out << scene.name; }
 
 // The scene file and the --set overrides it needs. real_rocks.json names ../../shared/data/...: point its
