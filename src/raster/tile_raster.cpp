@@ -171,6 +171,17 @@ private:
         for (int c = 0; c < channels; ++c) plane[std::size_t(channels) * i + std::size_t(c)] = values[c][l];
       }
     }
+    alignas(64) float iterations[kLanes];
+    out.iterations.store_aligned(iterations);
+    float longest = 0.0f;
+    for (int l = 0; l < kLanes; ++l) {
+      longest = std::max(longest, iterations[l]);
+      if (!((pass >> l) & 1u)) continue;
+      const auto n = std::uint64_t(iterations[l]);
+      counters_.iterations_useful += n;
+      ++counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)];
+    }
+    counters_.iterations_executed += std::uint64_t(longest) * kLanes;
     ++counters_.batches_shaded;
     counters_.pixels_shaded += std::popcount(pass);
     for (int q = 0; q < simd::kQuadsPerBatch; ++q) counters_.quads_shaded += ((pass >> (4 * q)) & 0xFu) != 0;
@@ -197,6 +208,9 @@ TileCounters& TileCounters::operator+=(const TileCounters& o) {
   quads_shaded += o.quads_shaded;
   pixels_shaded += o.pixels_shaded;
   pixels_depth_failed += o.pixels_depth_failed;
+  for (std::size_t i = 0; i < iteration_histogram.size(); ++i) iteration_histogram[i] += o.iteration_histogram[i];
+  iterations_useful += o.iterations_useful;
+  iterations_executed += o.iterations_executed;
   return *this;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Rasterizes one screen tile: coarse 8x8 block rejection, then batches of 2x2 quads through the
 // shading program with early depth test. Knows nothing about meshes or materials beyond program indices.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -19,6 +20,11 @@ struct TileCounters {
   std::uint64_t quads_shaded = 0;      // 2x2 quads with at least one written pixel
   std::uint64_t pixels_shaded = 0;     // lanes written (covered and passed the depth test)
   std::uint64_t pixels_depth_failed = 0;
+  // Intersection loop iterations of the written pixels: histogram (last bin: that many or more), and lane
+  // use: useful = sum of the lanes' own iterations, executed = the batch's longest lane times the lane count.
+  static constexpr int kIterationBins = 1024;
+  std::array<std::uint64_t, kIterationBins + 1> iteration_histogram{};
+  std::uint64_t iterations_useful = 0, iterations_executed = 0;
 
   TileCounters& operator+=(const TileCounters& o);
 };

@@ -109,6 +109,8 @@ nlohmann::json RenderStats::to_json() const {
   j["blocks"] = {{"rejected", blocks_rejected}, {"full", blocks_full}, {"partial", blocks_partial}};
   j["shading"] = {{"batches", batches}, {"quads", quads}, {"pixels_shaded", pixels_shaded},
                   {"pixels_depth_failed", pixels_depth_failed}, {"simd_lanes", simd_lanes}, {"simd_arch", simd_arch}};
+  j["iterations"] = {{"mean", iterations_mean}, {"p99", iterations_p99}, {"max", iterations_max},
+                     {"lane_utilisation", lane_utilisation}};
   j["threads"] = threads;
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes},
                  {"mesh_bytes", mesh_bytes}, {"peak_rss_bytes", peak_rss_bytes}};
@@ -212,6 +214,23 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     stats.quads = total.quads_shaded;
     stats.pixels_shaded = total.pixels_shaded;
     stats.pixels_depth_failed = total.pixels_depth_failed;
+    if (total.pixels_shaded > 0) {
+      stats.iterations_mean = double(total.iterations_useful) / double(total.pixels_shaded);
+      std::uint64_t seen = 0;
+      const std::uint64_t p99_rank = (total.pixels_shaded * 99 + 99) / 100;  // ceil(0.99 n)
+      bool p99_found = false;
+      for (std::size_t i = 0; i < total.iteration_histogram.size(); ++i) {
+        if (total.iteration_histogram[i] == 0) continue;
+        seen += total.iteration_histogram[i];
+        if (!p99_found && seen >= p99_rank) {
+          stats.iterations_p99 = double(i);
+          p99_found = true;
+        }
+        stats.iterations_max = double(i);
+      }
+    }
+    if (total.iterations_executed > 0)
+      stats.lane_utilisation = double(total.iterations_useful) / double(total.iterations_executed);
 
     frame.width = fb.width;
     frame.height = fb.height;

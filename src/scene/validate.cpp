@@ -327,7 +327,8 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
                                                {"binary", QdmRefinement::Binary},
                                                {"bilinear_patch", QdmRefinement::BilinearPatch}});
     if (auto t = technique.find("height_fetch"))
-      d.height_fetch = t->choice<HeightFetch>({{"point", HeightFetch::Point}, {"trilinear", HeightFetch::Trilinear}});
+      d.height_fetch = t->choice<HeightFetch>(
+          {{"point", HeightFetch::Point}, {"bilinear", HeightFetch::Bilinear}, {"trilinear", HeightFetch::Trilinear}});
     if (auto t = technique.find("lod_stop")) d.lod_stop = t->boolean();
     if (auto t = technique.find("fade_start")) d.fade_start = static_cast<float>(t->non_negative());
     if (auto t = technique.find("fade_end")) {

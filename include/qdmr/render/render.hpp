@@ -59,6 +59,9 @@ struct RenderStats {
   std::uint64_t triangles_in = 0, triangles_culled = 0, triangles_clipped = 0, triangles_rasterized = 0;
   std::uint64_t tiles = 0, tile_bin_entries = 0, blocks_rejected = 0, blocks_full = 0, blocks_partial = 0;
   std::uint64_t batches = 0, quads = 0, pixels_shaded = 0, pixels_depth_failed = 0;
+  // Intersection iterations per written pixel (0 for normal mapping); p99 and max from a histogram capped at
+  // 1024 (a max of 1024 means "1024 or more"). Lane utilisation: useful lane-iterations / executed ones.
+  double iterations_mean = 0, iterations_p99 = 0, iterations_max = 0, lane_utilisation = 1;
   int threads = 0, tile_size = 0, simd_lanes = 0;
   std::string simd_arch;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;

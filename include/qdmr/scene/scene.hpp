@@ -99,8 +99,10 @@ enum class TechniqueKind { Normal, Relief, Pom, Csm, Rcsm, Qdm };
 enum class QdmLevelUp { Stay, One, Aligned };
 // QDM: how the level-0 hit is refined between texels.
 enum class QdmRefinement { None, Linear, Binary, BilinearPatch };
-// QDM: how the max-quadtree is fetched (the talk: point; LinearMipMapLinear "possible but may introduce artifacts").
-enum class HeightFetch { Point, Trilinear };
+// How techniques fetch heights: the nearest or the bilinear level-0 texel (the box and bilinear surfaces the
+// exact reference knows), or trilinear with the pixel's LOD. QDM walks its max-quadtree with point fetches
+// unless trilinear (the talk: LinearMipMapLinear "possible but may introduce some artifacts").
+enum class HeightFetch { Point, Bilinear, Trilinear };
 
 // The intersection technique and its speed/accuracy knobs. Depth is in UV units of one texture repeat:
 // the surface lies between depth 0 (the polygon) and depth_scale.
@@ -121,7 +123,7 @@ struct TechniqueDesc {
   // qdm
   QdmLevelUp level_up = QdmLevelUp::One;
   QdmRefinement refinement = QdmRefinement::Linear;
-  HeightFetch height_fetch = HeightFetch::Point;
+  HeightFetch height_fetch = HeightFetch::Bilinear;
   bool lod_stop = false;          // stop descending at the level given by the pixel's mip LOD
   int min_iterations = 0;         // > 0: the cap grows linearly from this (view along the normal) to max_iterations (grazing)
   float fade_start = 0.0f;        // > 0: depth scale fades linearly to 0 between these view distances
