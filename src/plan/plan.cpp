@@ -245,10 +245,6 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
                             layer_where + "/normal", material.name);
   if (kind == TechniqueKind::Normal) return plan;  // normal mapping pays for no height data
 
-  if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm)
-    throw Error(where + "/technique/name", std::string("'") + technique_name(kind) +
-                                               "' is not available yet (cone maps are baked but not rendered): use "
-                                               "relief, pom or qdm");
   if (layer.height.source == TextureSource::None)
     throw Error(layer_where + "/height", std::string("technique '") + technique_name(kind) + "' needs a height map");
   plan.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
@@ -261,6 +257,13 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
                                                std::to_string(h.height));
     plan.height_max = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Max, layer,
                                   layer_where + "/height", material.name);
+  }
+  if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm) {
+    // Cones of the stored heights' level 0 (the box surface); the box-filtered chain serves the refinement.
+    const TextureRequest& h = textures[std::size_t(plan.height)];
+    plan.cone_map = true;
+    plan.cone_kind = kind == TechniqueKind::Csm ? ConeKind::Conservative : ConeKind::Relaxed;
+    plan.cone_bytes = std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float);
   }
   return plan;
 }
@@ -282,6 +285,7 @@ FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
     plan.materials.push_back(plan_material(material, file + ": /materials/" + material.name, plan.textures));
   }
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
+  for (const MaterialPlan& m : plan.materials) plan.cone_map_bytes += m.cone_bytes;
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
@@ -297,6 +301,8 @@ std::string FramePlan::describe() const {
     s << "    albedo: texture " << m.albedo << ", normal: texture " << m.normal;
     if (m.height >= 0) s << ", height: texture " << m.height;
     if (m.height_max >= 0) s << ", max-quadtree: texture " << m.height_max;
+    if (m.cone_map)
+      s << ", cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes);
     s << "\n";
   }
   s << "textures to build (" << textures.size() << "):\n";
@@ -307,7 +313,9 @@ std::string FramePlan::describe() const {
       << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
   }
   const bool quadtree = std::any_of(materials.begin(), materials.end(), [](const MaterialPlan& m) { return m.height_max >= 0; });
-  s << "derived data: " << (quadtree ? "max-quadtree (above); " : "") << "no cone map, AO or blend maps\n";
+  s << "derived data: " << (quadtree ? "max-quadtree (above); " : "")
+    << (cone_map_bytes > 0 ? "cone maps (above), " + mib(cone_map_bytes) + "; no AO or blend maps\n"
+                           : std::string("no cone map, AO or blend maps\n"));
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes)
     s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles"
@@ -316,8 +324,9 @@ std::string FramePlan::describe() const {
   if (aovs.empty()) s << " none";
   for (Aov a : aovs) s << " " << aov_name(a);
   s << "\n";
-  s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes) << ", meshes "
-    << mib(mesh_bytes) << ", total " << mib(total_bytes()) << "\n";
+  s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
+    << (cone_map_bytes > 0 ? ", cone maps " + mib(cone_map_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
+    << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
 
@@ -327,7 +336,9 @@ nlohmann::json FramePlan::to_json() const {
   j["height"] = height;
   for (const MaterialPlan& m : materials)
     j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal},
-                              {"height", m.height}, {"height_max", m.height_max}});
+                              {"height", m.height}, {"height_max", m.height_max},
+                              {"cone_map", m.cone_map ? nlohmann::json(cone_kind_name(m.cone_kind)) : nlohmann::json()},
+                              {"cone_bytes", m.cone_bytes}});
   for (const TextureRequest& t : textures)
     j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                              {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
@@ -338,7 +349,7 @@ nlohmann::json FramePlan::to_json() const {
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
-                 {"total_bytes", total_bytes()}};
+                 {"cone_map_bytes", cone_map_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

@@ -146,8 +146,8 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     inputs.normal = &normal;
     inputs.height = &assets.textures[std::size_t(m.height)];
     if (m.height_max >= 0) inputs.height_max = &assets.textures[std::size_t(m.height_max)];
-    if (reference_aovs) {
-      // The exact reference traces the stored heights, in fp64.
+    if (reference_aovs || m.cone_map) {
+      // The exact reference traces the stored heights, in fp64; cone maps are baked from the same values.
       auto field = std::make_unique<HeightField>();
       const Texture& h = *inputs.height;
       field->width = h.width();
@@ -156,8 +156,15 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
       field->h.resize(std::size_t(h.width()) * std::size_t(h.height()));
       for (int y = 0; y < h.height(); ++y)
         for (int x = 0; x < h.width(); ++x) field->h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
-      inputs.reference = field.get();
-      assets.reference_fields.push_back(std::move(field));
+      if (m.cone_map) {
+        assets.cone_maps.push_back(
+            std::make_unique<ConeMap>(load_or_bake_cone_map(*field, m.cone_kind, default_cache_dir())));
+        inputs.cones = assets.cone_maps.back().get();
+      }
+      if (reference_aovs) {
+        inputs.reference = field.get();
+        assets.reference_fields.push_back(std::move(field));
+      }
     }
     assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, material_descs[i], lights));
   }

@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "qdmr/bake/cone_map.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/study/heightfield.hpp"
@@ -23,13 +24,15 @@ struct Assets {
   std::vector<TextureStat> texture_stats;       // parallel to requests
   std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
   std::vector<std::unique_ptr<HeightField>> reference_fields;  // fp64 heights for the error AOVs
+  std::vector<std::unique_ptr<ConeMap>> cone_maps;             // csm, rcsm: baked or from the cache
 
   std::vector<DrawItem> draw_items() const;     // model matrices left as identity
   std::uint64_t texture_bytes() const;
   std::uint64_t mesh_bytes() const;
 };
 
-// Builds meshes and textures in parallel (in the caller's task arena). Throws qdmr::Error on bad input.
+// Builds meshes and textures in parallel (in the caller's task arena), and cone maps through the cache in
+// default_cache_dir(). Throws qdmr::Error on bad input.
 Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const RenderOptions& options);
 
 }  // namespace qdmr

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "qdmr/core/error.hpp"
 #include "qdmr/study/reference.hpp"
 #include "shade/shading_math.hpp"
 
@@ -25,20 +26,52 @@ Float texel_step(const DisplacementProgram::Ray& ray, float width, float height)
   return Float(1.0f) / xsimd::max(reach, Float(1e-6f));
 }
 
+// Texel coordinates are clamped to +-2^22 before they become indices: beyond that fp32 positions are meaningless
+// anyway, and indices (plus at most 2^20 capped steps) stay exact in fp32 for address_texel.
+constexpr float kMaxTexelCoordinate = 4194304.0f;
+
+// The texel a ray at texel coordinate p is over: the one ahead along the ray (direction dir) when p lies on a
+// texel boundary, so a step that ends on a wall moves on. Finite for any p (a NaN clamps to the bound).
+Int texel_ahead(const Float& p, const Float& dir) {
+  const Float c = xsimd::max(xsimd::min(p, Float(kMaxTexelCoordinate)), Float(-kMaxTexelCoordinate));
+  return xsimd::to_int(xsimd::select(dir < Float(0.0f), Float(-1.0f) - xsimd::floor(Float(0.0f) - c), xsimd::floor(c)));
+}
+
+// Texel index i (|i| < 2^24) to [0, n) by the address mode, as HeightField::at: wrap, clamp, mirror (period 2n).
+Int address_texel(const Int& i, int n, AddressMode mode) {
+  const Int last(n - 1);
+  if (mode == AddressMode::Clamp) return xsimd::min(xsimd::max(i, Int(0)), last);
+  const int period = mode == AddressMode::Mirror ? 2 * n : n;
+  // i and period are exact floats and the quotient is rounded to nearest, so its floor is floor(i / period) or
+  // one more: r lands in [-period, period) and one correction puts it in [0, period).
+  const Int q = xsimd::to_int(xsimd::floor(xsimd::to_float(i) / Float(float(period))));
+  Int r = i - q * Int(period);
+  r = xsimd::select(r < Int(0), r + Int(period), r);
+  if (mode == AddressMode::Mirror) r = xsimd::select(r >= Int(n), Int(period - 1) - r, r);
+  return xsimd::min(xsimd::max(r, Int(0)), last);
+}
+
 }  // namespace
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : albedo_(*inputs.albedo), normal_(*inputs.normal), reference_(inputs.reference),
+    : albedo_(*inputs.albedo), normal_(*inputs.normal), cones_(inputs.cones), reference_(inputs.reference),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
       technique_(material.technique), lighting_(material.lighting), lights_(lights) {
   if (inputs.height) height_.emplace(*inputs.height);
   if (inputs.height_max) height_max_.emplace(*inputs.height_max);
+  if (cones_ && (!inputs.height || cones_->width != inputs.height->width() || cones_->height != inputs.height->height()))
+    throw Error("cone map", "needs the height map it was baked from (same level-0 size)");
 }
 
+// Heights as the technique fetches them: the nearest or bilinear level-0 texel (the surfaces the exact
+// reference knows), or trilinear with the pixel's LOD (the talk's POM), which smooths heights with distance.
 Float DisplacementProgram::height_at(const Float& u, const Float& v, const Float& lod) const {
+  SamplerState state = sampler_;
+  if (technique_.height_fetch != HeightFetch::Trilinear)
+    state.filter = technique_.height_fetch == HeightFetch::Point ? Filter::Point : Filter::Bilinear;
   Float h[4];
-  sample(*height_, sampler_, u, v, lod, h);
+  sample(*height_, state, u, v, lod, h);
   return h[0];
 }
 
@@ -137,7 +170,7 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& d
     const Int size_x = simd::load_i32(quadtree.widths(), level, sampler_.fetch);
     const Int size_y = simd::load_i32(quadtree.heights(), level, sampler_.fetch);
     Float hmax;
-    if (technique_.height_fetch == HeightFetch::Point) {
+    if (technique_.height_fetch != HeightFetch::Trilinear) {
       Float texel[4];
       load(quadtree, level, cx & (size_x - Int(1)), cy & (size_y - Int(1)), sampler_.fetch, texel);
       hmax = texel[0];
@@ -233,6 +266,107 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& d
   return {xsimd::min(s, ds), iterations};
 }
 
+void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, Float& ratio) const {
+  const Int ax = address_texel(x, cones_->width, sampler_.address);
+  const Int ay = address_texel(y, cones_->height, sampler_.address);
+  Float texel[4];
+  load(*height_, Int(0), ax, ay, sampler_.fetch, texel);
+  height = texel[0];
+  ratio = simd::load_f32(cones_->ratio.data(), ay * Int(cones_->width) + ax, sampler_.fetch);
+}
+
+// Cone step mapping over the box surface (Dummer 2006; relaxed cones: Policarpo & Oliveira 2007). The ray reads
+// the cone of the level-0 texel p it is over; the cone stands for S_p, the union of cones with apex anywhere on
+// p's top face (cone_map.hpp), and the ray steps to where it leaves S_p. Along the ray S_p is: p's air column
+// up to the first wall, then, outside one wall, distance (alpha (s - sa)) <= r (top - s) / depth_scale, then,
+// outside both, the Euclidean distance to p's square; so the exit is p's top (a hit), a linear solve or a
+// quadratic. With r = 0 the step still reaches p's wall (or top): the march never stalls on rough maps.
+// Conservative cones never let a step pass through the surface: the first texel top the ray is at or below is
+// the hit. Relaxed cones let a step enter the surface at most once and not leave it before the step's end: a
+// step that ends below the surface brackets the first hit, found by binary search on the box surface.
+DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Float& ds, Mask active) const {
+  const bool relaxed = technique_.kind == TechniqueKind::Rcsm;
+  const float width = float(cones_->width), height = float(cones_->height);
+  const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
+  const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
+  const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
+  const Float ax = xsimd::abs(ray.du) * ds, ay = xsimd::abs(ray.dv) * ds;  // UV per unit of height, as the ratios
+  const IntMask step_x_pos = int_mask(dx > zero), step_y_pos = int_mask(dy > zero);
+  const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
+
+  Int cx = texel_ahead(x0, dx), cy = texel_ahead(y0, dy);
+  Float s(0.0f), s_prev(0.0f), iterations(0.0f);
+  Int done_iterations(0);
+  const Int cap(technique_.max_iterations);
+  Mask search = zero != zero;  // rcsm: the last step entered the surface
+  for (;;) {
+    const IntMask running = int_mask(active) & (done_iterations < cap);
+    active = float_mask(running);
+    if (!xsimd::any(active)) break;
+    iterations += count(active);
+    done_iterations += xsimd::select(running, Int(1), Int(0));
+
+    Float hp, r;
+    cone_texel(cx, cy, hp, r);
+    const Float top = ds * (Float(1.0f) - hp);
+    // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
+    // the surface), or a relaxed step that went in.
+    const Mask below = active & (s >= top);
+    if (relaxed) search = search | (below & (s_prev < s));
+    active = active & !below;
+
+    // The walls of p ahead, each crossing computed from the integer wall as in QDM.
+    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx));
+    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy));
+    const Float sx = xsimd::select(dx != zero, xsimd::max((wall_x - x0) / dx, s), inf);
+    const Float sy = xsimd::select(dy != zero, xsimd::max((wall_y - y0) / dy, s), inf);
+    const Mask x_first = sx <= sy;
+    const Float alpha = xsimd::select(x_first, ax, ay), beta = xsimd::select(x_first, ay, ax);
+    const Mask to_top = active & (top <= xsimd::min(sx, sy));
+    // Finite stand-ins (a wall never crossed lies beyond the top): lanes going to the top ignore the rest.
+    const Float sa = xsimd::min(xsimd::min(sx, sy), top), sb = xsimd::min(xsimd::max(sx, sy), top);
+    // Outside the first wall only: alpha (s - sa) = r (top - s).
+    const Float exit1 =
+        xsimd::max((alpha * sa + r * top) / xsimd::max(alpha + r, Float(1e-30f)), sa);
+    // Outside both: with tau = s - sb, delta = sb - sa, T = top - sb,
+    //   alpha^2 (tau + delta)^2 + beta^2 tau^2 = r^2 (T - tau)^2,
+    // a2 tau^2 + 2 b1 tau + c0 = 0 with c0 <= 0 (the ray is in S_p at sb): the root in [0, T] in the stable form.
+    const Float delta = sb - sa, T = top - sb;
+    const Float a2 = alpha * alpha + beta * beta - r * r;
+    const Float b1 = alpha * alpha * delta + r * r * T;
+    const Float c0 = (alpha * delta - r * T) * (alpha * delta + r * T);
+    const Float disc = xsimd::max(b1 * b1 - a2 * c0, zero);
+    const Float tau = xsimd::min(xsimd::max((zero - c0) / xsimd::max(b1 + xsimd::sqrt(disc), Float(1e-30f)), zero), T);
+    const Float next = xsimd::select(to_top, top, xsimd::min(xsimd::select(exit1 <= sb, exit1, sb + tau), top));
+    active = active & !to_top;  // on p's top while over p: the hit
+
+    // The texel at the step's end: the one ahead of the position, at least one past each wall crossed.
+    const Mask stepping = active;
+    const Int ahead_x = texel_ahead(x0 + dx * next, dx), ahead_y = texel_ahead(y0 + dy * next, dy);
+    const Int moved_x = xsimd::select(step_x_pos, xsimd::max(ahead_x, cx + step_x), xsimd::min(ahead_x, cx + step_x));
+    const Int moved_y = xsimd::select(step_y_pos, xsimd::max(ahead_y, cy + step_y), xsimd::min(ahead_y, cy + step_y));
+    cx = xsimd::select(int_mask(stepping & (next >= sx)), moved_x, cx);
+    cy = xsimd::select(int_mask(stepping & (next >= sy)), moved_y, cy);
+    s_prev = xsimd::select(stepping, s, s_prev);
+    s = xsimd::select(stepping | to_top, next, s);
+  }
+  if (relaxed) {
+    // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
+    Float lo = s_prev, hi = s;
+    for (int i = 0; i < technique_.binary_steps && xsimd::any(search); ++i) {
+      const Float mid = (lo + hi) * Float(0.5f);
+      Float h, unused;
+      cone_texel(texel_ahead(x0 + dx * mid, zero), texel_ahead(y0 + dy * mid, zero), h, unused);
+      const Mask below = mid >= ds * (Float(1.0f) - h);
+      iterations += count(search);
+      hi = xsimd::select(search & below, mid, hi);
+      lo = xsimd::select(search & !below, mid, lo);
+    }
+    s = xsimd::select(search, hi, s);
+  }
+  return {xsimd::min(s, ds), iterations};
+}
+
 // Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
 Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
                                   Mask active) const {
@@ -274,8 +408,10 @@ void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, cons
   ds.store_aligned(depth);
   hit.s.store_aligned(s);
   const std::uint32_t lanes = simd::to_bits(covered);
-  // Point-sampled QDM without refinement sees the box surface; everything else the filtered surface.
-  const bool box = technique_.kind == TechniqueKind::Qdm && technique_.refinement == QdmRefinement::None;
+  // QDM and cone stepping without refinement see the box surface; everything else the filtered surface.
+  const bool box = (technique_.kind == TechniqueKind::Qdm || technique_.kind == TechniqueKind::Csm ||
+                    technique_.kind == TechniqueKind::Rcsm) &&
+                   technique_.refinement == QdmRefinement::None;
   const ReferenceSurface surface = box ? ReferenceSurface::Box : ReferenceSurface::Bilinear;
   for (int l = 0; l < kLanes; ++l) {
     error[l] = missed[l] = 0.0f;
@@ -329,7 +465,10 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
       break;
     }
     case TechniqueKind::Csm:
-    case TechniqueKind::Rcsm: break;  // cone step mapping arrives with the cone maps
+    case TechniqueKind::Rcsm:
+      hit = cone_step(ray, ds, active);
+      hit.s = refine(ray, ds, hit.s, hit.iterations, active);
+      break;
     case TechniqueKind::Qdm: {
       Float stop(0.0f);
       if (technique_.lod_stop)

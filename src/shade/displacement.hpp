@@ -4,6 +4,7 @@
 // mapping. Optionally the exact fp64 reference is traced too, for the error AOVs.
 #include <optional>
 
+#include "qdmr/bake/cone_map.hpp"
 #include "qdmr/study/heightfield.hpp"
 #include "shade/lighting.hpp"
 #include "shade/program.hpp"
@@ -16,6 +17,7 @@ struct DisplacementInputs {
   const Texture* normal = nullptr;      // RGBA8, 0.5 + 0.5 n
   const Texture* height = nullptr;      // box-filtered heights (relief, POM, refinement)
   const Texture* height_max = nullptr;  // max-quadtree (QDM); power-of-two sizes
+  const ConeMap* cones = nullptr;       // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr;  // level-0 heights in fp64, for error_texels / missed; may be null
 };
 
@@ -40,6 +42,8 @@ private:
           simd::Mask active) const;
   Hit qdm(const Ray& ray, const simd::Float& depth_scale, const simd::Float& stop_level, const simd::Int& cap,
           simd::Mask active) const;
+  Hit cone_step(const Ray& ray, const simd::Float& depth_scale, simd::Mask active) const;
+  void cone_texel(const simd::Int& x, const simd::Int& y, simd::Float& height, simd::Float& ratio) const;
   simd::Float refine(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit, simd::Float& iterations,
                      simd::Mask active) const;
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
@@ -47,6 +51,7 @@ private:
 
   TextureView albedo_, normal_;
   std::optional<TextureView> height_, height_max_;
+  const ConeMap* cones_;
   const HeightField* reference_;
   SamplerState sampler_;
   LodMode lod_mode_;

@@ -1,10 +1,7 @@
 // Displacement techniques against the exact reference, and their termination at the extremes.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstring>
-#include <numbers>
-#include <random>
 
 #include <nlohmann/json.hpp>
 
@@ -16,66 +13,6 @@
 
 namespace qdmr::test {
 namespace {
-
-Image pattern(ProceduralPattern kind, int size, int cells) {
-  ProceduralDesc p;
-  p.pattern = kind;
-  p.size = size;
-  p.cells = cells;
-  return generate_procedural(p);
-}
-
-Image filled(int size, float value) {
-  Image img(size, size, 1);
-  for (float& t : img.texels) t = value;
-  return img;
-}
-
-// One-texel features: a pillar (one texel at 1 on a floor at 0) and a slit (one texel column at 0 in a plateau at 1).
-Image pillar(int size) {
-  Image img = filled(size, 0.0f);
-  img.at(size / 2, size / 2, 0) = 1.0f;
-  return img;
-}
-Image slit(int size) {
-  Image img = filled(size, 1.0f);
-  for (int y = 0; y < size; ++y) img.at(size / 2, y, 0) = 0.0f;
-  return img;
-}
-
-struct Field {
-  const char* name;
-  Image heights;
-};
-
-std::vector<Field> fields() {
-  return {{"flat", filled(32, 0.5f)},
-          {"steps", pattern(ProceduralPattern::Steps, 64, 8)},
-          {"sine", pattern(ProceduralPattern::Sine, 64, 3)},
-          {"spikes", pattern(ProceduralPattern::Spikes, 64, 4)},
-          {"checker", pattern(ProceduralPattern::Checker, 32, 32)},  // alternates at the finest level
-          {"pillar", pillar(32)},
-          {"slit", slit(32)}};
-}
-
-// Rays from 90 down to 1 degree above the surface, all around, from deterministic random origins.
-std::vector<TechniqueRay> rays(int per_angle, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<TechniqueRay> out;
-  for (double elevation : {90.0, 60.0, 30.0, 10.0, 3.0, 1.0})
-    for (int i = 0; i < per_angle; ++i) {
-      const double azimuth = 2.0 * std::numbers::pi * unit(rng);
-      const double reach = elevation == 90.0 ? 0.0 : 1.0 / std::tan(elevation * std::numbers::pi / 180.0);
-      out.push_back({unit(rng), unit(rng), reach * std::cos(azimuth), reach * std::sin(azimuth)});
-    }
-  return out;
-}
-
-// Distance in level-0 texels between a technique's hit and the reference's.
-double error_texels(const HeightField& f, const TechniqueResult& r, const ReferenceHit& ref) {
-  return std::hypot((r.hit_u - ref.point.x) * f.width, (r.hit_v - ref.point.y) * f.height);
-}
 
 TEST(Qdm, HitsTheBoxSurfaceExactlyWithEveryLevelUpPolicy) {
   for (QdmLevelUp policy : {QdmLevelUp::Stay, QdmLevelUp::One, QdmLevelUp::Aligned}) {
@@ -208,7 +145,8 @@ TEST(Techniques, TerminateWithinTheirCapsAtTheExtremes) {
   std::vector<TechniqueRay> rs = rays(8, 1);
   rs.push_back({0.5, 0.5, 1e6, 0.0});    // parallel to the surface, in effect
   rs.push_back({-1e4, 1e4, 0.3, -0.2});  // far outside [0,1]
-  for (TechniqueKind kind : {TechniqueKind::Relief, TechniqueKind::Pom, TechniqueKind::Qdm})
+  for (TechniqueKind kind :
+       {TechniqueKind::Relief, TechniqueKind::Pom, TechniqueKind::Qdm, TechniqueKind::Csm, TechniqueKind::Rcsm})
     for (float depth_scale : {0.0f, 1e-3f, 1.0f, 100.0f})
       for (const Field& field : extremes) {
         TechniqueDesc t;
@@ -217,6 +155,8 @@ TEST(Techniques, TerminateWithinTheirCapsAtTheExtremes) {
         t.max_iterations = 256;
         const double cap = kind == TechniqueKind::Relief ? t.linear_steps + 1 + t.binary_steps
                            : kind == TechniqueKind::Pom  ? t.max_steps + 1
+                           : kind == TechniqueKind::Csm  ? t.max_iterations + 2  // + the linear refinement's samples
+                           : kind == TechniqueKind::Rcsm ? t.max_iterations + t.binary_steps + 2
                                                          : t.max_iterations + 8;  // + refinement samples
         for (const TechniqueResult& r : TechniqueHarness(field.heights, t).run(rs)) {
           ASSERT_TRUE(std::isfinite(r.hit_u) && std::isfinite(r.hit_v) && std::isfinite(r.hit_depth)) << field.name;
@@ -228,6 +168,7 @@ TEST(Techniques, TerminateWithinTheirCapsAtTheExtremes) {
 }
 
 TEST(Techniques, DepthScaleZeroGivesExactlyTheNormalMappingImage) {
+  const TemporaryConeCache cache;  // csm and rcsm bake their cone maps through the cache
   const auto render_with = [](const std::string& technique) {
     std::vector<SceneOverride> sets = {{"/output/width", "160"}, {"/output/height", "90"},
                                        {"/materials/bricks/technique/name", technique}};
@@ -235,7 +176,7 @@ TEST(Techniques, DepthScaleZeroGivesExactlyTheNormalMappingImage) {
     return render_frame(load_scene(source_dir() / "scenes" / "plane.json", sets), RenderOptions{}).color;
   };
   const PixelBuffer normal = render_with("normal");
-  for (const char* technique : {"relief", "pom", "qdm"}) {
+  for (const char* technique : {"relief", "pom", "qdm", "csm", "rcsm"}) {
     const PixelBuffer displaced = render_with(technique);
     ASSERT_EQ(displaced.size(), normal.size());
     EXPECT_EQ(0, std::memcmp(displaced.data(), normal.data(), normal.size() * sizeof(float))) << technique;

@@ -2,11 +2,20 @@
 // Runs a displacement technique on chosen rays: each lane gets its own UV origin and UV-space direction on a
 // flat tangent frame (t = +x, b = +y, n = +z), with the camera placed along the view ray.
 #include <array>
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <string>
 #include <vector>
 
+#include "qdmr/bake/cone_map.hpp"
 #include "qdmr/study/reference.hpp"
 #include "qdmr/texture/height_texture.hpp"
+#include "qdmr/texture/texture.hpp"
 #include "shade/displacement.hpp"
+#include "support/test_support.hpp"
 
 namespace qdmr::test {
 
@@ -16,6 +25,89 @@ struct TechniqueRay {
 
 struct TechniqueResult {
   double hit_u, hit_v, hit_depth, iterations;
+};
+
+// Height fields and rays the technique tests share.
+inline Image pattern(ProceduralPattern kind, int size, int cells) {
+  ProceduralDesc p;
+  p.pattern = kind;
+  p.size = size;
+  p.cells = cells;
+  return generate_procedural(p);
+}
+
+inline Image filled(int size, float value) {
+  Image img(size, size, 1);
+  for (float& t : img.texels) t = value;
+  return img;
+}
+
+// One-texel features: a pillar (one texel at 1 on a floor at 0) and a slit (one texel column at 0 in a plateau at 1).
+inline Image pillar(int size) {
+  Image img = filled(size, 0.0f);
+  img.at(size / 2, size / 2, 0) = 1.0f;
+  return img;
+}
+inline Image slit(int size) {
+  Image img = filled(size, 1.0f);
+  for (int y = 0; y < size; ++y) img.at(size / 2, y, 0) = 0.0f;
+  return img;
+}
+
+struct Field {
+  const char* name;
+  Image heights;
+};
+
+inline std::vector<Field> fields() {
+  return {{"flat", filled(32, 0.5f)},
+          {"steps", pattern(ProceduralPattern::Steps, 64, 8)},
+          {"sine", pattern(ProceduralPattern::Sine, 64, 3)},
+          {"spikes", pattern(ProceduralPattern::Spikes, 64, 4)},
+          {"checker", pattern(ProceduralPattern::Checker, 32, 32)},  // alternates at the finest level
+          {"pillar", pillar(32)},
+          {"slit", slit(32)}};
+}
+
+// Rays from 90 down to 1 degree above the surface, all around, from deterministic random origins.
+inline std::vector<TechniqueRay> rays(int per_angle, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<TechniqueRay> out;
+  for (double elevation : {90.0, 60.0, 30.0, 10.0, 3.0, 1.0})
+    for (int i = 0; i < per_angle; ++i) {
+      const double azimuth = 2.0 * std::numbers::pi * unit(rng);
+      const double reach = elevation == 90.0 ? 0.0 : 1.0 / std::tan(elevation * std::numbers::pi / 180.0);
+      out.push_back({unit(rng), unit(rng), reach * std::cos(azimuth), reach * std::sin(azimuth)});
+    }
+  return out;
+}
+
+// Distance in level-0 texels between a technique's hit and the reference's.
+inline double error_texels(const HeightField& f, const TechniqueResult& r, const ReferenceHit& ref) {
+  return std::hypot((r.hit_u - ref.point.x) * f.width, (r.hit_v - ref.point.y) * f.height);
+}
+
+// Points QDMR_CACHE_DIR (where renders keep cone maps) at a temporary folder while it lives, so tests that
+// render csm or rcsm never touch the user's cache.
+class TemporaryConeCache {
+public:
+  TemporaryConeCache() {
+    if (const char* v = std::getenv("QDMR_CACHE_DIR")) previous_ = v;
+    ::setenv("QDMR_CACHE_DIR", dir_.path().c_str(), 1);
+  }
+  ~TemporaryConeCache() {
+    if (previous_)
+      ::setenv("QDMR_CACHE_DIR", previous_->c_str(), 1);
+    else
+      ::unsetenv("QDMR_CACHE_DIR");
+  }
+  TemporaryConeCache(const TemporaryConeCache&) = delete;
+  TemporaryConeCache& operator=(const TemporaryConeCache&) = delete;
+
+private:
+  TempDir dir_;
+  std::optional<std::string> previous_;
 };
 
 class TechniqueHarness {
@@ -32,6 +124,9 @@ public:
     field_.width = heights.width;
     field_.height = heights.height;
     field_.h.assign(heights.texels.begin(), heights.texels.end());
+    // csm, rcsm: the exact cones of these heights, baked here (never through the user's cache).
+    if (technique.kind == TechniqueKind::Csm || technique.kind == TechniqueKind::Rcsm)
+      cones_ = bake_cone_map(field_, technique.kind == TechniqueKind::Csm ? ConeKind::Conservative : ConeKind::Relaxed);
   }
 
   const HeightField& field() const { return field_; }
@@ -43,6 +138,7 @@ public:
     inputs.normal = &flat_;
     inputs.height = &height_;
     inputs.height_max = &height_max_;
+    if (!cones_.ratio.empty()) inputs.cones = &cones_;
     std::vector<TechniqueResult> results;
     for (std::size_t first = 0; first < rays.size(); first += simd::kLanes) {
       LightRig rig;
@@ -87,6 +183,7 @@ private:
   Texture height_, height_max_, flat_;
   MaterialDesc material_;
   HeightField field_;
+  ConeMap cones_;
 };
 
 }  // namespace qdmr::test

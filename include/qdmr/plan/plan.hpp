@@ -7,6 +7,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "qdmr/bake/cone_map.hpp"
 #include "qdmr/render/render.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/format.hpp"
@@ -36,6 +37,9 @@ struct MaterialPlan {
   int albedo = -1, normal = -1;  // indices into FramePlan::textures
   int height = -1;           // box-filtered heights (displacement techniques)
   int height_max = -1;       // max-quadtree (qdm)
+  bool cone_map = false;     // csm, rcsm: a cone map of the height's level 0, baked or from the cache
+  ConeKind cone_kind = ConeKind::Conservative;
+  std::uint64_t cone_bytes = 0;  // one float per level-0 texel
   SamplingDesc sampling;
   LightingDesc lighting;
 };
@@ -53,8 +57,8 @@ struct FramePlan {
   std::vector<TextureRequest> textures;
   std::vector<MeshPlan> meshes;
   std::vector<Aov> aovs;
-  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0;
-  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes; }
+  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, cone_map_bytes = 0;
+  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes + cone_map_bytes; }
 
   std::string describe() const;  // human-readable, for `qdmr plan`
   nlohmann::json to_json() const;
