@@ -37,7 +37,7 @@ struct Workload {
 Workload make_workload(const std::vector<SceneOverride>& overrides) {
   Workload w;
   w.scene = load_scene(std::string(QDMR_SOURCE_DIR) + "/scenes/plane.json", overrides);
-  w.assets = prepare_assets(w.scene, LightRig::from_scene(w.scene));
+  w.assets = prepare_assets(w.scene, LightRig::from_scene(w.scene), RenderOptions{});
   w.draws = w.assets.draw_items();  // the plane scene's single object has the identity transform
   const CameraDesc& cam = w.scene.camera;
   w.viewport = {w.scene.output.width, w.scene.output.height};

@@ -63,6 +63,9 @@ def technique_sets(scene, technique, knob_value=None):
 
 def tune(qdmr, scene, technique, tmp, start, limit):
     """Smallest doubling of the knob that leaves < 0.1 % of pixels missed (at 480x270)."""
+    if technique == "pom":  # max_steps may not go below the scene's min_steps
+        with open(os.path.join(ROOT, "scenes", scene + ".json")) as f:
+            start = max([start] + [m["technique"].get("min_steps", 8) for m in json.load(f)["materials"].values()])
     value = start
     while True:
         stats = render(qdmr, scene, technique_sets(scene, technique, value), 480, 270, tmp, aov=True)
@@ -81,7 +84,9 @@ def main():
     parser.add_argument("scenes", nargs="*", default=SCENES)
     args = parser.parse_args()
     qdmr = os.path.join(args.B, "qdmr")
-    rows = []
+    print(f"| scene | POM: {KNOB['pom']} / missed | QDM: {KNOB['qdm']} / missed | normal ms | POM ms over normal "
+          f"| QDM ms over normal | POM/QDM | talk POM/QDM | POM iter mean/p99 | QDM iter mean/p99 | lane use POM/QDM |")
+    print("|" + "---|" * 11, flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         for scene in args.scenes:
             settings = {t: tune(qdmr, scene, t, tmp, 16, 4096) for t in ("pom", "qdm")}
@@ -94,18 +99,14 @@ def main():
                     times[t].append(stats["time_ms"]["raster_shade"])
                     iters[t] = stats["iterations"]
             med = {t: statistics.median(v) for t, v in times.items()}
-            rows.append((scene, settings, med, iters))
-    print(f"| scene | POM: {KNOB['pom']} / missed | QDM: {KNOB['qdm']} / missed | normal ms | POM ms over normal "
-          f"| QDM ms over normal | POM/QDM | talk POM/QDM | POM iter mean/p99 | QDM iter mean/p99 | lane use POM/QDM |")
-    print("|" + "---|" * 11)
-    for scene, settings, med, iters in rows:
-        pom = med["pom"] - med["normal"]
-        qdm = med["qdm"] - med["normal"]
-        talk = TALK_MS[scene][0] / TALK_MS[scene][1] if scene in TALK_MS else float("nan")
-        print(f"| {scene} | {settings['pom'][0]} / {100 * settings['pom'][1]:.3f} % | {settings['qdm'][0]} / "
-              f"{100 * settings['qdm'][1]:.3f} % | {med['normal']:.1f} | {pom:.1f} | {qdm:.1f} | {pom / qdm:.2f}x "
-              f"| {talk:.2f}x | {iters['pom']['mean']:.1f} / {iters['pom']['p99']:.0f} | {iters['qdm']['mean']:.1f} / "
-              f"{iters['qdm']['p99']:.0f} | {iters['pom']['lane_utilisation']:.2f} / {iters['qdm']['lane_utilisation']:.2f} |")
+            pom = med["pom"] - med["normal"]
+            qdm = med["qdm"] - med["normal"]
+            talk = TALK_MS[scene][0] / TALK_MS[scene][1] if scene in TALK_MS else float("nan")
+            print(f"| {scene} | {settings['pom'][0]} / {100 * settings['pom'][1]:.3f} % | {settings['qdm'][0]} / "
+                  f"{100 * settings['qdm'][1]:.3f} % | {med['normal']:.1f} | {pom:.1f} | {qdm:.1f} | {pom / qdm:.2f}x "
+                  f"| {talk:.2f}x | {iters['pom']['mean']:.1f} / {iters['pom']['p99']:.0f} | "
+                  f"{iters['qdm']['mean']:.1f} / {iters['qdm']['p99']:.0f} | "
+                  f"{iters['pom']['lane_utilisation']:.2f} / {iters['qdm']['lane_utilisation']:.2f} |", flush=True)
     return 0
 
 
