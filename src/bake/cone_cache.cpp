@@ -1,9 +1,7 @@
 // Cone maps on disk: the content-hash cache of baked maps and the EXR the `qdmr bake cone` command writes.
 #include <OpenImageIO/imageio.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -12,6 +10,7 @@
 #include <string>
 
 #include "qdmr/bake/cone_map.hpp"
+#include "io/atomic_file.hpp"
 #include "qdmr/core/error.hpp"
 
 namespace qdmr {
@@ -56,15 +55,6 @@ std::string hex(std::uint64_t v) {
   return s;
 }
 
-// A temporary name unique per process and call, in the target's folder (so the rename is atomic).
-std::filesystem::path temporary_for(const std::filesystem::path& file) {
-  static std::atomic<unsigned> counter{0};
-  const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
-  std::string name = ".";
-  name.append(file.filename().string()).append(".tmp").append(std::to_string(::getpid()));
-  name.append("-").append(std::to_string(counter++)).append(file.extension().string());
-  return folder / name;
-}
 
 // The cached map, or nothing when the file is missing, foreign, truncated or corrupt.
 std::optional<ConeMap> read_cache(const std::filesystem::path& file, std::uint64_t key, const HeightField& field,
@@ -104,16 +94,15 @@ void write_cache(const std::filesystem::path& file, std::uint64_t key, const Con
   header.height = map.height;
   header.key = key;
   header.payload_hash = payload_hash(map.ratio);
-  const std::filesystem::path temporary = temporary_for(file);
-  bool ok = false;
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(&header), sizeof header);
-    out.write(reinterpret_cast<const char*>(map.ratio.data()), std::streamsize(map.ratio.size() * sizeof(float)));
-    ok = bool(out.flush());
+  try {  // the cache is best effort: an unwritable folder only costs a rebake next time
+    write_atomically(file, "cone map cache", [&](const std::filesystem::path& temporary) -> std::string {
+      std::ofstream out(temporary, std::ios::binary);
+      out.write(reinterpret_cast<const char*>(&header), sizeof header);
+      out.write(reinterpret_cast<const char*>(map.ratio.data()), std::streamsize(map.ratio.size() * sizeof(float)));
+      return out.flush() ? "" : "write failed";
+    });
+  } catch (const Error&) {
   }
-  if (ok) std::filesystem::rename(temporary, file, ec);
-  if (!ok || ec) std::filesystem::remove(temporary, ec);
 }
 
 }  // namespace
@@ -148,31 +137,14 @@ ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std
 }
 
 void write_cone_map_exr(const ConeMap& map, const std::filesystem::path& file) {
-  const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
-  if (!std::filesystem::is_directory(folder)) throw Error(file.string(), "folder does not exist: " + folder.string());
   // Row 0 (v = 0) is the last row of the file, as read_image expects.
   std::vector<float> rows(map.ratio.size());
   for (int y = 0; y < map.height; ++y)
     std::copy_n(map.ratio.begin() + std::ptrdiff_t(y) * map.width, map.width,
                 rows.begin() + std::ptrdiff_t(map.height - 1 - y) * map.width);
-  const std::filesystem::path temporary = temporary_for(file);
   OIIO::ImageSpec spec(map.width, map.height, 1, OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R"};
-  auto output = OIIO::ImageOutput::create(temporary.string());
-  bool ok = output && output->open(temporary.string(), spec) &&
-            output->write_image(OIIO::TypeDesc::FLOAT, rows.data()) && output->close();
-  std::string message = output ? output->geterror() : OIIO::geterror();
-  output.reset();
-  std::error_code ec;
-  if (ok) {
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) message = ec.message();
-    ok = !ec;
-  }
-  if (!ok) {
-    std::filesystem::remove(temporary, ec);
-    throw Error(file.string(), "cannot write cone map: " + (message.empty() ? std::string("unknown error") : message));
-  }
+  write_image_file(file, spec, OIIO::TypeDesc::FLOAT, rows.data(), "cone map");
 }
 
 }  // namespace qdmr

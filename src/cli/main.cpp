@@ -66,20 +66,6 @@ void check_output_path(const std::string& option, const std::filesystem::path& o
     throw qdmr::Error(option + " " + out.string(), "refusing to overwrite the scene file");
 }
 
-// Writes text through a temporary file and a rename.
-void write_text_file(const std::filesystem::path& file, const std::string& text) {
-  const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
-  const std::filesystem::path temporary = folder / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()));
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    if (!out.flush()) {
-      std::filesystem::remove(temporary);
-      throw qdmr::Error(file.string(), "cannot write file");
-    }
-  }
-  std::filesystem::rename(temporary, file);
-}
 
 int run_render(const SceneArgs& args, const RenderArgs& render) {
   using Clock = std::chrono::steady_clock;
@@ -127,7 +113,7 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   qdmr::write_frame(frame, render.output);
   for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file);
   frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  if (!render.stats.empty()) write_text_file(render.stats, frame.stats.to_json().dump(2) + "\n");
+  if (!render.stats.empty()) qdmr::write_stats(frame.stats, render.stats);
   const qdmr::RenderStats& s = frame.stats;
   std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
               frame.width, frame.height, static_cast<unsigned long long>(s.triangles_rasterized),

@@ -1,5 +1,3 @@
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -9,8 +7,10 @@
 #include <tbb/parallel_for.h>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "core/det_math.hpp"
+#include "io/atomic_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/render/render.hpp"
 
@@ -49,17 +49,10 @@ std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb
   return out;
 }
 
-// Writes pixels (float, `channels` per pixel) through a temporary file in the target folder, then renames.
+// Writes pixels (float, `channels` per pixel), atomically.
 void write_pixels(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
                   bool srgb) {
   const Container container = container_of(file);
-  const std::filesystem::path folder = file.parent_path().empty() ? std::filesystem::path(".") : file.parent_path();
-  if (!std::filesystem::is_directory(folder)) throw Error(file.string(), "folder does not exist: " + folder.string());
-  std::string temporary_name = ".";  // appended piecewise: GCC 12 warns falsely on a chain of string '+'
-  temporary_name.append(file.filename().string()).append(".tmp").append(std::to_string(::getpid()));
-  temporary_name.append(file.extension().string());
-  const std::filesystem::path temporary = folder / temporary_name;
-
   OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
   std::vector<std::uint8_t> bytes8;
   std::vector<std::uint16_t> bytes16;
@@ -78,26 +71,17 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
   if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
   // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
   if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
-  auto output = OIIO::ImageOutput::create(temporary.string());
-  bool ok = output && output->open(temporary.string(), spec) && output->write_image(format, data) && output->close();
-  std::string message = output ? output->geterror() : OIIO::geterror();
-  output.reset();
-  std::error_code ec;
-  if (ok) {
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) message = ec.message();
-    ok = !ec;
-  }
-  if (!ok) {
-    std::filesystem::remove(temporary, ec);
-    throw Error(file.string(), "cannot write image: " + (message.empty() ? std::string("unknown error") : message));
-  }
+  write_image_file(file, spec, format, data, "image");
 }
 
 }  // namespace
 
 void write_frame(const Frame& frame, const std::filesystem::path& file) {
   write_pixels(file, frame.width, frame.height, 3, frame.color, true);
+}
+
+void write_stats(const RenderStats& stats, const std::filesystem::path& file) {
+  write_text_file(file, stats.to_json().dump(2) + "\n");
 }
 
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {

@@ -14,15 +14,6 @@
 namespace qdmr {
 namespace {
 
-const char* purpose_name(TexturePurpose p) {
-  switch (p) {
-    case TexturePurpose::Albedo: return "albedo";
-    case TexturePurpose::Normal: return "normal";
-    case TexturePurpose::Height: return "height";
-  }
-  return "?";
-}
-
 const char* filter_name(Filter f) {
   switch (f) {
     case Filter::Point: return "point";

@@ -10,15 +10,6 @@
 namespace qdmr {
 namespace {
 
-const char* purpose_name(TexturePurpose p) {
-  switch (p) {
-    case TexturePurpose::Albedo: return "albedo";
-    case TexturePurpose::Normal: return "normal";
-    case TexturePurpose::Height: return "height";
-  }
-  return "?";
-}
-
 // Builds one requested texture. Heights (and the heights behind from_height normals) go through the storage
 // the scene asks for — quantisation, BC3 — so what is rendered is what a GPU would sample.
 Texture build_texture(const TextureRequest& request, TextureStat& stat) {

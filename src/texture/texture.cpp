@@ -230,6 +230,15 @@ float srgb_to_linear(float c) {
 
 }  // namespace texture_detail
 
+const char* purpose_name(TexturePurpose purpose) {
+  switch (purpose) {
+    case TexturePurpose::Albedo: return "albedo";
+    case TexturePurpose::Normal: return "normal";
+    case TexturePurpose::Height: return "height";
+  }
+  return "?";
+}
+
 Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerDesc& layer, const Image* height,
                    const std::string& where) {
   switch (purpose) {

@@ -88,6 +88,8 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear) through a temporary
 // file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file);
+// Writes the stats as JSON, atomically like the images.
+void write_stats(const RenderStats& stats, const std::filesystem::path& file);
 // Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
 // fractional part, depth, iterations, hit depth and errors divided by their maximum).
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);

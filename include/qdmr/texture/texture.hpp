@@ -14,6 +14,8 @@ enum class TexturePurpose {
   Height   // 1 channel, h in [0,1] after the layer's scale and offset
 };
 
+const char* purpose_name(TexturePurpose purpose);  // "albedo", "normal", "height"
+
 // Deterministic procedural height pattern in [0,1], size x size, 1 channel.
 Image generate_procedural(const ProceduralDesc& desc);
 
