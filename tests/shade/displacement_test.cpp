@@ -60,6 +60,43 @@ TEST(Qdm, Sm3AgreesWithSm4OnSmallMaps) {
   }
 }
 
+// Far from the origin the fp32 emulation breaks where #3's math-mode study says fp32 positions do: at a texel
+// position |uv| * n the fp32 spacing is 2^(floor(log2(|uv| n)) - 23) texels, and SM3's 1/64-texel nudge across a
+// wall is lost once that spacing exceeds it, from |uv| * n >= 2^18 on: the cell is recomputed as the one just
+// left and the ray stalls until its cap. SM4 steps integer cells and keeps going (its error then comes only from
+// the fp32 ray itself).
+TEST(Qdm, Sm3DivergesFromSm4WhereFp32PositionsRunOut) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::None;
+  t.depth_scale = 0.05f;
+  t.max_iterations = 4096;
+  struct Case {
+    int size;
+    double offset;
+    bool diverges;
+  };
+  for (const Case& c : {Case{64, 1000.0, false}, Case{256, 1000.0, false}, Case{64, 10000.0, true},
+                        Case{1024, 100.0, false}, Case{1024, 1000.0, true}}) {
+    const Image heights = pattern(ProceduralPattern::Sine, c.size, 4);
+    TechniqueHarness sm4(heights, t), sm3(heights, t);
+    sm3.set_math(MathMode::Sm3);
+    std::vector<TechniqueRay> rs = rays(16, 3);
+    for (TechniqueRay& r : rs) r.u0 += c.offset, r.v0 += c.offset;
+    const auto a = sm4.run(rs), b = sm3.run(rs);
+    int differ = 0, sm4_capped = 0;
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      differ += a[i].hit_u != b[i].hit_u || a[i].hit_v != b[i].hit_v;
+      sm4_capped += a[i].iterations >= t.max_iterations;
+    }
+    EXPECT_EQ(sm4_capped, 0) << c.size << " at " << c.offset;
+    if (c.diverges)
+      EXPECT_GT(differ, 0) << c.size << " at " << c.offset;
+    else
+      EXPECT_EQ(differ, 0) << c.size << " at " << c.offset;
+  }
+}
+
 TEST(Qdm, LevelUpAfterCrossingsAvoidsDegeneratingIntoLinearSearch) {
   // The talk's failure case: a ray that descended next to a tall feature and then travels far over low ground
   // keeps stepping cell by cell at the fine level unless it goes up after crossings. One pillar on a floor,
