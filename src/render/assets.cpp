@@ -137,7 +137,9 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     inputs.normal = &normal;
     inputs.height = &assets.textures[std::size_t(m.height)];
     if (m.height_max >= 0) inputs.height_max = &assets.textures[std::size_t(m.height_max)];
-    if (reference_aovs || m.cone_map) {
+    const bool bilinear_patch =
+        m.technique == TechniqueKind::Qdm && material_descs[i].technique.refinement == QdmRefinement::BilinearPatch;
+    if (reference_aovs || m.cone_map || bilinear_patch) {
       // The exact reference traces the stored heights, in fp64; cone maps are baked from the same values.
       auto field = std::make_unique<HeightField>();
       const Texture& h = *inputs.height;
@@ -152,10 +154,15 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
             std::make_unique<ConeMap>(load_or_bake_cone_map(*field, m.cone_kind, default_cache_dir())));
         inputs.cones = assets.cone_maps.back().get();
       }
-      if (reference_aovs) {
-        inputs.reference = field.get();
-        assets.reference_fields.push_back(std::move(field));
+      if (bilinear_patch) {
+        // QDM walks a quadtree of the 3x3 maxima, conservative for the bilinear surface it then solves exactly.
+        assets.derived_textures.push_back(std::make_unique<Texture>(
+            make_mip_texture(bilinear_upper_bound(*field), TexelFormat::R32F, false, MipReduce::Max)));
+        inputs.height_max = assets.derived_textures.back().get();
+        inputs.surface = field.get();
       }
+      if (reference_aovs) inputs.reference = field.get();
+      if (reference_aovs || bilinear_patch) assets.reference_fields.push_back(std::move(field));
     }
     assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, material_descs[i], lights));
   }

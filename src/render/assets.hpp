@@ -23,7 +23,8 @@ struct Assets {
   std::vector<Texture> textures;                // parallel to requests
   std::vector<TextureStat> texture_stats;       // parallel to requests
   std::vector<std::unique_ptr<ShadingProgram>> programs;  // parallel to materials
-  std::vector<std::unique_ptr<HeightField>> reference_fields;  // fp64 heights for the error AOVs
+  std::vector<std::unique_ptr<HeightField>> reference_fields;  // fp64 heights (error AOVs, bilinear patches)
+  std::vector<std::unique_ptr<Texture>> derived_textures;      // bilinear-bound quadtrees
   std::vector<std::unique_ptr<ConeMap>> cone_maps;             // csm, rcsm: baked or from the cache
 
   std::vector<DrawItem> draw_items() const;     // model matrices left as identity

@@ -55,7 +55,7 @@ Int address_texel(const Int& i, int n, AddressMode mode) {
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : albedo_(*inputs.albedo), normal_(*inputs.normal), cones_(inputs.cones), reference_(inputs.reference),
+    : albedo_(*inputs.albedo), normal_(*inputs.normal), cones_(inputs.cones), reference_(inputs.reference), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
       technique_(material.technique), lighting_(material.lighting), lights_(lights) {
   if (inputs.height) height_.emplace(*inputs.height);
@@ -382,7 +382,8 @@ Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& 
     const Float t = gap_lo / (gap_lo - gap_hi);
     return xsimd::select(bracket, lo + (hi - lo) * t, xsimd::select(gap_lo <= Float(0.0f), lo, hi));
   }
-  // Binary (and, for now, the bilinear patch): bisection on the filtered surface.
+  if (technique_.refinement == QdmRefinement::BilinearPatch && surface_) return bilinear_patch(ray, ds, s_hit, iterations, active);
+  // Binary (and the bilinear patch without its fp64 surface): bisection on the filtered surface.
   const int steps = technique_.refinement == QdmRefinement::Binary ? 8 : 24;
   Mask searching = active & (gap_lo > Float(0.0f));
   hi = xsimd::select(gap_lo > Float(0.0f), hi, lo);
@@ -395,6 +396,32 @@ Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& 
     lo = xsimd::select(searching & !below, mid, lo);
   }
   return hi;
+}
+
+// The exact bilinear-patch hit: from the point where the ray reached the conservative bound, the patches are
+// walked cell by cell and solved analytically in fp64 (the reference's traversal), per lane.
+Float DisplacementProgram::bilinear_patch(const Ray& ray, const Float& ds, const Float& s_start, Float& iterations,
+                                          Mask active) const {
+  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes], s[kLanes], cells[kLanes];
+  ray.u0.store_aligned(u0);
+  ray.v0.store_aligned(v0);
+  ray.du.store_aligned(du);
+  ray.dv.store_aligned(dv);
+  ds.store_aligned(depth);
+  s_start.store_aligned(s);
+  const std::uint32_t lanes = simd::to_bits(active);
+  for (int l = 0; l < kLanes; ++l) {
+    cells[l] = 0.0f;
+    if (!((lanes >> l) & 1u)) continue;
+    const double start = s[l];
+    const SurfaceRay r{{u0[l] + double(du[l]) * start, v0[l] + double(dv[l]) * start, start}, {du[l], dv[l], 1.0}};
+    const ReferenceHit hit = intersect_reference(*surface_, depth[l], r, ReferenceSurface::Bilinear,
+                                                 std::max(1, technique_.max_iterations));
+    cells[l] = float(hit.cells_visited);
+    if (hit.hit) s[l] = float(hit.point.z);
+  }
+  iterations += Float::load_aligned(cells);
+  return Float::load_aligned(s);
 }
 
 void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, const Hit& hit, const Mask& covered,

@@ -19,6 +19,9 @@ struct DisplacementInputs {
   const Texture* height_max = nullptr;  // max-quadtree (QDM); power-of-two sizes
   const ConeMap* cones = nullptr;       // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr;  // level-0 heights in fp64, for error_texels / missed; may be null
+  // qdm with bilinear-patch refinement: the fp64 heights solved exactly, and height_max built from
+  // bilinear_upper_bound() of them (conservative for the bilinear surface).
+  const HeightField* surface = nullptr;
 };
 
 class DisplacementProgram final : public ShadingProgram {
@@ -46,6 +49,8 @@ private:
   void cone_texel(const simd::Int& x, const simd::Int& y, simd::Float& height, simd::Float& ratio) const;
   simd::Float refine(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit, simd::Float& iterations,
                      simd::Mask active) const;
+  simd::Float bilinear_patch(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_start,
+                             simd::Float& iterations, simd::Mask active) const;
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
 
@@ -53,6 +58,7 @@ private:
   std::optional<TextureView> height_, height_max_;
   const ConeMap* cones_;
   const HeightField* reference_;
+  const HeightField* surface_;
   SamplerState sampler_;
   LodMode lod_mode_;
   MathMode math_;

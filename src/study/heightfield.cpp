@@ -51,4 +51,18 @@ double surface_depth(const HeightField& field, double depth_scale, double u, dou
   return depth_scale * (1.0 - h);
 }
 
+Image bilinear_upper_bound(const HeightField& field) {
+  Image bound(field.width, field.height, 1);
+  for (int y = 0; y < field.height; ++y)
+    for (int x = 0; x < field.width; ++x) {
+      double m = 0.0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) m = std::max(m, field.at(x + dx, y + dy));
+      float f = float(m);
+      if (double(f) < m) f = std::nextafter(f, 2.0f);  // never below the bound
+      bound.at(x, y, 0) = f;
+    }
+  return bound;
+}
+
 }  // namespace qdmr

@@ -42,6 +42,30 @@ TEST(Qdm, HitsTheBoxSurfaceExactlyWithEveryLevelUpPolicy) {
   }
 }
 
+TEST(Qdm, BilinearPatchRefinementHitsTheBilinearSurfaceExactly) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::BilinearPatch;
+  t.depth_scale = 0.1f;
+  t.max_iterations = 100000;
+  for (const Field& field : fields()) {
+    const TechniqueHarness harness(field.heights, t);
+    const std::vector<TechniqueRay> rs = rays(24, 13);
+    const std::vector<TechniqueResult> results = harness.run(rs);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      const ReferenceHit ref = intersect_reference(harness.field(), t.depth_scale,
+                                                   {{rs[i].u0, rs[i].v0, 0.0}, {rs[i].du, rs[i].dv, 1.0}},
+                                                   ReferenceSurface::Bilinear);
+      ASSERT_TRUE(ref.hit);
+      worst = std::max(worst, error_texels(harness.field(), results[i], ref));
+    }
+    // Same bound as for the box surface: the patches are solved in fp64 from the fp32 ray's traversal point,
+    // so what remains is the fp32 ray (~1e-5 texel) and the fp32 hit depth.
+    EXPECT_LE(worst, 1e-3) << field.name;
+  }
+}
+
 TEST(Qdm, Sm3AgreesWithSm4OnSmallMaps) {
   // Up to 64 texels, fp32 cell positions are exact enough that the emulation finds the same cells.
   TechniqueDesc t;

@@ -127,6 +127,9 @@ public:
     // csm, rcsm: the exact cones of these heights, baked here (never through the user's cache).
     if (technique.kind == TechniqueKind::Csm || technique.kind == TechniqueKind::Rcsm)
       cones_ = bake_cone_map(field_, technique.kind == TechniqueKind::Csm ? ConeKind::Conservative : ConeKind::Relaxed);
+    // qdm with bilinear patches walks the quadtree of the 3x3 maxima, as prepare_assets builds it.
+    if (technique.refinement == QdmRefinement::BilinearPatch)
+      height_max_ = make_mip_texture(bilinear_upper_bound(field_), TexelFormat::R32F, false, MipReduce::Max);
   }
 
   const HeightField& field() const { return field_; }
@@ -139,6 +142,7 @@ public:
     inputs.height = &height_;
     inputs.height_max = &height_max_;
     if (!cones_.ratio.empty()) inputs.cones = &cones_;
+    if (material_.technique.refinement == QdmRefinement::BilinearPatch) inputs.surface = &field_;
     std::vector<TechniqueResult> results;
     for (std::size_t first = 0; first < rays.size(); first += simd::kLanes) {
       LightRig rig;

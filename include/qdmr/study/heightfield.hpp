@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace qdmr {
 
@@ -40,6 +41,11 @@ enum class ReferenceSurface {
 //   the highest (least deep) of the texels touching it counts; the exact reference uses the same rule.
 // - Bilinear: the bilinear interpolation of the four texel centres around (u, v).
 double surface_depth(const HeightField& field, double depth_scale, double u, double v, ReferenceSurface surface);
+
+// Per level-0 texel, the maximum of its 3x3 neighbourhood (address mode applied), as a 1-channel float image:
+// the bilinear surface over a texel's square interpolates only those texels, so a max-quadtree built from this
+// bound is conservative for the bilinear surface (QDM with bilinear-patch refinement traverses it).
+Image bilinear_upper_bound(const HeightField& field);
 
 struct ReferenceHit {
   bool hit = false;  // false: the ray left the [0, depth_scale] slab or exceeded max_cells without a hit
