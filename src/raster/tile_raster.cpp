@@ -136,6 +136,14 @@ private:
 
     ShadeOutput out;
     program_->shade(in, out);
+    if (out.writes_depth) {
+      const std::uint32_t late = pass & simd::to_bits(out.depth < Float::load_aligned(stored_depth));
+      counters_.pixels_depth_failed += std::popcount(pass) - std::popcount(late);
+      if (late == 0) return;
+      in.view_depth = out.view_depth;
+      write(x, y, late, out.depth, in, out);
+      return;
+    }
     write(x, y, pass, z, in, out);
   }
 

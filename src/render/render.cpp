@@ -161,10 +161,8 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     const Viewport viewport{scene.output.width, scene.output.height};
     std::vector<DrawItem> draws = assets.draw_items();
     for (std::size_t i = 0; i < draws.size(); ++i) draws[i].model = model_matrix(scene.objects[i].transform);
-    const CameraDesc& cam = scene.camera;
-    const glm::mat4 view = glm::lookAt(cam.position, cam.target, cam.up);
-    const glm::mat4 projection =
-        glm::perspective(glm::radians(cam.fov_y_deg), float(viewport.width) / float(viewport.height), cam.near, cam.far);
+    const glm::mat4 view = LightRig::view_matrix(scene.camera);
+    const glm::mat4 projection = LightRig::projection_matrix(scene.camera, scene.output);
     const GeometryResult geometry = run_geometry(draws, view, projection, viewport);
     stats.geometry_ms = ms_since(start);
     stats.triangles_in = geometry.counters.triangles_in;

@@ -424,6 +424,31 @@ Float DisplacementProgram::bilinear_patch(const Ray& ray, const Float& ds, const
   return Float::load_aligned(s);
 }
 
+// The hit in world space: the UV offset through dP/du and dP/dv (from the quad derivatives of the world
+// position and the UVs), the depth along -n scaled by sqrt(|dP/du| |dP/dv|) world units per UV unit; then its
+// window depth through the camera's view-projection.
+void DisplacementProgram::displaced_depth(const Fragments& in, const UvDerivatives& d, const TangentFrame& frame,
+                                          const Ray& ray, const Float& s, ShadeOutput& out) const {
+  const Vec3 p{in.varyings[kWorldX], in.varyings[kWorldY], in.varyings[kWorldZ]};
+  const Vec3 dpdx{simd::quad_ddx(p.x), simd::quad_ddx(p.y), simd::quad_ddx(p.z)};
+  const Vec3 dpdy{simd::quad_ddy(p.x), simd::quad_ddy(p.y), simd::quad_ddy(p.z)};
+  const Float det = d.dudx * d.dvdy - d.dudy * d.dvdx;
+  const Mask usable = xsimd::abs(det) > Float(1e-30f);
+  const Float inv = xsimd::select(usable, Float(1.0f) / det, Float(0.0f));
+  const Vec3 dpdu = scale(add(scale(dpdx, d.dvdy), scale(dpdy, Float(0.0f) - d.dvdx)), inv);
+  const Vec3 dpdv = scale(add(scale(dpdy, d.dudx), scale(dpdx, Float(0.0f) - d.dudy)), inv);
+  const Float k = xsimd::sqrt(xsimd::sqrt(dot(dpdu, dpdu)) * xsimd::sqrt(dot(dpdv, dpdv)));
+  const Vec3 hit = add(add(p, add(scale(dpdu, ray.du * s), scale(dpdv, ray.dv * s))), scale(frame.n, Float(0.0f) - s * k));
+  const glm::mat4& m = lights_.view_projection;
+  const auto row = [&](int r) {
+    return Float(m[0][r]) * hit.x + Float(m[1][r]) * hit.y + Float(m[2][r]) * hit.z + Float(m[3][r]);
+  };
+  const Float clip_z = row(2), clip_w = row(3);
+  out.depth = (clip_z / clip_w) * Float(0.5f) + Float(0.5f);
+  out.view_depth = clip_w;
+  out.writes_depth = true;
+}
+
 void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, const Hit& hit, const Mask& covered,
                                            ShadeOutput& out) const {
   alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes], s[kLanes], error[kLanes],
@@ -530,6 +555,7 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   out.hit_depth = hit.s;
   out.error_texels = out.missed = Float(0.0f);
   if (reference_ && technique_.kind != TechniqueKind::Normal) reference_errors(ray, ds, hit, in.covered, out);
+  if (technique_.write_depth) displaced_depth(in, d, frame, ray, hit.s, out);
 }
 
 }  // namespace qdmr

@@ -8,6 +8,7 @@
 #include "qdmr/study/heightfield.hpp"
 #include "shade/lighting.hpp"
 #include "shade/program.hpp"
+#include "shade/shading_math.hpp"
 #include "texture/sampler.hpp"
 
 namespace qdmr {
@@ -51,6 +52,8 @@ private:
                      simd::Mask active) const;
   simd::Float bilinear_patch(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_start,
                              simd::Float& iterations, simd::Mask active) const;
+  void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
+                       const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
 

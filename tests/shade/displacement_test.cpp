@@ -246,3 +246,47 @@ TEST(Techniques, DepthScaleZeroGivesExactlyTheNormalMappingImage) {
 
 }  // namespace
 }  // namespace qdmr::test
+
+namespace qdmr::test {
+namespace {
+
+// A red plane just below a displaced white plane: with write_depth the red plane shows where the displaced
+// surface lies deeper than it; without, the white polygon hides it everywhere.
+TEST(Techniques, WriteDepthLetsCloserGeometryShowThroughDeepParts) {
+  const nlohmann::json document = nlohmann::json::parse(R"({
+    "output": {"width": 128, "height": 128},
+    "camera": {"position": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 40, "near": 0.1, "far": 10},
+    "lights": [{"type": "ambient", "color": [1, 1, 1], "intensity": 1}],
+    "materials": {
+      "displaced": {"layers": [{"albedo": {"constant": [1, 1, 1]}, "height": {"procedural": "checker", "size": 16, "cells": 4}}],
+                    "technique": {"name": "qdm", "depth_scale": 0.2, "refinement": "none", "write_depth": true}},
+      "red": {"layers": [{"albedo": {"constant": [1, 0, 0]}}]}
+    },
+    "objects": [
+      {"mesh": {"type": "plane", "size": 2}, "material": "displaced"},
+      {"mesh": {"type": "plane", "size": 2}, "material": "red", "transform": {"translate": [0, 0, -0.1]}}
+    ]})");
+  // The plane is 2 units per UV repeat, so depth 0.2 UV is 0.4 units: low checker cells lie at 0.4 below the
+  // polygon, under the red plane at 0.1; high cells stay at the polygon, above it.
+  auto red_fraction = [&](bool write_depth) {
+    nlohmann::json doc = document;
+    doc["materials"]["displaced"]["technique"]["write_depth"] = write_depth;
+    const Frame frame = render_frame(load_scene_json(doc, "test.json", source_dir()), RenderOptions{});
+    int red = 0, covered = 0;
+    for (std::size_t i = 0; i < frame.color.size(); i += 3) {
+      const bool is_red = frame.color[i] > 0.9f && frame.color[i + 1] < 0.1f;
+      const bool is_white = frame.color[i] > 0.9f && frame.color[i + 1] > 0.9f;
+      red += is_red;
+      covered += is_red || is_white;
+    }
+    return double(red) / double(std::max(covered, 1));
+  };
+  EXPECT_EQ(red_fraction(false), 0.0);
+  const double with_depth = red_fraction(true);
+  // About half the cells are low; seen from straight above, red shows where the view ray reaches a low cell.
+  EXPECT_GT(with_depth, 0.3);
+  EXPECT_LT(with_depth, 0.7);
+}
+
+}  // namespace
+}  // namespace qdmr::test
