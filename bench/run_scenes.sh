@@ -8,8 +8,8 @@
 # CASE: plane terrain objects real_rocks grid1m (default: all; real_rocks only when ../shared/data exists).
 # grid1m is scenes/plane.json with its plane replaced by a 710x710 grid: 1,008,200 small triangles.
 # --sse also runs BUILD_DIR/qdmr-sse; --llvmpipe also runs BUILD_DIR/bench/llvmpipe/llvmpipe_bench on
-# plane and grid1m with LP_NUM_THREADS set to each thread count. For clean timings run it under the
-# build lock: flock /tmp/qdmr-build.lock bench/run_scenes.sh ...
+# plane and grid1m with LP_NUM_THREADS set to each thread count. For clean timings run it on an otherwise
+# idle machine (nothing compiling).
 set -eu
 
 root=$(cd "$(dirname "$0")/.." && pwd)
