@@ -5,6 +5,8 @@
 // the portable one reads texels with memcpy, which AddressSanitizer checks (it does not see AVX2 gathers).
 #include <gtest/gtest.h>
 
+#include "texture/sampler_test_util.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,20 +25,8 @@ namespace {
 
 using simd::Float;
 using simd::kLanes;
+using namespace test;
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-constexpr Filter kFilters[] = {Filter::Point,         Filter::Bilinear,       Filter::Trilinear,
-                               Filter::PointMipPoint, Filter::PointMipLinear, Filter::LinearMipPoint};
-constexpr AddressMode kAddressModes[] = {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror};
-constexpr SamplePrecision kPrecisions[] = {SamplePrecision::Exact, SamplePrecision::Hw8, SamplePrecision::Hw6};
-
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
 
 SamplingDesc desc_of(Filter filter, AddressMode address, SamplePrecision precision = SamplePrecision::Exact) {
   SamplingDesc d;

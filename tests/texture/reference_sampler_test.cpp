@@ -3,6 +3,8 @@
 // special values (far outside [0,1], texel boundaries, NaN, infinities).
 #include <gtest/gtest.h>
 
+#include "texture/sampler_test_util.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -20,21 +22,8 @@ namespace {
 
 using simd::Float;
 using simd::kLanes;
-using Lanes = std::array<float, kLanes>;
+using namespace test;
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-constexpr Filter kFilters[] = {Filter::Point,         Filter::Bilinear,       Filter::Trilinear,
-                               Filter::PointMipPoint, Filter::PointMipLinear, Filter::LinearMipPoint};
-constexpr AddressMode kAddressModes[] = {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror};
-constexpr SamplePrecision kPrecisions[] = {SamplePrecision::Exact, SamplePrecision::Hw8, SamplePrecision::Hw6};
-
-std::uint32_t bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
 
 Lanes lanes(const Float& f) {
   Lanes a;
