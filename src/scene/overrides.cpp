@@ -1,5 +1,7 @@
 #include "scene/overrides.hpp"
 
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "qdmr/core/error.hpp"
@@ -43,7 +45,20 @@ void apply_override(nlohmann::json& document, const SceneOverride& override_, co
   if (pointer.empty()) fail("cannot replace the whole document");
   const nlohmann::json::json_pointer parent_pointer = pointer.parent_pointer();
   const std::string parent_text = parent_pointer.empty() ? "/" : parent_pointer.to_string();
-  if (!document.contains(parent_pointer)) fail(parent_text + " does not exist");
+  // Optional blocks the file leaves out (a material's "technique", the "camera") are created as empty objects
+  // on the way, so any value can be set; validation then reports misspelt keys with suggestions. Array
+  // elements are never created, except by '-' at the end.
+  std::vector<nlohmann::json::json_pointer> ancestors;  // the parent and its ancestors, root-most first
+  for (auto p = parent_pointer; !p.empty(); p = p.parent_pointer()) ancestors.insert(ancestors.begin(), p);
+  for (const nlohmann::json::json_pointer& next : ancestors) {
+    if (document.contains(next)) continue;
+    const nlohmann::json::json_pointer above = next.parent_pointer();
+    nlohmann::json& node = document[above];
+    const std::string above_text = above.empty() ? "/" : above.to_string();
+    if (node.is_array()) fail(above_text + " has no element '" + next.back() + "'");
+    if (!node.is_object()) fail(above_text + " is a " + std::string(node.type_name()) + ", not an object or array");
+    node[next.back()] = nlohmann::json::object();
+  }
   nlohmann::json& parent = document[parent_pointer];
   const std::string& key = pointer.back();
   nlohmann::json value = parse_value(override_.value);

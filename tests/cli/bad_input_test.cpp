@@ -181,7 +181,9 @@ TEST_F(CliBadInput, UnknownAov) {
 
 TEST_F(CliBadInput, BadSetPointer) {
   expect_refused(render_args({"--set", "camera/fov_deg"}), {"--set 'camera/fov_deg': expected POINTER=VALUE"});
-  expect_refused(render_args({"--set", "/sky/color=1"}), {"scene.json: /sky/color: cannot apply --set: /sky does not exist"});
+  expect_refused(render_args({"--set", "/objects/0/mesh/type/x=1"}),
+                 {"scene.json: /objects/0/mesh/type/x: cannot apply --set: /objects/0/mesh/type is a string, not an object or array"});
+  expect_refused(render_args({"--set", "/sky/color=1"}), {"scene.json: /: unknown key 'sky'"});
 }
 
 TEST_F(CliBadInput, UnsupportedOutputType) {

@@ -70,11 +70,18 @@ TEST(SceneOverride, DashAppendsToAnArray) {
   EXPECT_EQ(load(minimal_scene(), {{"/objects/0/mesh/type", "box"}}).objects[0].mesh.kind, MeshKind::Box);
 }
 
-TEST(SceneOverride, MissingParentIsAnErrorNamingThePointer) {
-  EXPECT_EQ(load_error(minimal_scene(), {{"/camera/fov_deg", "30"}}),
-            "scene.json: /camera/fov_deg: cannot apply --set: /camera does not exist");
-  EXPECT_EQ(load_error(minimal_scene(), {{"/materials/rock/sampling/filter", "point"}}),
-            "scene.json: /materials/rock/sampling/filter: cannot apply --set: /materials/rock/sampling does not exist");
+TEST(SceneOverride, MissingOptionalBlocksAreCreated) {
+  const SceneDesc scene = load(minimal_scene(), {{"/camera/fov_deg", "30"},
+                                                  {"/materials/rock/sampling/filter", "point"},
+                                                  {"/materials/rock/technique/name", "qdm"}});
+  EXPECT_EQ(scene.camera.fov_y_deg, 30.0f);
+  EXPECT_EQ(scene.materials[0].sampling.filter, Filter::Point);
+  EXPECT_EQ(scene.materials[0].technique.kind, TechniqueKind::Qdm);
+  // What is created is validated like the file: a misspelt block is reported with a suggestion.
+  EXPECT_EQ(load_error(minimal_scene(), {{"/camra/fov_deg", "30"}}), "scene.json: /: unknown key 'camra'; did you mean 'camera'?");
+}
+
+TEST(SceneOverride, BadPointersAreErrorsNamingThePointer) {
   EXPECT_EQ(
       load_error(minimal_scene(), {{"/objects/3", "{}"}}),
       "scene.json: /objects/3: cannot apply --set: no element '3' in /objects (it has 1 elements; use '-' to append)");
