@@ -20,6 +20,23 @@ IntMask int_mask(const Mask& m) { return xsimd::to_int(xsimd::select(m, Float(1.
 Mask float_mask(const IntMask& m) { return xsimd::to_float(xsimd::select(m, Int(1), Int(0))) != Float(0.0f); }
 Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
 
+// The iteration budget of a capped SIMD loop, as a GPU wave runs it: a lane stops when it is done or when
+// its own count reaches the cap; the loop ends when no lane is left.
+struct CappedLoop {
+  Int cap;
+  Int done = Int(0);
+
+  // Drops the lanes that used up their budget and counts one more iteration for the others.
+  bool next(Mask& active) {
+    const IntMask running = int_mask(active) & (done < cap);
+    active = float_mask(running);
+    if (!xsimd::any(active)) return false;
+    done += xsimd::select(running, Int(1), Int(0));
+    return true;
+  }
+  Float iterations() const { return xsimd::to_float(done); }
+};
+
 // Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
 Float texel_step(const DisplacementProgram::Ray& ray, float width, float height) {
   const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));
@@ -156,15 +173,10 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& d
 
   Int level(top);
   Int cx = xsimd::to_int(xsimd::floor(x0)) >> top, cy = xsimd::to_int(xsimd::floor(y0)) >> top;
-  Float s(0.0f), iterations(0.0f);
-  Int done_iterations(0);
+  Float s(0.0f);
   const Int stop = xsimd::to_int(stop_level);
-  for (;;) {
-    const IntMask running = int_mask(active) & (done_iterations < cap);
-    active = float_mask(running);
-    if (!xsimd::any(active)) break;
-    iterations += count(active);
-    done_iterations += xsimd::select(running, Int(1), Int(0));
+  CappedLoop loop{cap};
+  while (loop.next(active)) {
 
     // The cell's highest point (wrap addressing: power-of-two level sizes).
     const Int size_x = simd::load_i32(quadtree.widths(), level, sampler_.fetch);
@@ -263,7 +275,7 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& d
     cx = xsimd::select(up, cx >> 1, cx);
     cy = xsimd::select(up, cy >> 1, cy);
   }
-  return {xsimd::min(s, ds), iterations};
+  return {xsimd::min(s, ds), loop.iterations()};
 }
 
 void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, Float& ratio) const {
@@ -295,16 +307,10 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
   const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
 
   Int cx = texel_ahead(x0, dx), cy = texel_ahead(y0, dy);
-  Float s(0.0f), s_prev(0.0f), iterations(0.0f);
-  Int done_iterations(0);
-  const Int cap(technique_.max_iterations);
+  Float s(0.0f), s_prev(0.0f);
   Mask search = zero != zero;  // rcsm: the last step entered the surface
-  for (;;) {
-    const IntMask running = int_mask(active) & (done_iterations < cap);
-    active = float_mask(running);
-    if (!xsimd::any(active)) break;
-    iterations += count(active);
-    done_iterations += xsimd::select(running, Int(1), Int(0));
+  CappedLoop loop{Int(technique_.max_iterations)};
+  while (loop.next(active)) {
 
     Float hp, r;
     cone_texel(cx, cy, hp, r);
@@ -350,6 +356,7 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
     s_prev = xsimd::select(stepping, s, s_prev);
     s = xsimd::select(stepping | to_top, next, s);
   }
+  Float iterations = loop.iterations();
   if (relaxed) {
     // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
     Float lo = s_prev, hi = s;
