@@ -36,6 +36,11 @@ inline Mask from_bits(std::uint32_t bits) {
   return Float::load_aligned(lanes) != Float(0.0f);
 }
 
+// Mask conversions between float and integer lanes (xsimd 8 has no batch_bool_cast), and a mask as 0/1.
+inline IntMask int_mask(const Mask& m) { return xsimd::to_int(xsimd::select(m, Float(1.0f), Float(0.0f))) != Int(0); }
+inline Mask float_mask(const IntMask& m) { return xsimd::to_float(xsimd::select(m, Int(1), Int(0))) != Float(0.0f); }
+inline Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
+
 // Coarse derivatives (what GPUs do): per quad, d/dx = top-right - top-left, d/dy = bottom-left - top-left,
 // the same value broadcast to the quad's four lanes.
 inline Float quad_ddx(const Float& v) {

@@ -258,7 +258,8 @@ TextureDesc read_texture(const Value& value, Slot slot) {
 
 LayerDesc read_layer(const Value& value) {
   const Object object(
-      value, {"albedo", "normal", "normal_convention", "normal_strength", "height", "height_scale", "height_offset"});
+      value, {"albedo", "normal", "normal_convention", "normal_strength", "height", "height_scale", "height_offset",
+              "specular"});
   LayerDesc layer;
   layer.albedo.source = TextureSource::Constant;
   if (auto v = object.find("albedo")) layer.albedo = read_texture(*v, Slot::Albedo);
@@ -276,11 +277,98 @@ LayerDesc read_layer(const Value& value) {
   if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
   if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
   if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
+  if (auto v = object.find("specular")) {
+    const Object specular(*v, {"power", "scale", "invert"});
+    layer.specular.enabled = true;
+    if (auto s = specular.find("power")) layer.specular.power = static_cast<float>(s->number_in(0.0, 64.0));
+    if (auto s = specular.find("scale")) layer.specular.scale = static_cast<float>(s->number_in(0.0, 16.0));
+    if (auto s = specular.find("invert")) layer.specular.invert = s->boolean();
+  }
   return layer;
 }
 
+ShadowDesc read_shadow(const Value& value) {
+  const Object object(value, {"mode", "strength", "max_iterations", "samples", "length", "profile", "penumbra",
+                              "tap_weights"});
+  ShadowDesc d;
+  if (auto v = object.find("mode"))
+    d.mode = v->choice<ShadowMode>({{"off", ShadowMode::Off},
+                                    {"hard", ShadowMode::Hard},
+                                    {"horizon", ShadowMode::Horizon},
+                                    {"qdm_soft", ShadowMode::QdmSoft}});
+  if (auto v = object.find("strength")) d.strength = static_cast<float>(v->number_in(1e-3, 1e6));
+  if (auto v = object.find("max_iterations")) d.max_iterations = static_cast<int>(v->integer(1, 1 << 20));
+  if (auto v = object.find("samples")) d.samples = static_cast<int>(v->integer(1, 1024));
+  if (auto v = object.find("length")) d.length = static_cast<float>(v->number_in(0.0, 1e4));
+  if (auto v = object.find("profile"))
+    d.profile = v->choice<ProfileOperator>(
+        {{"max", ProfileOperator::Max}, {"min", ProfileOperator::Min}, {"average", ProfileOperator::Average}});
+  if (auto v = object.find("penumbra")) d.penumbra = static_cast<float>(v->number_in(0.0, 1e6));
+  if (auto v = object.find("tap_weights")) {
+    const std::vector<Value> items = v->array();
+    v->require(!items.empty() && items.size() <= 16, "expected 1 to 16 weights, got " + std::to_string(items.size()));
+    d.tap_weights.clear();
+    for (const Value& item : items) d.tap_weights.push_back(static_cast<float>(item.number_in(0.0, 1e3)));
+  }
+  return d;
+}
+
+AoDesc read_ao(const Value& value) {
+  const Object object(value, {"mode", "directions", "jitter", "seed", "radius", "coarse", "strength", "resolution"});
+  AoDesc d;
+  if (auto v = object.find("mode"))
+    d.mode = v->choice<AoMode>({{"off", AoMode::Off}, {"frame", AoMode::Frame}, {"baked", AoMode::Baked}});
+  if (auto v = object.find("directions")) d.directions = static_cast<int>(v->integer(4, 16));
+  if (auto v = object.find("jitter")) d.jitter = v->boolean();
+  if (auto v = object.find("seed")) d.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
+  if (auto v = object.find("radius")) d.radius = static_cast<float>(v->number_in(1e-6, 1e3));
+  if (auto v = object.find("coarse")) d.coarse = v->boolean();
+  if (auto v = object.find("strength")) d.strength = static_cast<float>(v->number_in(0.0, 1.0));
+  if (auto v = object.find("resolution")) d.resolution = static_cast<int>(v->integer(0, limits::kMaxTextureSide));
+  return d;
+}
+
+WeightsDesc read_weights(const Value& value) {
+  const Object object(value, {"mode", "source", "scale", "resolution", "seed", "cells", "sharpness", "height", "low",
+                              "slope", "relief", "file"});
+  WeightsDesc d;
+  if (auto v = object.find("mode")) d.mode = v->choice<WeightMode>({{"vertex", WeightMode::Vertex}, {"pixel", WeightMode::Pixel}});
+  if (auto v = object.find("source"))
+    d.source = v->choice<WeightSource>(
+        {{"noise", WeightSource::Noise}, {"terrain", WeightSource::Terrain}, {"file", WeightSource::File}});
+  if (auto v = object.find("scale")) d.scale = static_cast<float>(v->number_in(1e-3, 1e5));
+  if (auto v = object.find("resolution")) d.resolution = static_cast<int>(v->integer(1, limits::kMaxTextureSide));
+  if (auto v = object.find("seed")) d.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
+  if (auto v = object.find("cells")) d.cells = static_cast<int>(v->integer(1, 4096));
+  if (auto v = object.find("sharpness")) d.sharpness = static_cast<float>(v->number_in(0.0, 64.0));
+  if (auto v = object.find("low")) d.low = static_cast<float>(v->number_in(0.0, 1.0));
+  if (auto v = object.find("slope")) d.slope = static_cast<float>(v->positive());
+  if (auto v = object.find("relief")) d.relief = static_cast<float>(v->positive());
+  if (auto v = object.find("height")) {
+    d.height = read_texture(*v, Slot::Height);
+    v->require(d.height.source == TextureSource::File || d.height.source == TextureSource::Procedural,
+               "expected a height file or a procedural height");
+  }
+  if (auto v = object.find("file")) d.file = v->existing_file();
+  if (d.source == WeightSource::Terrain && d.height.source == TextureSource::None)
+    object.value().fail("source 'terrain' needs a 'height'");
+  if (d.source == WeightSource::File && d.file.empty()) object.value().fail("source 'file' needs a 'file'");
+  return d;
+}
+
+BlendDesc read_blend(const Value& value) {
+  const Object object(value, {"operator", "width", "weights"});
+  BlendDesc d;
+  if (auto v = object.find("operator"))
+    d.op = v->choice<BlendOperator>(
+        {{"alpha", BlendOperator::Alpha}, {"height", BlendOperator::Height}, {"height_width", BlendOperator::HeightWidth}});
+  if (auto v = object.find("width")) d.width = static_cast<float>(v->number_in(1e-4, 1.0));
+  if (auto v = object.find("weights")) d.weights = read_weights(*v);
+  return d;
+}
+
 MaterialDesc read_material(const Value& value, const std::string& name) {
-  const Object object(value, {"layers", "technique", "sampling", "lighting"});
+  const Object object(value, {"layers", "technique", "sampling", "lighting", "shadow", "ao", "blend"});
   MaterialDesc material;
   material.name = name;
   const Value layers = object.required("layers");
@@ -364,12 +452,24 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
       d.math = s->choice<MathMode>({{"sm4", MathMode::Sm4}, {"sm3", MathMode::Sm3}, {"exact", MathMode::Exact}});
   }
   if (auto v = object.find("lighting")) {
-    const Object lighting(*v, {"model", "specular", "shininess"});
+    const Object lighting(*v, {"model", "specular", "shininess", "roughness"});
     if (auto l = lighting.find("model"))
-      material.lighting.model = l->choice<LightingModel>({{"blinn_phong", LightingModel::BlinnPhong}});
+      material.lighting.model = l->choice<LightingModel>(
+          {{"blinn_phong", LightingModel::BlinnPhong}, {"cook_torrance", LightingModel::CookTorrance}});
     if (auto l = lighting.find("specular")) material.lighting.specular = static_cast<float>(l->non_negative());
     if (auto l = lighting.find("shininess")) material.lighting.shininess = static_cast<float>(l->positive());
+    if (auto l = lighting.find("roughness")) material.lighting.roughness = static_cast<float>(l->number_in(0.02, 1.0));
   }
+  if (auto v = object.find("shadow")) material.shadow = read_shadow(*v);
+  if (auto v = object.find("ao")) material.ao = read_ao(*v);
+  if (auto v = object.find("blend")) material.blend = read_blend(*v);
+  const bool displaced = material.technique.kind != TechniqueKind::Normal;
+  if (material.shadow.mode != ShadowMode::Off && !displaced)
+    object.required("shadow").fail("self-shadowing needs a displacement technique (technique/name is 'normal')");
+  if (material.ao.mode != AoMode::Off && !displaced)
+    object.required("ao").fail("ambient occlusion needs a displacement technique (technique/name is 'normal')");
+  if (material.layers.size() > 1 && !object.find("blend"))
+    layers.fail("more than one layer needs a 'blend' block (operator and weights)");
   return material;
 }
 

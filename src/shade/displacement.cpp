@@ -16,9 +16,9 @@ using simd::IntMask;
 using simd::kLanes;
 using simd::Mask;
 
-IntMask int_mask(const Mask& m) { return xsimd::to_int(xsimd::select(m, Float(1.0f), Float(0.0f))) != Int(0); }
-Mask float_mask(const IntMask& m) { return xsimd::to_float(xsimd::select(m, Int(1), Int(0))) != Float(0.0f); }
-Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
+using simd::count;
+using simd::float_mask;
+using simd::int_mask;
 
 // The iteration budget of a capped SIMD loop, as a GPU wave runs it: a lane stops when it is done or when
 // its own count reaches the cap; the loop ends when no lane is left.

@@ -84,6 +84,15 @@ struct TextureDesc {
 
 enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
 
+// Specular reflectance generated from the albedo instead of stored (the talk's terrain saves the texture):
+// specular = scale * pow(invert ? 1 - luminance : luminance, power).
+struct SpecularFromAlbedo {
+  bool enabled = false;  // off: the material's lighting.specular constant
+  float power = 1.0f;
+  float scale = 0.5f;
+  bool invert = false;
+};
+
 struct LayerDesc {
   TextureDesc albedo;            // default: constant white
   TextureDesc normal;            // default: from_height when a height exists, else flat
@@ -92,6 +101,7 @@ struct LayerDesc {
   TextureDesc height;            // default: none (flat)
   float height_scale = 1.0f;     // h' = h * height_scale + height_offset
   float height_offset = 0.0f;
+  SpecularFromAlbedo specular;
 };
 
 enum class TechniqueKind { Normal, Relief, Pom, Csm, Rcsm, Qdm };
@@ -159,20 +169,85 @@ struct SamplingDesc {
   MathMode math = MathMode::Sm4;
 };
 
-enum class LightingModel { BlinnPhong };
+enum class LightingModel { BlinnPhong, CookTorrance };
 
 struct LightingDesc {
   LightingModel model = LightingModel::BlinnPhong;
-  float specular = 0.25f;    // specular reflectance scale
+  float specular = 0.25f;    // specular reflectance scale (Blinn-Phong), F0 at normal incidence (Cook-Torrance)
   float shininess = 32.0f;   // Blinn-Phong exponent
+  float roughness = 0.5f;    // Cook-Torrance: GGX roughness (alpha = roughness^2)
+};
+
+// Self-shadowing of the displaced surface towards each directional light (the talk's "Self-shadowing").
+enum class ShadowMode { Off, Hard, Horizon, QdmSoft };
+// How the horizon shadow combines the occlusion of its samples along the light direction.
+enum class ProfileOperator { Max, Min, Average };
+
+struct ShadowDesc {
+  ShadowMode mode = ShadowMode::Off;
+  float strength = 8.0f;          // horizon, qdm_soft: occluding height (in depth-scale units) for full shadow is 1/strength
+  int max_iterations = 64;        // hard: traversal cap towards the light (a capped trace counts as lit)
+  int samples = 16;               // horizon: samples along the light direction; with `length` caps the shadow length
+  float length = 0.0f;            // horizon, qdm_soft: longest shadow in UV units; 0 = until the light ray leaves the relief
+  ProfileOperator profile = ProfileOperator::Max;
+  float penumbra = 1.0f;          // horizon, qdm_soft: softening growing with the blocker's distance
+  std::vector<float> tap_weights{1.0f, 1.0f, 1.0f, 1.0f, 1.0f};  // qdm_soft: artist weight per tap, near to far
+};
+
+// Ambient occlusion of the displaced surface from horizon queries (applied to the ambient light).
+enum class AoMode { Off, Frame, Baked };
+
+struct AoDesc {
+  AoMode mode = AoMode::Off;
+  int directions = 8;       // equally spaced horizon directions, 4..16
+  bool jitter = false;      // frame: rotate the directions per pixel by a hash of (pixel, seed)
+  std::uint32_t seed = 1;
+  float radius = 0.05f;     // horizon search distance in UV units
+  bool coarse = true;       // far samples from coarser max-quadtree levels (log2 of the texels instead of all)
+  float strength = 1.0f;    // ao' = 1 - strength * (1 - ao)
+  int resolution = 0;       // baked: texture side (0 = the height map's)
+};
+
+// Height blending of up to 4 layers (the talk's "Surface Blending" / "Height Blending").
+enum class BlendOperator { Alpha, Height, HeightWidth };
+// Where blend weights come from: the vertices (interpolated, constant along each view ray), or a per-pixel
+// weight texture sampled where the ray hits.
+enum class WeightMode { Vertex, Pixel };
+enum class WeightSource { Noise, Terrain, File };
+
+struct WeightsDesc {
+  WeightMode mode = WeightMode::Pixel;
+  WeightSource source = WeightSource::Noise;
+  float scale = 1.0f;       // the weight map spans this many texture repeats (set it to the mesh's uv_scale)
+  int resolution = 256;     // pixel mode: side of the weight texture made from the map
+  // noise: one smooth noise field per layer at `cells` per side, sharpened; the strongest layer gets weight 1
+  std::uint32_t seed = 1;
+  int cells = 4;
+  float sharpness = 4.0f;
+  // terrain: from a height map (the DEM the grid is displaced by): layer 0 on slopes, 1 on flat ground,
+  // 2 below `low`, 3 where noise says so
+  TextureDesc height;
+  float low = 0.2f;         // normalised elevation below which layer 2 (sand) takes over
+  float slope = 0.6f;       // slope (height units per map width, times `relief`) where layer 0 (rock) takes over
+  float relief = 1.0f;      // vertical extent of the height map relative to its width, for slopes
+  std::filesystem::path file;  // file: RGBA image, channel i = weight of layer i (linear, not sRGB)
+};
+
+struct BlendDesc {
+  BlendOperator op = BlendOperator::Height;
+  float width = 0.2f;       // height_width: transition width in height units
+  WeightsDesc weights;
 };
 
 struct MaterialDesc {
   std::string name;
-  std::vector<LayerDesc> layers;  // 1 .. limits::kMaxLayers; this release shades layer 0
+  std::vector<LayerDesc> layers;  // 1 .. limits::kMaxLayers; more than one needs `blend`
   TechniqueDesc technique;
   SamplingDesc sampling;
   LightingDesc lighting;
+  ShadowDesc shadow;
+  AoDesc ao;
+  BlendDesc blend;          // used when there is more than one layer
 };
 
 enum class MeshKind { Plane, Box, Sphere, Grid, Obj };
