@@ -468,8 +468,6 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
     object.required("shadow").fail("self-shadowing needs a displacement technique (technique/name is 'normal')");
   if (material.ao.mode != AoMode::Off && !displaced)
     object.required("ao").fail("ambient occlusion needs a displacement technique (technique/name is 'normal')");
-  if (material.layers.size() > 1 && !object.find("blend"))
-    layers.fail("more than one layer needs a 'blend' block (operator and weights)");
   return material;
 }
 
