@@ -217,6 +217,33 @@ const char* technique_name(TechniqueKind k) {
   return "?";
 }
 
+namespace {
+
+const char* lighting_name(LightingModel m) { return m == LightingModel::CookTorrance ? "cook_torrance" : "blinn_phong"; }
+
+const char* shadow_name(ShadowMode m) {
+  switch (m) {
+    case ShadowMode::Off: return "off";
+    case ShadowMode::Hard: return "hard";
+    case ShadowMode::Horizon: return "horizon";
+    case ShadowMode::QdmSoft: return "qdm_soft";
+  }
+  return "?";
+}
+
+const char* blend_name(BlendOperator op) {
+  switch (op) {
+    case BlendOperator::Alpha: return "alpha";
+    case BlendOperator::Height: return "height";
+    case BlendOperator::HeightWidth: return "height_width";
+  }
+  return "?";
+}
+
+std::uint64_t rgba8_chain_bytes(int side) { return chain_bytes(side, side, TexelFormat::RGBA8); }
+
+}  // namespace
+
 MaterialPlan plan_material(const MaterialDesc& material, const std::string& where,
                            std::vector<TextureRequest>& textures) {
   MaterialPlan plan;
@@ -225,33 +252,83 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
   plan.sampling = material.sampling;
   plan.lighting = material.lighting;
   const TechniqueKind kind = material.technique.kind;
-  plan.program = (kind == TechniqueKind::Normal ? std::string("normal_mapping")
-                                                : std::string("displacement:") + technique_name(kind)) +
-                 " | blinn_phong | " + filter_name(material.sampling.filter);
-  const LayerDesc& layer = material.layers.at(0);
-  const std::string layer_where = where + "/layers/0";
-  plan.albedo = add_request(textures, layer.albedo, TexturePurpose::Albedo, MipReduce::Box, layer,
-                            layer_where + "/albedo", material.name);
-  plan.normal = add_request(textures, layer.normal, TexturePurpose::Normal, MipReduce::BoxNormal, layer,
-                            layer_where + "/normal", material.name);
-  if (kind == TechniqueKind::Normal) return plan;  // normal mapping pays for no height data
+  const std::size_t layer_count = material.layers.size();
+  plan.blend = layer_count > 1;
+  plan.weight_mode = material.blend.weights.mode;
+  const bool displaced = kind != TechniqueKind::Normal;
+  const bool blend_by_height = plan.blend && material.blend.op != BlendOperator::Alpha;
+  // The max-quadtree serves QDM, and self-shadowing and AO queries that read coarse levels.
+  const bool hierarchy = kind == TechniqueKind::Qdm || material.shadow.mode == ShadowMode::QdmSoft ||
+                         (material.ao.mode != AoMode::Off && material.ao.coarse);
+  plan.program = (kind == TechniqueKind::Normal && !plan.blend ? std::string("normal_mapping")
+                                                               : std::string("displacement:") + technique_name(kind));
+  if (plan.blend)
+    plan.program += std::string(" | blend ") + blend_name(material.blend.op) + " x" + std::to_string(layer_count) +
+                    (material.blend.weights.mode == WeightMode::Vertex ? " per vertex" : " per pixel");
+  if (material.shadow.mode != ShadowMode::Off) plan.program += std::string(" | shadow ") + shadow_name(material.shadow.mode);
+  if (material.ao.mode != AoMode::Off)
+    plan.program += std::string(" | ao ") + (material.ao.mode == AoMode::Baked ? "baked" : "frame");
+  plan.program += std::string(" | ") + lighting_name(material.lighting.model) + " | " + filter_name(material.sampling.filter);
 
-  if (layer.height.source == TextureSource::None)
-    throw Error(layer_where + "/height", std::string("technique '") + technique_name(kind) + "' needs a height map");
-  plan.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
-                            layer_where + "/height", material.name);
-  if (kind == TechniqueKind::Qdm) {
-    const TextureRequest& h = textures[std::size_t(plan.height)];
-    const bool pot = (h.width & (h.width - 1)) == 0 && (h.height & (h.height - 1)) == 0;
-    if (!pot)
-      throw Error(layer_where + "/height", "qdm needs a power-of-two height map, got " + std::to_string(h.width) + "x" +
-                                               std::to_string(h.height));
-    plan.height_max = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Max, layer,
-                                  layer_where + "/height", material.name);
+  if (plan.blend && (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm))
+    throw Error(where + "/technique/name", std::string("'") + technique_name(kind) +
+                                               "' needs a cone map of one height map and cannot march blended layers "
+                                               "(use relief, pom or qdm)");
+  int side_w = 0, side_h = 0;
+  for (std::size_t i = 0; i < layer_count; ++i) {
+    const LayerDesc& layer = material.layers[i];
+    const std::string layer_where = where + "/layers/" + std::to_string(i);
+    LayerPlan lp;
+    lp.albedo = add_request(textures, layer.albedo, TexturePurpose::Albedo, MipReduce::Box, layer,
+                            layer_where + "/albedo", material.name);
+    lp.normal = add_request(textures, layer.normal, TexturePurpose::Normal, MipReduce::BoxNormal, layer,
+                            layer_where + "/normal", material.name);
+    if (displaced || blend_by_height) {
+      if (layer.height.source == TextureSource::None)
+        throw Error(layer_where + "/height", displaced ? std::string("technique '") + technique_name(kind) + "' needs a height map"
+                                                       : std::string("height blending needs a height map in every layer"));
+      lp.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
+                              layer_where + "/height", material.name);
+      const TextureRequest& h = textures[std::size_t(lp.height)];
+      if (plan.blend && displaced) {
+        // Blended layers are marched as one surface on one texel grid.
+        if (i == 0) {
+          side_w = h.width;
+          side_h = h.height;
+        } else if (h.width != side_w || h.height != side_h) {
+          throw Error(layer_where + "/height", "blended layers need height maps of one size: layer 0 is " +
+                                                   std::to_string(side_w) + "x" + std::to_string(side_h) + ", this one " +
+                                                   std::to_string(h.width) + "x" + std::to_string(h.height));
+        }
+      }
+      if (displaced && hierarchy) {
+        const bool pot = (h.width & (h.width - 1)) == 0 && (h.height & (h.height - 1)) == 0;
+        if (!pot)
+          throw Error(layer_where + "/height", std::string(kind == TechniqueKind::Qdm ? "qdm" : "a max-quadtree (qdm_soft shadows, coarse AO)") +
+                                                   " needs a power-of-two height map, got " + std::to_string(h.width) +
+                                                   "x" + std::to_string(h.height));
+        lp.height_max = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Max, layer,
+                                    layer_where + "/height", material.name);
+      }
+    }
+    plan.layers.push_back(lp);
+  }
+  if (plan.blend && material.blend.weights.mode == WeightMode::Pixel) {
+    const int r = material.blend.weights.resolution;
+    if ((r & (r - 1)) != 0)
+      throw Error(where + "/blend/weights/resolution", "must be a power of two, got " + std::to_string(r));
+    plan.weight_bytes = rgba8_chain_bytes(r);
+  }
+  if (material.ao.mode == AoMode::Baked) {
+    const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
+    const int w = material.ao.resolution > 0 ? material.ao.resolution : h.width;
+    const int hh = material.ao.resolution > 0 ? material.ao.resolution : h.height;
+    plan.ao_map = true;
+    plan.ao_bytes = chain_bytes(w, hh, TexelFormat::R16);
   }
   if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm) {
     // Cones of the stored heights' level 0 (the box surface); the box-filtered chain serves the refinement.
-    const TextureRequest& h = textures[std::size_t(plan.height)];
+    const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
     plan.cone_map = true;
     plan.cone_kind = kind == TechniqueKind::Csm ? ConeKind::Conservative : ConeKind::Relaxed;
     plan.cone_bytes = std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float);
@@ -276,7 +353,10 @@ FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
     plan.materials.push_back(plan_material(material, file + ": /materials/" + material.name, plan.textures));
   }
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
-  for (const MaterialPlan& m : plan.materials) plan.cone_map_bytes += m.cone_bytes;
+  for (const MaterialPlan& m : plan.materials) {
+    plan.cone_map_bytes += m.cone_bytes;
+    plan.derived_bytes += m.weight_bytes + m.ao_bytes;
+  }
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
@@ -289,12 +369,20 @@ std::string FramePlan::describe() const {
   s << "materials (" << materials.size() << "):\n";
   for (const MaterialPlan& m : materials) {
     s << "  " << m.name << ": " << m.program << "\n";
-    s << "    albedo: texture " << m.albedo << ", normal: texture " << m.normal;
-    if (m.height >= 0) s << ", height: texture " << m.height;
-    if (m.height_max >= 0) s << ", max-quadtree: texture " << m.height_max;
+    for (std::size_t i = 0; i < m.layers.size(); ++i) {
+      const LayerPlan& l = m.layers[i];
+      s << "    layer " << i << ": albedo: texture " << l.albedo << ", normal: texture " << l.normal;
+      if (l.height >= 0) s << ", height: texture " << l.height;
+      if (l.height_max >= 0) s << ", max-quadtree: texture " << l.height_max;
+      s << "\n";
+    }
+    if (m.blend)
+      s << "    blend weights: " << (m.weight_mode == WeightMode::Vertex ? "per vertex (interpolated)"
+                                                                         : "per pixel, weight texture " + mib(m.weight_bytes))
+        << "\n";
+    if (m.ao_map) s << "    ao: baked map, " << mib(m.ao_bytes) << ", baked or from cache\n";
     if (m.cone_map)
-      s << ", cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes);
-    s << "\n";
+      s << "    cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes) << "\n";
   }
   s << "textures to build (" << textures.size() << "):\n";
   for (std::size_t i = 0; i < textures.size(); ++i) {
@@ -303,10 +391,7 @@ std::string FramePlan::describe() const {
       << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
       << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
   }
-  const bool quadtree = std::any_of(materials.begin(), materials.end(), [](const MaterialPlan& m) { return m.height_max >= 0; });
-  s << "derived data: " << (quadtree ? "max-quadtree (above); " : "")
-    << (cone_map_bytes > 0 ? "cone maps (above), " + mib(cone_map_bytes) + "; no AO or blend maps\n"
-                           : std::string("no cone map, AO or blend maps\n"));
+  s << "derived data: cone maps " << mib(cone_map_bytes) << ", blend weight and AO maps " << mib(derived_bytes) << "\n";
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes)
     s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles"
@@ -316,7 +401,8 @@ std::string FramePlan::describe() const {
   for (Aov a : aovs) s << " " << aov_name(a);
   s << "\n";
   s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
-    << (cone_map_bytes > 0 ? ", cone maps " + mib(cone_map_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
+    << (cone_map_bytes > 0 ? ", cone maps " + mib(cone_map_bytes) : std::string())
+    << (derived_bytes > 0 ? ", weight/AO maps " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
     << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
@@ -325,11 +411,14 @@ nlohmann::json FramePlan::to_json() const {
   nlohmann::json j;
   j["width"] = width;
   j["height"] = height;
-  for (const MaterialPlan& m : materials)
-    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"albedo", m.albedo}, {"normal", m.normal},
-                              {"height", m.height}, {"height_max", m.height_max},
+  for (const MaterialPlan& m : materials) {
+    nlohmann::json layers = nlohmann::json::array();
+    for (const LayerPlan& l : m.layers)
+      layers.push_back({{"albedo", l.albedo}, {"normal", l.normal}, {"height", l.height}, {"height_max", l.height_max}});
+    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"layers", layers},
                               {"cone_map", m.cone_map ? nlohmann::json(cone_kind_name(m.cone_kind)) : nlohmann::json()},
-                              {"cone_bytes", m.cone_bytes}});
+                              {"cone_bytes", m.cone_bytes}, {"weight_bytes", m.weight_bytes}, {"ao_bytes", m.ao_bytes}});
+  }
   for (const TextureRequest& t : textures)
     j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                              {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
@@ -340,7 +429,7 @@ nlohmann::json FramePlan::to_json() const {
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
-                 {"cone_map_bytes", cone_map_bytes}, {"total_bytes", total_bytes()}};
+                 {"cone_map_bytes", cone_map_bytes}, {"derived_bytes", derived_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

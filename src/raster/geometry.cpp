@@ -136,8 +136,9 @@ ItemVertices transform_vertices(const DrawItem& item, const glm::mat4& view_proj
       const glm::vec3 t = glm::normalize(linear * glm::vec3(t4));
       ClipVertex& v = out.clip[i];
       v.clip = view_projection * world;
+      const glm::vec4 w = mesh.blend_weights.empty() ? glm::vec4(0.0f) : mesh.blend_weights[i];
       v.varyings = {world.x, world.y, world.z, nrm.x, nrm.y, nrm.z, t.x, t.y, t.z, mirrored ? -t4.w : t4.w,
-                    mesh.uvs[i].x, mesh.uvs[i].y};
+                    mesh.uvs[i].x, mesh.uvs[i].y, w.x, w.y, w.z, w.w};
       out.frustum_code[i] = outcode(v.clip, 1.0f, 1.0f);
       out.band_code[i] = outcode(v.clip, projection.gx(), projection.gy());
       if (out.band_code[i] == 0) out.projected[i] = projection.project(v);

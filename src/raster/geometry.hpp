@@ -13,9 +13,11 @@
 
 namespace qdmr {
 
-// Per-vertex values interpolated across triangles, in this order.
+// Per-vertex values interpolated across triangles, in this order. Programs say how many they read: the
+// blend weights are interpolated only for programs that blend layers per vertex.
 enum Varying : int { kWorldX, kWorldY, kWorldZ, kNormalX, kNormalY, kNormalZ, kTangentX, kTangentY, kTangentZ, kTangentW, kU, kV,
-                     kVaryingCount };
+                     kWeight0, kWeight1, kWeight2, kWeight3, kVaryingCount };
+inline constexpr int kBaseVaryingCount = kWeight0;  // everything but the blend weights
 
 struct ClipVertex {
   glm::vec4 clip;  // homogeneous clip-space position (GL convention: -w <= z <= w)

@@ -128,7 +128,7 @@ private:
     }
     in.pixel_x = Float::load_aligned(px);
     in.pixel_y = Float::load_aligned(py);
-    for (int k = 0; k < kVaryingCount; ++k)
+    for (int k = 0; k < program_->varying_count(); ++k)
       in.varyings[k] = b0 * Float(vertex_[0]->varyings[k]) + b1 * Float(vertex_[1]->varyings[k]) +
                        b2 * Float(vertex_[2]->varyings[k]);
     in.view_depth = Float(float(s.area2)) * inv_sum;

@@ -4,6 +4,7 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/height_texture.hpp"
+#include "texture/blend_weights.hpp"
 #include "shade/displacement.hpp"
 #include "shade/normal_mapping.hpp"
 
@@ -126,23 +127,35 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
                                           [](Aov a) { return a == Aov::ErrorTexels || a == Aov::Missed; });
   for (std::size_t i = 0; i < assets.materials.size(); ++i) {
     const MaterialPlan& m = assets.materials[i];
-    const Texture& albedo = assets.textures[std::size_t(m.albedo)];
-    const Texture& normal = assets.textures[std::size_t(m.normal)];
-    if (m.technique == TechniqueKind::Normal) {
-      assets.programs.push_back(std::make_unique<NormalMappingProgram>(albedo, normal, m.sampling, m.lighting, lights));
+    const MaterialDesc& desc = material_descs[i];
+    const auto texture = [&](int index) { return index >= 0 ? &assets.textures[std::size_t(index)] : nullptr; };
+    if (m.technique == TechniqueKind::Normal && !m.blend) {
+      assets.programs.push_back(std::make_unique<NormalMappingProgram>(
+          *texture(m.layers[0].albedo), *texture(m.layers[0].normal), m.sampling, m.lighting, lights));
       continue;
     }
     DisplacementInputs inputs;
-    inputs.albedo = &albedo;
-    inputs.normal = &normal;
-    inputs.height = &assets.textures[std::size_t(m.height)];
-    if (m.height_max >= 0) inputs.height_max = &assets.textures[std::size_t(m.height_max)];
+    for (const LayerPlan& l : m.layers)
+      inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max)});
+    if (m.blend) {
+      const Image map = make_weight_map(desc.blend.weights, int(desc.layers.size()), file + ": /materials/" + desc.name + "/blend/weights");
+      if (m.weight_mode == WeightMode::Pixel) {
+        assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(map, desc.blend.weights.resolution)));
+        inputs.weights = assets.derived_textures.back().get();
+      } else {
+        for (std::size_t k = 0; k < objects; ++k)
+          if (assets.object_material[k] == i && !scene.objects[k].material.empty())
+            assets.meshes[k].blend_weights = vertex_weights(map, assets.meshes[k].uvs, desc.blend.weights.scale);
+      }
+    }
     const bool bilinear_patch =
-        m.technique == TechniqueKind::Qdm && material_descs[i].technique.refinement == QdmRefinement::BilinearPatch;
-    if (reference_aovs || m.cone_map || bilinear_patch) {
+        m.technique == TechniqueKind::Qdm && desc.technique.refinement == QdmRefinement::BilinearPatch && !m.blend;
+    // The exact reference of a blend needs the combined surface; it is traced for single layers only.
+    const bool reference = reference_aovs && !m.blend && m.technique != TechniqueKind::Normal;
+    if (reference || m.cone_map || bilinear_patch) {
       // The exact reference traces the stored heights, in fp64; cone maps are baked from the same values.
       auto field = std::make_unique<HeightField>();
-      const Texture& h = *inputs.height;
+      const Texture& h = *inputs.layers[0].height;
       field->width = h.width();
       field->height = h.height();
       field->address = m.sampling.address;
@@ -158,13 +171,13 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         // QDM walks a quadtree of the 3x3 maxima, conservative for the bilinear surface it then solves exactly.
         assets.derived_textures.push_back(std::make_unique<Texture>(
             make_mip_texture(bilinear_upper_bound(*field), TexelFormat::R32F, false, MipReduce::Max)));
-        inputs.height_max = assets.derived_textures.back().get();
+        inputs.layers[0].height_max = assets.derived_textures.back().get();
         inputs.surface = field.get();
       }
-      if (reference_aovs) inputs.reference = field.get();
-      if (reference_aovs || bilinear_patch) assets.reference_fields.push_back(std::move(field));
+      if (reference) inputs.reference = field.get();
+      if (reference || bilinear_patch) assets.reference_fields.push_back(std::move(field));
     }
-    assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, material_descs[i], lights));
+    assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, desc, lights));
   }
   return assets;
 }

@@ -340,7 +340,7 @@ WeightsDesc read_weights(const Value& value) {
   if (auto v = object.find("resolution")) d.resolution = static_cast<int>(v->integer(1, limits::kMaxTextureSide));
   if (auto v = object.find("seed")) d.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
   if (auto v = object.find("cells")) d.cells = static_cast<int>(v->integer(1, 4096));
-  if (auto v = object.find("sharpness")) d.sharpness = static_cast<float>(v->number_in(0.0, 64.0));
+  if (auto v = object.find("sharpness")) d.sharpness = static_cast<int>(v->integer(1, 32));
   if (auto v = object.find("low")) d.low = static_cast<float>(v->number_in(0.0, 1.0));
   if (auto v = object.find("slope")) d.slope = static_cast<float>(v->positive());
   if (auto v = object.find("relief")) d.relief = static_cast<float>(v->positive());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/study/reference.hpp"
@@ -72,35 +73,43 @@ Int address_texel(const Int& i, int n, AddressMode mode) {
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : albedo_(*inputs.albedo), normal_(*inputs.normal), cones_(inputs.cones), reference_(inputs.reference), surface_(inputs.surface),
+    : ShadingProgram(inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
+                         ? kWeight0 + int(inputs.layers.size())
+                         : kBaseVaryingCount),
+      cones_(inputs.cones), reference_(inputs.reference), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
-      technique_(material.technique), lighting_(material.lighting), lights_(lights) {
-  if (inputs.height) height_.emplace(*inputs.height);
-  if (inputs.height_max) height_max_.emplace(*inputs.height_max);
-  if (cones_ && (!inputs.height || cones_->width != inputs.height->width() || cones_->height != inputs.height->height()))
+      technique_(material.technique), lighting_(material.lighting), blend_(material.blend), lights_(lights) {
+  if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
+    throw Error("displacement program", "needs 1 to 4 layers");
+  for (const LayerInputs& l : inputs.layers) {
+    Layer layer{TextureView(*l.albedo), TextureView(*l.normal), std::nullopt, std::nullopt};
+    if (l.height) layer.height.emplace(*l.height);
+    if (l.height_max) layer.height_max.emplace(*l.height_max);
+    layers_.push_back(std::move(layer));
+  }
+  if (inputs.weights) weights_.emplace(*inputs.weights);
+  if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
+    throw Error("displacement program", "per-pixel blending needs a weight texture");
+  const Texture* height0 = inputs.layers[0].height;
+  if (cones_ && (!height0 || cones_->width != height0->width() || cones_->height != height0->height()))
     throw Error("cone map", "needs the height map it was baked from (same level-0 size)");
 }
 
-// Heights as the technique fetches them: the nearest or bilinear level-0 texel (the surfaces the exact
-// reference knows), or trilinear with the pixel's LOD (the talk's POM), which smooths heights with distance.
-Float DisplacementProgram::height_at(const Float& u, const Float& v, const Float& lod) const {
-  SamplerState state = sampler_;
-  if (technique_.height_fetch != HeightFetch::Trilinear)
-    state.filter = technique_.height_fetch == HeightFetch::Point ? Filter::Point : Filter::Bilinear;
-  Float h[4];
-  sample(*height_, state, u, v, lod, h);
-  return h[0];
+SingleLayerSurface DisplacementProgram::layer_surface(int i) const {
+  const Layer& l = layers_[std::size_t(i)];
+  return SingleLayerSurface(*l.height, l.height_max ? &*l.height_max : nullptr, sampler_, technique_.height_fetch);
 }
 
 // Relief mapping (Policarpo 2005): fixed linear steps from the top, then a binary search in the last step.
-DisplacementProgram::Hit DisplacementProgram::relief(const Ray& ray, const Float& ds, const Float& lod,
-                                                    Mask active) const {
+template <class Surface>
+DisplacementProgram::Hit DisplacementProgram::relief(const Surface& surface, const Ray& ray, const Float& ds,
+                                                    const Float& lod, Mask active) const {
   const int steps = technique_.linear_steps;
   const Float step = ds / Float(float(steps));
   Float lo(0.0f), hi = ds, iterations(0.0f);
   for (int i = 0; i <= steps && xsimd::any(active); ++i) {
     const Float s = step * Float(float(i));
-    const Float h = height_at(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
+    const Float h = surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
     const Mask found = active & (s >= ds * (Float(1.0f) - h));
     iterations += count(active);
     hi = xsimd::select(found, s, hi);
@@ -111,7 +120,7 @@ DisplacementProgram::Hit DisplacementProgram::relief(const Ray& ray, const Float
   Mask searching = lo < hi;
   for (int i = 0; i < technique_.binary_steps && xsimd::any(searching); ++i) {
     const Float mid = (lo + hi) * Float(0.5f);
-    const Float h = height_at(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
+    const Float h = surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
     const Mask below = mid >= ds * (Float(1.0f) - h);
     iterations += count(searching);
     hi = xsimd::select(searching & below, mid, hi);
@@ -122,8 +131,9 @@ DisplacementProgram::Hit DisplacementProgram::relief(const Ray& ray, const Float
 
 // Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
 // the ray with the line through the last two height samples.
-DisplacementProgram::Hit DisplacementProgram::pom(const Ray& ray, const Float& ds, const Float& lod,
-                                                 const Float& cos_view, Mask active) const {
+template <class Surface>
+DisplacementProgram::Hit DisplacementProgram::pom(const Surface& surface, const Ray& ray, const Float& ds,
+                                                 const Float& lod, const Float& cos_view, Mask active) const {
   const Float lerp = xsimd::min(xsimd::max(cos_view, Float(0.0f)), Float(1.0f));
   const Float n = xsimd::floor(Float(float(technique_.max_steps)) +
                                (Float(float(technique_.min_steps)) - Float(float(technique_.max_steps))) * lerp +
@@ -132,7 +142,7 @@ DisplacementProgram::Hit DisplacementProgram::pom(const Ray& ray, const Float& d
   Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
   // gap = surface depth - ray depth: > 0 while the ray is above the surface.
   {
-    const Float gap0 = ds * (Float(1.0f) - height_at(ray.u0, ray.v0, lod));
+    const Float gap0 = ds * (Float(1.0f) - surface.height(ray.u0, ray.v0, lod));
     iterations += count(active);
     const Mask at_top = active & (gap0 <= Float(0.0f));
     s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
@@ -143,7 +153,7 @@ DisplacementProgram::Hit DisplacementProgram::pom(const Ray& ray, const Float& d
     const Float fi = Float(static_cast<float>(i));
     const Mask in_range = active & (fi <= n);
     const Float s = step * fi;
-    const Float gap = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
+    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
     iterations += count(in_range);
     const Mask found = in_range & (gap <= Float(0.0f));
     const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
@@ -159,11 +169,11 @@ DisplacementProgram::Hit DisplacementProgram::pom(const Ray& ray, const Float& d
 // the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
 // level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped
 // exactly across walls, or recomputed from the fp32 position (SM3 emulation).
-DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& ds, const Float& stop_level,
-                                                 const Int& cap, Mask active) const {
-  const TextureView& quadtree = *height_max_;
-  const int top = quadtree.levels() - 1;
-  const float width = float(quadtree.texture().width()), height = float(quadtree.texture().height());
+template <class Surface>
+DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const Ray& ray, const Float& ds,
+                                                 const Float& stop_level, const Int& cap, Mask active) const {
+  const int top = surface.top_level();
+  const float width = float(surface.width()), height = float(surface.height());
   const bool sm3 = math_ == MathMode::Sm3;
   const IntMask none = Int(0) != Int(0);
   const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
@@ -178,26 +188,11 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Ray& ray, const Float& d
   CappedLoop loop{cap};
   while (loop.next(active)) {
 
-    // The cell's highest point (wrap addressing: power-of-two level sizes).
-    const Int size_x = simd::load_i32(quadtree.widths(), level, sampler_.fetch);
-    const Int size_y = simd::load_i32(quadtree.heights(), level, sampler_.fetch);
-    Float hmax;
-    if (technique_.height_fetch != HeightFetch::Trilinear) {
-      Float texel[4];
-      load(quadtree, level, cx & (size_x - Int(1)), cy & (size_y - Int(1)), sampler_.fetch, texel);
-      hmax = texel[0];
-    } else {
-      // LinearMipMapLinear at the ray's position on this level: smooths the maxima, so it can miss features.
-      SamplerState trilinear = sampler_;
-      trilinear.filter = Filter::Trilinear;
-      trilinear.address = AddressMode::Wrap;
-      trilinear.lod_bias = 0.0f;
-      trilinear.min_lod = 0.0f;
-      trilinear.max_lod = 16.0f;
-      Float texel[4];
-      sample(quadtree, trilinear, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level), texel);
-      hmax = texel[0];
-    }
+    // The cell's highest point (wrap addressing: power-of-two level sizes), or LinearMipMapLinear at the ray's
+    // position on this level, which smooths the maxima and so can miss features.
+    const Float hmax = technique_.height_fetch != HeightFetch::Trilinear
+                           ? surface.cell_max(level, cx, cy)
+                           : surface.cell_max_filtered(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level));
     const Float top_depth = ds * (Float(1.0f) - hmax);
     const Mask below = active & (s >= top_depth);
     const IntMask at_stop = level <= stop;
@@ -282,7 +277,7 @@ void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, 
   const Int ax = address_texel(x, cones_->width, sampler_.address);
   const Int ay = address_texel(y, cones_->height, sampler_.address);
   Float texel[4];
-  load(*height_, Int(0), ax, ay, sampler_.fetch, texel);
+  load(*layers_[0].height, Int(0), ax, ay, sampler_.fetch, texel);
   height = texel[0];
   ratio = simd::load_f32(cones_->ratio.data(), ay * Int(cones_->width) + ax, sampler_.fetch);
 }
@@ -375,14 +370,15 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
 }
 
 // Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
-Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
-                                  Mask active) const {
+template <class Surface>
+Float DisplacementProgram::refine(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit,
+                                  Float& iterations, Mask active) const {
   if (technique_.refinement == QdmRefinement::None) return s_hit;
   const Float lod0(0.0f);
-  const Float step = texel_step(ray, float(height_->texture().width()), float(height_->texture().height()));
+  const Float step = texel_step(ray, float(surface.width()), float(surface.height()));
   Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
-  const Float gap_lo = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * lo, ray.v0 + ray.dv * lo, lod0)) - lo;
-  const Float gap_hi = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * hi, ray.v0 + ray.dv * hi, lod0)) - hi;
+  const Float gap_lo = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * lo, ray.v0 + ray.dv * lo, lod0)) - lo;
+  const Float gap_hi = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * hi, ray.v0 + ray.dv * hi, lod0)) - hi;
   iterations += count(active) * Float(2.0f);
   if (technique_.refinement == QdmRefinement::Linear) {
     const Mask bracket = active & (gap_lo > Float(0.0f)) & (gap_hi <= Float(0.0f));
@@ -396,7 +392,7 @@ Float DisplacementProgram::refine(const Ray& ray, const Float& ds, const Float& 
   hi = xsimd::select(gap_lo > Float(0.0f), hi, lo);
   for (int i = 0; i < steps && xsimd::any(searching); ++i) {
     const Float mid = (lo + hi) * Float(0.5f);
-    const Float gap = ds * (Float(1.0f) - height_at(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
+    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
     iterations += count(searching);
     const Mask below = gap <= Float(0.0f);
     hi = xsimd::select(searching & below, mid, hi);
@@ -487,72 +483,132 @@ void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, cons
   out.missed = Float::load_aligned(missed);
 }
 
-void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
-  const Float& u = in.varyings[kU];
-  const Float& v = in.varyings[kV];
-  const UvDerivatives d = UvDerivatives::from(u, v, lod_mode_);
-  const TangentFrame frame = TangentFrame::from(in);
-  const Vec3 view = view_vector(in, lights_);
-  const Vec3 view_tangent = frame.to_tangent(view);
+struct DisplacementProgram::Setup {
+  UvDerivatives d;
+  TangentFrame frame;
+  Vec3 view, view_tangent;
+  Float ds;  // depth scale after the distance fade
+  Ray ray;
+  Mask active;  // the covered lanes (helper lanes are not traced)
+};
 
-  // Depth scale, faded with camera distance when asked; the ray leaves the polygon along -view.
-  Float ds(technique_.depth_scale);
-  if (technique_.fade_end > 0.0f) {
-    const Float range(std::max(technique_.fade_end - technique_.fade_start, 1e-6f));
-    const Float fade = xsimd::min(xsimd::max((in.view_depth - Float(technique_.fade_start)) / range, Float(0.0f)), Float(1.0f));
-    ds = ds * (Float(1.0f) - fade);
-  }
-  const Float vz = xsimd::max(view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
-  const Ray ray{u, v, (Float(0.0f) - view_tangent.x) / vz, (Float(0.0f) - view_tangent.y) / vz};
-  const Mask active = in.covered;
-
+template <class Surface>
+DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup, Float& ds) const {
+  const UvDerivatives& d = setup.d;
+  const Ray& ray = setup.ray;
+  const TextureView& height0 = *layers_[0].height;
+  const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f)};
   switch (technique_.kind) {
     case TechniqueKind::Normal: break;
     case TechniqueKind::Relief:
-      hit = relief(ray, ds, lod_from_derivatives(*height_, d.dudx, d.dvdx, d.dudy, d.dvdy), active);
+      hit = relief(surface, ray, ds, lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy), active);
       break;
     case TechniqueKind::Pom: {
-      const Float lod = lod_from_derivatives(*height_, d.dudx, d.dvdx, d.dudy, d.dvdy);
+      const Float lod = lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy);
       // Far away (high LOD) POM fades to normal mapping.
       const Float fade = xsimd::min(
           xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
           Float(1.0f));
-      const Float pom_ds = ds * (Float(1.0f) - fade);
-      hit = pom(ray, pom_ds, lod, view_tangent.z, active);
-      ds = pom_ds;
+      ds = ds * (Float(1.0f) - fade);
+      hit = pom(surface, ray, ds, lod, setup.view_tangent.z, active);
       break;
     }
     case TechniqueKind::Csm:
     case TechniqueKind::Rcsm:
       hit = cone_step(ray, ds, active);
-      hit.s = refine(ray, ds, hit.s, hit.iterations, active);
+      hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
       break;
     case TechniqueKind::Qdm: {
       Float stop(0.0f);
       if (technique_.lod_stop)
-        stop = xsimd::max(xsimd::floor(lod_from_derivatives(*height_max_, d.dudx, d.dvdx, d.dudy, d.dvdy)), Float(0.0f));
+        stop = xsimd::max(xsimd::floor(lod_from_derivatives(*layers_[0].height_max, d.dudx, d.dvdx, d.dudy, d.dvdy)),
+                          Float(0.0f));
       Int cap(technique_.max_iterations);
       if (technique_.min_iterations > 0) {
-        const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(view_tangent.z, Float(0.0f)), Float(1.0f));
+        const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
         cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
                             Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
       }
-      hit = qdm(ray, ds, stop, cap, active);
-      hit.s = refine(ray, ds, hit.s, hit.iterations, active);
+      hit = qdm(surface, ray, ds, stop, cap, active);
+      hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
       break;
     }
   }
+  return hit;
+}
+
+namespace {
+
+// Albedo and tangent-space normal (unnormalised) of one layer at the hit.
+void layer_colour(const TextureView& albedo_view, const TextureView& normal_view, const SamplerState& sampler,
+                  const UvDerivatives& d, const Float& u, const Float& v, Float* albedo, Float* normal) {
+  sample(albedo_view, sampler, u, v, lod_from_derivatives(albedo_view, d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+  Float n[4];
+  sample(normal_view, sampler, u, v, lod_from_derivatives(normal_view, d.dudx, d.dvdx, d.dudy, d.dvdy), n);
+  for (int c = 0; c < 3; ++c) normal[c] = n[c] * Float(2.0f) - Float(1.0f);
+}
+
+// The colour blend factors of the layers at one point (they sum to 1 where any layer has weight):
+//   alpha:        w_i / sum(w)
+//   height:       the talk's operator, w_i h_i / sum(w h), with heights floored at 1/256 so that all-zero
+//                 heights still blend by weight instead of dividing by the talk's epsilon
+//   height_width: the widely used transition-width form: b_i = max(h_i + w_i - (max_j(h_j + w_j) - width), 0)
+//                 over layers with weight, normalised
+void blend_factors(BlendOperator op, float width, int count, const Float* h, const Float* w, Float* f) {
+  const Float zero(0.0f);
+  Float sum(0.0f);
+  if (op == BlendOperator::Alpha) {
+    for (int i = 0; i < count; ++i) f[i] = w[i];
+  } else if (op == BlendOperator::Height) {
+    for (int i = 0; i < count; ++i) f[i] = w[i] * xsimd::max(h[i], Float(1.0f / 256.0f));
+  } else {
+    Float top(-1.0f);
+    for (int i = 0; i < count; ++i) top = xsimd::max(top, xsimd::select(w[i] > zero, h[i] + w[i], Float(-1.0f)));
+    const Float floor_level = top - Float(width);
+    for (int i = 0; i < count; ++i) f[i] = xsimd::select(w[i] > zero, xsimd::max(h[i] + w[i] - floor_level, zero), zero);
+  }
+  for (int i = 0; i < count; ++i) sum += f[i];
+  const Float inv = xsimd::select(sum > zero, Float(1.0f) / sum, zero);
+  for (int i = 0; i < count; ++i) f[i] = f[i] * inv;
+}
+
+}  // namespace
+
+template <class Surface>
+void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup, const Surface& surface,
+                                        ShadeOutput& out) const {
+  const UvDerivatives& d = setup.d;
+  const Ray& ray = setup.ray;
+  Float ds = setup.ds;
+  const Hit hit = trace(surface, setup, ds);
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
-  Float albedo[4];
-  sample(albedo_, sampler_, hu, hv, lod_from_derivatives(albedo_, d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
-  Float tangent_normal[4];
-  sample(normal_, sampler_, hu, hv, lod_from_derivatives(normal_, d.dudx, d.dvdx, d.dudy, d.dvdy), tangent_normal);
-  const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),
-                                                        tangent_normal[1] * Float(2.0f) - Float(1.0f),
-                                                        tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
-  blinn_phong(shading_normal, frame.n, view, albedo, lighting_, lights_, out.color);
+  Float albedo[4], tangent_normal[3];
+  if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
+    layer_colour(layers_[0].albedo, layers_[0].normal, sampler_, d, hu, hv, albedo, tangent_normal);
+  } else {
+    const int count = surface.layer_count();
+    Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
+    if (blend_.op != BlendOperator::Alpha) {
+      const Float lod = lod_from_derivatives(*layers_[0].height, d.dudx, d.dvdx, d.dudy, d.dvdy);
+      for (int i = 0; i < count; ++i) h[i] = surface.layer(i).height(hu, hv, lod);
+    }
+    surface.weights_at(hu, hv, w);
+    blend_factors(blend_.op, blend_.width, count, h, w, f);
+    for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
+    for (int c = 0; c < 3; ++c) tangent_normal[c] = Float(0.0f);
+    for (int i = 0; i < count; ++i) {
+      if (!xsimd::any(f[i] > Float(0.0f))) continue;  // a layer absent from the whole batch costs no fetch
+      Float a[4], n[3];
+      layer_colour(layers_[std::size_t(i)].albedo, layers_[std::size_t(i)].normal, sampler_, d, hu, hv, a, n);
+      for (int c = 0; c < 4; ++c) albedo[c] += f[i] * a[c];
+      for (int c = 0; c < 3; ++c) tangent_normal[c] += f[i] * n[c];
+    }
+  }
+  const TangentFrame& frame = setup.frame;
+  const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0], tangent_normal[1], tangent_normal[2]}));
+  blinn_phong(shading_normal, frame.n, setup.view, albedo, lighting_, lights_, out.color);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
@@ -563,6 +619,49 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   out.error_texels = out.missed = Float(0.0f);
   if (reference_ && technique_.kind != TechniqueKind::Normal) reference_errors(ray, ds, hit, in.covered, out);
   if (technique_.write_depth) displaced_depth(in, d, frame, ray, hit.s, out);
+}
+
+void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
+  const Float& u = in.varyings[kU];
+  const Float& v = in.varyings[kV];
+  Setup setup;
+  setup.d = UvDerivatives::from(u, v, lod_mode_);
+  setup.frame = TangentFrame::from(in);
+  setup.view = view_vector(in, lights_);
+  setup.view_tangent = setup.frame.to_tangent(setup.view);
+
+  // Depth scale, faded with camera distance when asked; the ray leaves the polygon along -view.
+  setup.ds = Float(technique_.depth_scale);
+  if (technique_.fade_end > 0.0f) {
+    const Float range(std::max(technique_.fade_end - technique_.fade_start, 1e-6f));
+    const Float fade = xsimd::min(xsimd::max((in.view_depth - Float(technique_.fade_start)) / range, Float(0.0f)), Float(1.0f));
+    setup.ds = setup.ds * (Float(1.0f) - fade);
+  }
+  const Float vz = xsimd::max(setup.view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
+  setup.ray = Ray{u, v, (Float(0.0f) - setup.view_tangent.x) / vz, (Float(0.0f) - setup.view_tangent.y) / vz};
+  setup.active = in.covered;
+
+  const int count = int(layers_.size());
+  if (count == 1) {
+    shade_surface(in, setup, layer_surface(0), out);
+    return;
+  }
+  const SingleLayerSurface surfaces[BlendedSurface::kMaxLayers] = {
+      layer_surface(0), layer_surface(1), layer_surface(std::min(2, count - 1)), layer_surface(std::min(3, count - 1))};
+  if (blend_.weights.mode == WeightMode::Vertex) {
+    const Float w[BlendedSurface::kMaxLayers] = {in.varyings[kWeight0], in.varyings[kWeight1],
+                                                 count > 2 ? in.varyings[kWeight2] : Float(0.0f),
+                                                 count > 3 ? in.varyings[kWeight3] : Float(0.0f)};
+    shade_surface(in, setup, BlendedSurface(surfaces, count, blend_.op, w), out);
+    return;
+  }
+  // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
+  const Ray& ray = setup.ray;
+  const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
+  const BlendedSurface surface(surfaces, count, blend_.op, WeightTexture{&*weights_, blend_.weights.scale},
+                               xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
+                               xsimd::max(ray.v0, v1));
+  shade_surface(in, setup, surface, out);
 }
 
 }  // namespace qdmr

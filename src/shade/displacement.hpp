@@ -1,11 +1,15 @@
 #pragma once
 // Per-pixel displacement: a view ray in tangent space traced through the height field by one of the talk's
 // techniques (relief, POM, QDM; CSM/RCSM with a cone map), then the surface shaded at the hit as in normal
-// mapping. Optionally the exact fp64 reference is traced too, for the error AOVs.
+// mapping. Up to four layers are blended into one surface (blended_surface.hpp) and their colours by the
+// material's blend operator. Optionally the exact fp64 reference is traced too, for the error AOVs.
 #include <optional>
+#include <vector>
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/study/heightfield.hpp"
+#include "shade/blended_surface.hpp"
+#include "shade/height_surface.hpp"
 #include "shade/lighting.hpp"
 #include "shade/program.hpp"
 #include "shade/shading_math.hpp"
@@ -13,13 +17,18 @@
 
 namespace qdmr {
 
-struct DisplacementInputs {
+struct LayerInputs {
   const Texture* albedo = nullptr;      // RGBA8 sRGB
   const Texture* normal = nullptr;      // RGBA8, 0.5 + 0.5 n
-  const Texture* height = nullptr;      // box-filtered heights (relief, POM, refinement)
-  const Texture* height_max = nullptr;  // max-quadtree (QDM); power-of-two sizes
-  const ConeMap* cones = nullptr;       // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
-  const HeightField* reference = nullptr;  // level-0 heights in fp64, for error_texels / missed; may be null
+  const Texture* height = nullptr;      // box-filtered heights (techniques, height blending)
+  const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
+};
+
+struct DisplacementInputs {
+  std::vector<LayerInputs> layers;        // 1 .. 4
+  const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
+  const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
+  const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
   // qdm with bilinear-patch refinement: the fp64 heights solved exactly, and height_max built from
   // bilinear_upper_bound() of them (conservative for the bilinear surface).
   const HeightField* surface = nullptr;
@@ -40,16 +49,32 @@ public:
   };
 
 private:
-  simd::Float height_at(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const;
-  Hit relief(const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod, simd::Mask active) const;
-  Hit pom(const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod, const simd::Float& cos_view,
-          simd::Mask active) const;
-  Hit qdm(const Ray& ray, const simd::Float& depth_scale, const simd::Float& stop_level, const simd::Int& cap,
-          simd::Mask active) const;
+  struct Layer {
+    TextureView albedo, normal;
+    std::optional<TextureView> height, height_max;
+  };
+  // What shade() computes before the surface is known: the frame, the ray and the depth scale.
+  struct Setup;
+
+  SingleLayerSurface layer_surface(int i) const;
+  template <class Surface>
+  void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
+  template <class Surface>
+  Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
+  template <class Surface>
+  Hit relief(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
+             simd::Mask active) const;
+  template <class Surface>
+  Hit pom(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
+          const simd::Float& cos_view, simd::Mask active) const;
+  template <class Surface>
+  Hit qdm(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& stop_level,
+          const simd::Int& cap, simd::Mask active) const;
+  template <class Surface>
+  simd::Float refine(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit,
+                     simd::Float& iterations, simd::Mask active) const;
   Hit cone_step(const Ray& ray, const simd::Float& depth_scale, simd::Mask active) const;
   void cone_texel(const simd::Int& x, const simd::Int& y, simd::Float& height, simd::Float& ratio) const;
-  simd::Float refine(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit, simd::Float& iterations,
-                     simd::Mask active) const;
   simd::Float bilinear_patch(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_start,
                              simd::Float& iterations, simd::Mask active) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
@@ -57,8 +82,8 @@ private:
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
 
-  TextureView albedo_, normal_;
-  std::optional<TextureView> height_, height_max_;
+  std::vector<Layer> layers_;
+  std::optional<TextureView> weights_;
   const ConeMap* cones_;
   const HeightField* reference_;
   const HeightField* surface_;
@@ -67,6 +92,7 @@ private:
   MathMode math_;
   TechniqueDesc technique_;
   LightingDesc lighting_;
+  BlendDesc blend_;
   LightRig lights_;
 };
 

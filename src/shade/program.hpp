@@ -27,8 +27,14 @@ struct ShadeOutput {
 
 class ShadingProgram {
 public:
+  explicit ShadingProgram(int varying_count = kBaseVaryingCount) : varying_count_(varying_count) {}
   virtual ~ShadingProgram() = default;
   virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
+  // The rasterizer interpolates varyings [0, varying_count()) only; the others are left unset.
+  int varying_count() const { return varying_count_; }
+
+private:
+  int varying_count_;
 };
 
 }  // namespace qdmr

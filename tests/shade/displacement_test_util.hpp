@@ -137,10 +137,7 @@ public:
 
   std::vector<TechniqueResult> run(const std::vector<TechniqueRay>& rays) const {
     DisplacementInputs inputs;
-    inputs.albedo = &flat_;
-    inputs.normal = &flat_;
-    inputs.height = &height_;
-    inputs.height_max = &height_max_;
+    inputs.layers.push_back({&flat_, &flat_, &height_, &height_max_});
     if (!cones_.ratio.empty()) inputs.cones = &cones_;
     if (material_.technique.refinement == QdmRefinement::BilinearPatch) inputs.surface = &field_;
     std::vector<TechniqueResult> results;

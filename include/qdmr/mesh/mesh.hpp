@@ -17,6 +17,7 @@ struct MeshData {
   std::vector<glm::vec3> normals;    // unit length
   std::vector<glm::vec4> tangents;   // xyz: unit tangent along +u, orthogonal to the normal; w: +-1, bitangent = w * cross(n, t)
   std::vector<glm::vec2> uvs;
+  std::vector<glm::vec4> blend_weights;  // per vertex, layers 0..3; filled for blended materials with per-vertex weights
   std::vector<std::uint32_t> indices;             // 3 per triangle, counter-clockwise front faces
   std::vector<std::uint32_t> triangle_materials;  // obj only: per triangle, an index into `materials`; empty otherwise
   std::vector<MaterialDesc> materials;            // obj only: materials from the MTL file (named "<mtl name>")

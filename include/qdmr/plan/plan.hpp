@@ -30,13 +30,24 @@ struct TextureRequest {
   std::vector<std::string> users;  // material names
 };
 
+// Indices into FramePlan::textures of one layer's textures (-1: not needed).
+struct LayerPlan {
+  int albedo = -1, normal = -1;
+  int height = -1;           // box-filtered heights (displacement techniques, height blending)
+  int height_max = -1;       // max-quadtree (qdm, hard or qdm_soft shadows, coarse AO)
+};
+
 struct MaterialPlan {
   std::string name;
   std::string program;       // the shading program variant
   TechniqueKind technique = TechniqueKind::Normal;
-  int albedo = -1, normal = -1;  // indices into FramePlan::textures
-  int height = -1;           // box-filtered heights (displacement techniques)
-  int height_max = -1;       // max-quadtree (qdm)
+  std::vector<LayerPlan> layers;  // one per material layer
+  // Blending (more than one layer): the weights come per vertex or from a weight texture built from the map.
+  bool blend = false;
+  WeightMode weight_mode = WeightMode::Pixel;
+  std::uint64_t weight_bytes = 0;  // pixel mode: RGBA8 weight texture with its max chain
+  bool ao_map = false;       // baked AO: one float per texel, baked or from the cache
+  std::uint64_t ao_bytes = 0;
   bool cone_map = false;     // csm, rcsm: a cone map of the height's level 0, baked or from the cache
   ConeKind cone_kind = ConeKind::Conservative;
   std::uint64_t cone_bytes = 0;  // one float per level-0 texel
@@ -57,8 +68,10 @@ struct FramePlan {
   std::vector<TextureRequest> textures;
   std::vector<MeshPlan> meshes;
   std::vector<Aov> aovs;
-  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, cone_map_bytes = 0;
-  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes + cone_map_bytes; }
+  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, cone_map_bytes = 0, derived_bytes = 0;
+  std::uint64_t total_bytes() const {
+    return framebuffer_bytes + texture_bytes + mesh_bytes + cone_map_bytes + derived_bytes;
+  }
 
   std::string describe() const;  // human-readable, for `qdmr plan`
   nlohmann::json to_json() const;

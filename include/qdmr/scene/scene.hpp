@@ -223,7 +223,7 @@ struct WeightsDesc {
   // noise: one smooth noise field per layer at `cells` per side, sharpened; the strongest layer gets weight 1
   std::uint32_t seed = 1;
   int cells = 4;
-  float sharpness = 4.0f;
+  int sharpness = 4;         // noise: weights are the noise to this power before normalising
   // terrain: from a height map (the DEM the grid is displaced by): layer 0 on slopes, 1 on flat ground,
   // 2 below `low`, 3 where noise says so
   TextureDesc height;

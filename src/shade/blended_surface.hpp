@@ -1,0 +1,59 @@
+#pragma once
+// BlendedSurface: up to four layers' heights combined by blend weights into the one surface the techniques
+// march (see height_surface.hpp for the interface). The talk's operators:
+//   alpha:  H = sum(w_i h_i) / sum(w_i)    (the usual reconstruction, an aggregate)
+//   height: H = max(w_i h_i)               ("HB = max(h1..h4)", weighted as in the QDMHB slide)
+// The weights come from the vertices (constant along a pixel's ray: the talk's view-dependent "floating"
+// artifact), or from a weight texture sampled where the surface is evaluated (exact).
+// cell_max is conservative: the level-0 box value is exact (weights at the texel centre), coarser cells use
+// max(hmax_i * wmax_i) — "QDM1 * QDM2 = conservative QDM" — with wmax_i the largest weight over the UV box the
+// queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
+#include "shade/height_surface.hpp"
+
+namespace qdmr {
+
+struct WeightTexture {
+  const TextureView* view = nullptr;  // RGBA8 linear, power-of-two, max chain; level 0 sampled bilinearly (wrap)
+  float scale = 1.0f;                 // weight-map UV = layer UV / scale
+};
+
+class BlendedSurface {
+public:
+  static constexpr int kMaxLayers = 4;
+
+  // Per-vertex weights: w[0..count) per lane.
+  BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const simd::Float* w);
+  // Per-pixel weights; every query lies within [u_lo, u_hi] x [v_lo, v_hi] (layer UV).
+  BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const WeightTexture& weights,
+                 const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi);
+
+  int width() const { return layers_[0].width(); }
+  int height() const { return layers_[0].height(); }
+  bool has_hierarchy() const { return layers_[0].has_hierarchy(); }
+  int top_level() const { return layers_[0].top_level(); }
+  const SamplerState& sampler() const { return layers_[0].sampler(); }
+  HeightFetch fetch() const { return layers_[0].fetch(); }
+  int layer_count() const { return count_; }
+  const SingleLayerSurface& layer(int i) const { return layers_[i]; }
+
+  simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const;
+  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
+  simd::Float cell_max_filtered(const simd::Float& u, const simd::Float& v, const simd::Float& level) const;
+
+  // The layer weights at (u, v): the vertex weights, or the weight texture sampled bilinearly.
+  void weights_at(const simd::Float& u, const simd::Float& v, simd::Float* w) const;
+  // The blend operator applied to layer heights h and weights w.
+  simd::Float combine(const simd::Float* h, const simd::Float* w) const;
+
+private:
+  void bound_weights(const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi);
+  simd::Float bound(const simd::Float* hmax) const;
+
+  const SingleLayerSurface* layers_;
+  int count_;
+  BlendOperator op_;
+  WeightTexture texture_;        // view == nullptr: per-vertex weights
+  simd::Float weights_[kMaxLayers];  // per-vertex: the weights; per-pixel: their maxima over the query box
+};
+
+}  // namespace qdmr

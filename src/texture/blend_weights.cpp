@@ -1,0 +1,140 @@
+#include "texture/blend_weights.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "qdmr/texture/texture.hpp"
+
+namespace qdmr {
+namespace {
+
+double wrap(double x, int n) {
+  const double r = std::fmod(x, double(n));
+  return r < 0.0 ? r + n : r;
+}
+
+// Bilinear sample of channel c at texel coordinates (x, y) (centres at i + 0.5), wrapping.
+float bilinear(const Image& map, double x, double y, int c) {
+  x = wrap(x - 0.5, map.width);
+  y = wrap(y - 0.5, map.height);
+  const int x0 = int(x), y0 = int(y);
+  const int x1 = (x0 + 1) % map.width, y1 = (y0 + 1) % map.height;
+  const double fx = x - x0, fy = y - y0;
+  const double top = map.at(x0, y0, c) * (1.0 - fx) + map.at(x1, y0, c) * fx;
+  const double bottom = map.at(x0, y1, c) * (1.0 - fx) + map.at(x1, y1, c) * fx;
+  return float(top * (1.0 - fy) + bottom * fy);
+}
+
+double clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
+
+// Scales each texel's weights so that the largest is 1 (all-zero texels go to layer 0).
+void normalise_to_strongest(Image& map, int layers) {
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      float top = 0.0f;
+      for (int i = 0; i < layers; ++i) top = std::max(top, map.at(x, y, i));
+      if (!(top > 0.0f)) {
+        map.at(x, y, 0) = 1.0f;
+        continue;
+      }
+      for (int i = 0; i < layers; ++i) map.at(x, y, i) /= top;
+    }
+}
+
+Image noise_map(const WeightsDesc& desc, int layers) {
+  const int side = std::max(desc.resolution, 64);
+  Image map(side, side, 4);
+  for (int i = 0; i < layers; ++i) {
+    ProceduralDesc p;
+    p.pattern = ProceduralPattern::Noise;
+    p.size = 1;
+    while (p.size < side) p.size *= 2;
+    p.seed = desc.seed * 4u + std::uint32_t(i);
+    p.cells = desc.cells;
+    p.octaves = 2;
+    const Image noise = generate_procedural(p);
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x) {
+        double w = bilinear(noise, (x + 0.5) * noise.width / side, (y + 0.5) * noise.height / side, 0);
+        double powered = 1.0;
+        for (int k = 0; k < desc.sharpness; ++k) powered *= w;  // integer power: exact and the same everywhere
+        map.at(x, y, i) = float(powered);
+      }
+  }
+  normalise_to_strongest(map, layers);
+  return map;
+}
+
+// Terrain rules over a height map: rock (layer 0) on slopes, sand (2) low down, dirt (3) in noise patches,
+// grass (1) elsewhere, each rule a linear ramp so the weights change smoothly.
+Image terrain_map(const WeightsDesc& desc, int layers, const std::string& where) {
+  LayerDesc layer;
+  layer.height = desc.height;
+  const Image h = make_layer_height(layer, where + "/height");
+  float lo = 1.0f, hi = 0.0f;
+  for (float v : h.texels) lo = std::min(lo, v), hi = std::max(hi, v);
+  const double range = hi > lo ? double(hi) - lo : 1.0;
+  ProceduralDesc p;
+  p.pattern = ProceduralPattern::Noise;
+  p.size = 256;
+  p.seed = desc.seed;
+  p.cells = desc.cells;
+  p.octaves = 3;
+  const Image noise = generate_procedural(p);
+  Image map(h.width, h.height, 4);
+  for (int y = 0; y < h.height; ++y)
+    for (int x = 0; x < h.width; ++x) {
+      const auto at = [&](int i, int j) { return double(h.at(std::clamp(i, 0, h.width - 1), std::clamp(j, 0, h.height - 1), 0)); };
+      // Slope in height units per map width, times the relief (vertical extent over width).
+      const double gx = (at(x + 1, y) - at(x - 1, y)) * 0.5 * h.width * desc.relief;
+      const double gy = (at(x, y + 1) - at(x, y - 1)) * 0.5 * h.height * desc.relief;
+      const double slope = std::sqrt(gx * gx + gy * gy);
+      const double elevation = (at(x, y) - lo) / range;
+      const double rock = clamp01((slope - desc.slope) / (0.5 * desc.slope) + 0.5);
+      const double sand = clamp01((desc.low - elevation) / (0.25 * std::max(desc.low, 1e-3f)) + 0.5);
+      const double patch = bilinear(noise, (x + 0.5) * noise.width / h.width, (y + 0.5) * noise.height / h.height, 0);
+      const double dirt = clamp01((patch - 0.55) * 8.0);
+      const double w[4] = {rock, (1 - rock) * (1 - sand) * (1 - dirt), (1 - rock) * sand, (1 - rock) * (1 - sand) * dirt};
+      for (int i = 0; i < layers; ++i) map.at(x, y, i) = float(w[i]);
+    }
+  normalise_to_strongest(map, layers);
+  return map;
+}
+
+}  // namespace
+
+Image make_weight_map(const WeightsDesc& desc, int layers, const std::string& where) {
+  switch (desc.source) {
+    case WeightSource::Noise: return noise_map(desc, layers);
+    case WeightSource::Terrain: return terrain_map(desc, layers, where);
+    case WeightSource::File: {
+      const Image file = read_image(desc.file, where + "/file");
+      Image map(file.width, file.height, 4);
+      for (int y = 0; y < file.height; ++y)
+        for (int x = 0; x < file.width; ++x)
+          for (int i = 0; i < std::min(file.channels, 4); ++i) map.at(x, y, i) = std::clamp(file.at(x, y, i), 0.0f, 1.0f);
+      return map;
+    }
+  }
+  return {};
+}
+
+Texture make_weight_texture(const Image& map, int resolution) {
+  Image level0(resolution, resolution, 4);
+  for (int y = 0; y < resolution; ++y)
+    for (int x = 0; x < resolution; ++x)
+      for (int c = 0; c < 4; ++c)
+        level0.at(x, y, c) = bilinear(map, (x + 0.5) * map.width / resolution, (y + 0.5) * map.height / resolution, c);
+  return make_mip_texture(level0, TexelFormat::RGBA8, false, MipReduce::Max);
+}
+
+std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::vec2>& uvs, float scale) {
+  std::vector<glm::vec4> out(uvs.size());
+  for (std::size_t k = 0; k < uvs.size(); ++k) {
+    const double x = double(uvs[k].x) / scale * map.width, y = double(uvs[k].y) / scale * map.height;
+    for (int c = 0; c < 4; ++c) out[k][c] = bilinear(map, x, y, c);
+  }
+  return out;
+}
+
+}  // namespace qdmr

@@ -1,0 +1,29 @@
+#pragma once
+// Blend weights of up to four layers: the weight map a material describes (noise, terrain rules or a file),
+// the per-pixel weight texture made from it, and the per-vertex weights sampled from it.
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/image.hpp"
+#include "qdmr/texture/mip_texture.hpp"
+
+namespace qdmr {
+
+// RGBA float image over one span of the weight map (it wraps), channel i = weight of layer i in [0, 1].
+// noise and terrain maps are scaled per texel so that the strongest layer has weight 1 (pure regions show
+// one layer's full height under the height-blend surface max(w_i h_i)); file maps are used as stored.
+// Throws qdmr::Error(where + "/...", ...) on unreadable inputs.
+Image make_weight_map(const WeightsDesc& desc, int layers, const std::string& where);
+
+// The per-pixel weight texture: the map resampled (bilinear, wrapping) to resolution x resolution, RGBA8
+// linear, with a max chain so coarse levels bound the weights of regions.
+Texture make_weight_texture(const Image& map, int resolution);
+
+// Per-vertex weights: the map sampled bilinearly (wrapping) at uv / scale.
+std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::vec2>& uvs, float scale);
+
+}  // namespace qdmr
