@@ -10,6 +10,7 @@
 #include <string>
 
 #include "qdmr/bake/cone_map.hpp"
+#include "bake/content_hash.hpp"
 #include "io/atomic_file.hpp"
 #include "qdmr/core/error.hpp"
 
@@ -19,18 +20,6 @@ namespace {
 // Bump when the definition, the rounding or the file layout of a cone map changes: old files stop matching.
 constexpr std::uint32_t kConeFormatVersion = 1;
 constexpr char kMagic[8] = {'Q', 'D', 'M', 'R', 'C', 'O', 'N', 'E'};
-
-struct Fnv1a {
-  std::uint64_t hash = 0xcbf29ce484222325ull;
-  void bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < size; ++k) hash = (hash ^ p[k]) * 0x100000001b3ull;
-  }
-  template <class T>
-  void value(const T& v) {
-    bytes(&v, sizeof v);
-  }
-};
 
 // The fixed-size header in front of the float ratios of a cache file (host byte order: the cache is local).
 struct CacheHeader {
@@ -47,14 +36,6 @@ std::uint64_t payload_hash(const std::vector<float>& ratio) {
   f.bytes(ratio.data(), ratio.size() * sizeof(float));
   return f.hash;
 }
-
-std::string hex(std::uint64_t v) {
-  static const char* digits = "0123456789abcdef";
-  std::string s(16, '0');
-  for (int k = 15; k >= 0; --k, v >>= 4) s[std::size_t(k)] = digits[v & 15];
-  return s;
-}
-
 
 // The cached map, or nothing when the file is missing, foreign, truncated or corrupt.
 std::optional<ConeMap> read_cache(const std::filesystem::path& file, std::uint64_t key, const HeightField& field,
