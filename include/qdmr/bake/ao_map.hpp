@@ -1,0 +1,41 @@
+#pragma once
+// Baked ambient occlusion (the talk: AO "need[s] to calculate only when height field changes ... use at content
+// generation"): the per-frame horizon AO of shade/ambient_occlusion.hpp evaluated once per texel of a map, in
+// double precision, to be sampled bilinearly at the hit UV.
+//
+// Texel (i, j) of a W' x H' map holds the AO of the surface point above UV ((i + 0.5) / W', (j + 0.5) / H'):
+// W' x H' = the field's size when desc.resolution is 0, else resolution x max(1, resolution * H / W).
+// The point lies on the bilinear surface through the texel centres (surface_depth, ReferenceSurface::Bilinear)
+// and the directions and tap distances are those of the per-frame AO (one texel = 1 / max(W, H) UV):
+//   fine:   taps read the bilinear surface (what bilinear and trilinear fetch see near LOD 0);
+//   coarse: the tap at 2^k texels reads the maximum of the level-k cell of a max pyramid of the heights built
+//           like the max-quadtree (level k+1 = max(1, floor(n/2)) per axis, the last cell covering the leftover),
+//           the tap's texel found with the field's address mode.
+// With jitter, texel (i, j) uses the rotation of pixel (i, j) with desc.seed. The stored value is the raw
+// average visibility in [0, 1], 1 = open: desc.strength is not applied (apply it when shading, so changing
+// it needs no rebake). depth_scale is the material's technique depth scale (depth in UV units).
+#include <cstdint>
+#include <filesystem>
+
+#include "qdmr/scene/scene.hpp"
+#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/image.hpp"
+
+namespace qdmr {
+
+// A one-channel fp32 image, row 0 at v = 0. Parallel over rows with oneTBB; the same bits for any thread count.
+// Throws qdmr::Error on an empty field.
+Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc);
+
+// 64-bit FNV-1a of the format version, W, H, address mode, heights (as doubles), depth scale, direction count
+// (clamped to 4..16), radius, coarse, jitter, the seed (when jittered) and the map's size. Not strength or mode.
+std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc);
+
+// The cached map of (field, depth_scale, desc) from cache_dir (e.g. default_cache_dir() of cone_map.hpp), or
+// the bake, stored there through a temporary file and a rename. A cached file is used only if its header
+// (magic, version, key, size) and payload checksum match and every value lies in [0, 1]; anything else is
+// rebuilt and overwritten. A cache that cannot be written is skipped, not an error.
+Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
+                          const std::filesystem::path& cache_dir);
+
+}  // namespace qdmr

@@ -1,0 +1,220 @@
+// Baked ambient occlusion: the per-frame horizon AO per texel in double precision, and its content-hash cache.
+#include "qdmr/bake/ao_map.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bake/content_hash.hpp"
+#include "io/atomic_file.hpp"
+#include "qdmr/core/error.hpp"
+#include "shade/ao_pattern.hpp"
+
+namespace qdmr {
+namespace {
+
+// Bump when the definition, the rounding or the file layout of an AO map changes: old files stop matching.
+constexpr std::uint32_t kAoFormatVersion = 1;
+constexpr char kMagic[8] = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
+
+struct MapSize {
+  int width, height;
+};
+
+MapSize map_size(const HeightField& field, const AoDesc& desc) {
+  if (desc.resolution <= 0) return {field.width, field.height};
+  const auto h = std::int64_t(desc.resolution) * field.height / field.width;
+  return {desc.resolution, int(std::max<std::int64_t>(1, h))};
+}
+
+// Level-0 texel index of i under the address mode (the rule of HeightField::at).
+std::int64_t address(std::int64_t i, std::int64_t n, AddressMode mode) {
+  switch (mode) {
+    case AddressMode::Wrap: return ((i % n) + n) % n;
+    case AddressMode::Clamp: return std::clamp<std::int64_t>(i, 0, n - 1);
+    case AddressMode::Mirror: {
+      const std::int64_t m = ((i % (2 * n)) + 2 * n) % (2 * n);
+      return m < n ? m : 2 * n - 1 - m;
+    }
+  }
+  return 0;
+}
+
+// The max pyramid of the heights, shaped like the max-quadtree: level k+1 has max(1, floor(n/2)) cells per axis,
+// the last one also covering the leftover row/column, so texel x of level 0 lies in cell min(x >> k, n_k - 1).
+struct MaxPyramid {
+  std::vector<int> width, height;
+  std::vector<std::vector<double>> level;
+
+  explicit MaxPyramid(const HeightField& field) {
+    width.push_back(field.width);
+    height.push_back(field.height);
+    level.push_back(field.h);
+    while (width.back() > 1 || height.back() > 1) {
+      const int w = width.back(), h = height.back();
+      const int pw = std::max(1, w / 2), ph = std::max(1, h / 2);
+      std::vector<double> parent(std::size_t(pw) * std::size_t(ph), 0.0);
+      const std::vector<double>& child = level.back();
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          double& p = parent[std::size_t(std::min(y / 2, ph - 1)) * std::size_t(pw) + std::size_t(std::min(x / 2, pw - 1))];
+          p = std::max(p, child[std::size_t(y) * std::size_t(w) + std::size_t(x)]);
+        }
+      width.push_back(pw);
+      height.push_back(ph);
+      level.push_back(std::move(parent));
+    }
+  }
+
+  int top() const { return int(level.size()) - 1; }
+
+  double cell_max(int k, std::int64_t x, std::int64_t y) const {
+    const std::int64_t cx = std::min<std::int64_t>(x >> k, width[std::size_t(k)] - 1);
+    const std::int64_t cy = std::min<std::int64_t>(y >> k, height[std::size_t(k)] - 1);
+    return level[std::size_t(k)][std::size_t(cy * width[std::size_t(k)] + cx)];
+  }
+};
+
+// The raw AO of the point above (u, v); pyramid: the max pyramid for coarse taps (null when fine).
+double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double depth_scale, const AoDesc& desc,
+                const ao::Taps& taps, int i, int j, double u, double v) {
+  const int n = ao::direction_count(desc);
+  const int rotation = desc.jitter ? ao::rotation(std::uint32_t(i), std::uint32_t(j), desc.seed) : 0;
+  const double s = surface_depth(field, depth_scale, u, v, ReferenceSurface::Bilinear);
+  double visible = 0.0;
+  for (int d = 0; d < n; ++d) {
+    const int index = ao::direction_index(n, d, rotation);
+    const double dx = ao::kDirections.cos[std::size_t(index)], dy = ao::kDirections.sin[std::size_t(index)];
+    double slope = 0.0;
+    for (int k = 0; k < taps.count; ++k) {
+      const ao::Tap& tap = taps.tap[std::size_t(k)];
+      const double tu = u + dx * double(tap.distance), tv = v + dy * double(tap.distance);
+      double depth;
+      if (desc.coarse) {
+        const auto x = address(std::int64_t(std::floor(tu * field.width)), field.width, field.address);
+        const auto y = address(std::int64_t(std::floor(tv * field.height)), field.height, field.address);
+        depth = depth_scale * (1.0 - pyramid->cell_max(std::min(tap.level, pyramid->top()), x, y));
+      } else {
+        depth = surface_depth(field, depth_scale, tu, tv, ReferenceSurface::Bilinear);
+      }
+      slope = std::max(slope, (s - depth) / double(tap.distance));
+    }
+    visible += 1.0 - slope / std::sqrt(1.0 + slope * slope);
+  }
+  return visible / double(n);
+}
+
+// The fixed-size header in front of the float values of a cache file (host byte order: the cache is local).
+struct CacheHeader {
+  char magic[8];
+  std::uint32_t version;
+  std::int32_t width, height;
+  std::uint32_t reserved;
+  std::uint64_t key;
+  std::uint64_t payload_hash;  // FNV-1a of the values' bytes
+};
+
+std::uint64_t payload_hash(const std::vector<float>& values) {
+  Fnv1a f;
+  f.bytes(values.data(), values.size() * sizeof(float));
+  return f.hash;
+}
+
+// The cached map, or nothing when the file is missing, foreign, truncated or corrupt.
+std::optional<Image> read_cache(const std::filesystem::path& file, std::uint64_t key, MapSize size) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::size_t count = std::size_t(size.width) * std::size_t(size.height);
+  std::error_code ec;
+  if (std::filesystem::file_size(file, ec) != sizeof(CacheHeader) + count * sizeof(float) || ec) return std::nullopt;
+  CacheHeader header{};
+  if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return std::nullopt;
+  if (std::memcmp(header.magic, kMagic, sizeof kMagic) != 0 || header.version != kAoFormatVersion ||
+      header.width != size.width || header.height != size.height || header.key != key)
+    return std::nullopt;
+  Image map(size.width, size.height, 1);
+  if (!in.read(reinterpret_cast<char*>(map.texels.data()), std::streamsize(count * sizeof(float)))) return std::nullopt;
+  if (payload_hash(map.texels) != header.payload_hash) return std::nullopt;
+  for (float a : map.texels)
+    if (!(a >= 0.0f && a <= 1.0f)) return std::nullopt;
+  return map;
+}
+
+void write_cache(const std::filesystem::path& file, std::uint64_t key, const Image& map) {
+  std::error_code ec;
+  std::filesystem::create_directories(file.parent_path(), ec);
+  if (ec) return;
+  CacheHeader header{};
+  std::memcpy(header.magic, kMagic, sizeof kMagic);
+  header.version = kAoFormatVersion;
+  header.width = map.width;
+  header.height = map.height;
+  header.key = key;
+  header.payload_hash = payload_hash(map.texels);
+  try {  // the cache is best effort: an unwritable folder only costs a rebake next time
+    write_atomically(file, "ao map cache", [&](const std::filesystem::path& temporary) -> std::string {
+      std::ofstream out(temporary, std::ios::binary);
+      out.write(reinterpret_cast<const char*>(&header), sizeof header);
+      out.write(reinterpret_cast<const char*>(map.texels.data()), std::streamsize(map.bytes()));
+      return out.flush() ? "" : "write failed";
+    });
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace
+
+Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc) {
+  if (field.width <= 0 || field.height <= 0 || field.h.size() != std::size_t(field.width) * std::size_t(field.height))
+    throw Error("ao map", "empty or inconsistent height field");
+  const MapSize size = map_size(field, desc);
+  const std::optional<MaxPyramid> pyramid = desc.coarse ? std::optional<MaxPyramid>(field) : std::nullopt;
+  const ao::Taps taps = ao::make_taps(desc, field.width, field.height);
+  Image map(size.width, size.height, 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int j = rows.begin(); j < rows.end(); ++j)
+      for (int i = 0; i < size.width; ++i)
+        map.at(i, j, 0) = float(texel_ao(field, pyramid ? &*pyramid : nullptr, depth_scale, desc, taps, i, j, (i + 0.5) / size.width,
+                                         (j + 0.5) / size.height));
+  });
+  return map;
+}
+
+std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {
+  const MapSize size = map_size(field, desc);
+  Fnv1a f;
+  f.value(kAoFormatVersion);
+  f.value(std::int32_t(field.width));
+  f.value(std::int32_t(field.height));
+  f.value(std::int32_t(field.address));
+  for (double h : field.h) f.value(h);
+  f.value(depth_scale);
+  f.value(std::int32_t(ao::direction_count(desc)));
+  f.value(desc.radius);
+  f.value(std::uint8_t(desc.coarse));
+  f.value(std::uint8_t(desc.jitter));
+  f.value(desc.jitter ? desc.seed : 0u);
+  f.value(std::int32_t(size.width));
+  f.value(std::int32_t(size.height));
+  return f.hash;
+}
+
+Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
+                          const std::filesystem::path& cache_dir) {
+  if (field.width <= 0 || field.height <= 0) return bake_ao_map(field, depth_scale, desc);  // throws
+  const std::uint64_t key = ao_map_key(field, depth_scale, desc);
+  const std::filesystem::path file = cache_dir / ("ao-" + hex(key) + ".bin");
+  if (std::optional<Image> cached = read_cache(file, key, map_size(field, desc))) return std::move(*cached);
+  Image map = bake_ao_map(field, depth_scale, desc);
+  write_cache(file, key, map);
+  return map;
+}
+
+}  // namespace qdmr

@@ -1,0 +1,36 @@
+#pragma once
+// Per-frame ambient occlusion of the displaced surface from horizon queries (the talk's "Ambient Occlusion":
+// n equally spaced horizon queries per pixel, averaged, optionally rotated per pixel by a random angle).
+//
+// For each direction of ao_pattern.hpp, the horizon slope over the search radius is
+//   tan(horizon) = max(0, max over taps of rise / t),   rise = s - ds * (1 - h(tap)),
+// the height of the surface at the tap above the point, in depth units, over the horizontal UV distance t.
+// The direction's visibility is the cosine-weighted unoccluded part of its vertical slice of the hemisphere
+// around the polygon normal, 1 - sin(horizon), with sin(atan(x)) = x / sqrt(1 + x^2) (no trigonometry);
+// ao = the average over the directions, and the result is apply_ao_strength(ao, strength).
+//   coarse: the tap at 2^k texels reads cell_max(k, cell of the tap) (capped at the surface's top level, level 0
+//           without a hierarchy): a conservative height for the cell, log2(radius in texels) fetches;
+//   fine:   every tap reads the filtered surface height(u, v, lod 0), as the material's technique fetches it.
+// Cell addressing wraps (the max-quadtree's rule); the filtered surface uses the material's address mode.
+// A flat surface (h(tap) equal to the point's height, s = ds * (1 - h)) gives exactly 1.
+#include "core/simd.hpp"
+#include "qdmr/scene/scene.hpp"
+
+namespace qdmr {
+
+// ao' = 1 - strength * (1 - ao): strength 0 disables the darkening, 1 keeps it (for baked maps too).
+inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
+  const simd::Float one(1.0f);
+  return one - simd::Float(strength) * (one - ao);
+}
+
+// Ambient visibility in [0, 1] (1 = open) of the surface point at (u, v) and depth s (0 = polygon, ds = deepest),
+// ds the depth scale, per lane. Jitter rotates the directions by a hash of (floor(pixel_x), floor(pixel_y),
+// desc.seed), nothing else. Inactive lanes return 1. Defined for SingleLayerSurface (and surfaces with its
+// interface, instantiated in ambient_occlusion.cpp).
+template <class Surface>
+simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const simd::Float& u, const simd::Float& v,
+                              const simd::Float& s, const simd::Float& ds, const simd::Float& pixel_x,
+                              const simd::Float& pixel_y, simd::Mask active);
+
+}  // namespace qdmr
