@@ -1,0 +1,68 @@
+#include "shade/lighting_models.hpp"
+
+namespace qdmr::shading {
+namespace {
+
+// pi * D * Vis * F * n.l of the header, for one light.
+Float cook_torrance(const Float& n_dot_l, const Float& n_dot_v, const Float& n_dot_h, const Float& v_dot_h,
+                    const Float& f0, float roughness) {
+  const Float one(1.0f);
+  const float alpha = roughness * roughness;
+  const Float a2(alpha * alpha), one_minus_a2(1.0f - alpha * alpha);
+  const Float d_root = n_dot_h * n_dot_h * (a2 - one) + one;  // >= alpha^2 > 0
+  const Float d = a2 / (d_root * d_root);                     // pi * D
+  const Float lambda_v = n_dot_l * xsimd::sqrt(n_dot_v * n_dot_v * one_minus_a2 + a2);
+  const Float lambda_l = n_dot_v * xsimd::sqrt(n_dot_l * n_dot_l * one_minus_a2 + a2);
+  // Both dot products 0 (a grazing view of a light on the horizon): no highlight instead of 0 / 0.
+  const Float vis = Float(0.5f) / xsimd::max(lambda_v + lambda_l, Float(1e-30f));
+  const Float m = one - v_dot_h;
+  const Float m2 = m * m;
+  const Float fresnel = f0 + (one - f0) * (m2 * m2 * m);
+  return d * vis * fresnel * n_dot_l;
+}
+
+}  // namespace
+
+void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
+                  const Float* light_visibility, const LightingDesc& lighting, const LightRig& lights, Float* color) {
+  const Float zero(0.0f);
+  Float diffuse[3] = {Float(lights.ambient.x) * surface.ambient_occlusion, Float(lights.ambient.y) * surface.ambient_occlusion,
+                      Float(lights.ambient.z) * surface.ambient_occlusion};
+  Float specular[3] = {zero, zero, zero};
+  const bool cook_torrance_model = lighting.model == LightingModel::CookTorrance;
+  const Float n_dot_v = xsimd::max(dot(shading_normal, view), zero);
+  for (std::size_t i = 0; i < lights.directional.size(); ++i) {
+    const LightRig::Directional& light = lights.directional[i];
+    const Vec3 l{Float(light.direction.x), Float(light.direction.y), Float(light.direction.z)};
+    Float n_dot_l = xsimd::max(dot(shading_normal, l), zero);
+    const Vec3 h = normalize(add(l, view));
+    const Float facing = xsimd::select(dot(geometric_normal, l) > zero, Float(1.0f), zero);
+    Float spec = cook_torrance_model
+                     ? cook_torrance(n_dot_l, n_dot_v, xsimd::max(dot(shading_normal, h), zero),
+                                     xsimd::max(dot(view, h), zero), surface.specular, lighting.roughness) *
+                           facing
+                     : detmath::pow(xsimd::max(dot(shading_normal, h), zero), Float(lighting.shininess)) *
+                           surface.specular * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
+    if (light_visibility) {
+      n_dot_l = n_dot_l * light_visibility[i];
+      spec = spec * light_visibility[i];
+    }
+    const float radiance[3] = {light.radiance.x, light.radiance.y, light.radiance.z};
+    for (int c = 0; c < 3; ++c) {
+      diffuse[c] += n_dot_l * Float(radiance[c]);
+      specular[c] += spec * Float(radiance[c]);
+    }
+  }
+  for (int c = 0; c < 3; ++c) color[c] = surface.albedo[c] * diffuse[c] + specular[c];
+}
+
+Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs, float fallback) {
+  if (!coeffs.enabled) return Float(fallback);
+  const Float one(1.0f);
+  const Float luminance = Float(0.2126f) * albedo[0] + Float(0.7152f) * albedo[1] + Float(0.0722f) * albedo[2];
+  const Float clamped = xsimd::min(xsimd::max(luminance, Float(0.0f)), one);
+  const Float x = coeffs.invert ? one - clamped : clamped;
+  return Float(coeffs.scale) * detmath::pow(x, Float(coeffs.power));
+}
+
+}  // namespace qdmr::shading

@@ -1,0 +1,37 @@
+#pragma once
+// The lighting models of a material (LightingDesc::model), lit by a LightRig, per lane:
+//   color = albedo * (ambient * ao + sum_i radiance_i * visibility_i * n.l_i) + sum_i radiance_i * visibility_i * spec_i
+// with n.l_i = max(dot(shading normal, l_i), 0) and spec_i gated to 0 when the light is below the polygon
+// (dot(geometric normal, l_i) <= 0). The diffuse term is Lambert with the 1/pi folded into the radiance
+// (radiance 1 head-on lights a white surface to 1), so both specular terms carry the same factor pi.
+//   Blinn-Phong:   spec = max(n.h, 0)^shininess * specular * min(8 n.l, 1)    (exactly shading::blinn_phong)
+//   Cook-Torrance: spec = pi * D * Vis * F * n.l, the GGX microfacet BRDF with
+//     alpha = roughness^2, D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2),
+//     Vis = G / (4 n.l n.v) = 0.5 / (n.l sqrt((n.v)^2 (1 - alpha^2) + alpha^2) + n.v sqrt((n.l)^2 (1 - alpha^2) + alpha^2))
+//           (height-correlated Smith, Heitz 2014), F = F0 + (1 - F0) (1 - v.h)^5 (Schlick), F0 = specular,
+//     where n.v, n.h and v.h are clamped to >= 0. Single scattering: the specular energy never exceeds 1.
+// Lane-wise IEEE only; pow through detmath.
+#include "core/simd.hpp"
+#include "qdmr/scene/scene.hpp"
+#include "shade/lighting.hpp"
+#include "shade/shading_math.hpp"
+
+namespace qdmr::shading {
+
+struct SurfaceSample {
+  const Float* albedo;      // 3 channels, linear RGB
+  Float specular;           // Blinn-Phong: highlight scale; Cook-Torrance: F0 (reflectance at normal incidence)
+  Float ambient_occlusion;  // multiplies the ambient light; 1 = open
+};
+
+// light_visibility: one factor per directional light of the rig (1 = lit, 0 = shadowed), or nullptr for all lit.
+// LightingDesc::specular is not read: the caller puts it (or specular_from_albedo) into surface.specular.
+void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
+                  const Float* light_visibility, const LightingDesc& lighting, const LightRig& lights, Float* color);
+
+// The specular reflectance of SpecularFromAlbedo: scale * pow(x, power) with x the Rec. 709 luminance
+// 0.2126 r + 0.7152 g + 0.0722 b of the albedo clamped to [0, 1], or 1 - that when inverted (x = 0 gives 0).
+// `fallback` (the material's lighting.specular) when coeffs.enabled is false.
+Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs, float fallback);
+
+}  // namespace qdmr::shading
