@@ -2,6 +2,7 @@
 
 #include "core/gather.hpp"
 #include "shade/ao_pattern.hpp"
+#include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
 
 namespace qdmr {
@@ -52,5 +53,8 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
 template simd::Float ambient_occlusion<SingleLayerSurface>(const SingleLayerSurface&, const AoDesc&, const simd::Float&,
                                                            const simd::Float&, const simd::Float&, const simd::Float&,
                                                            const simd::Float&, const simd::Float&, simd::Mask);
+template simd::Float ambient_occlusion<BlendedSurface>(const BlendedSurface&, const AoDesc&, const simd::Float&,
+                                                       const simd::Float&, const simd::Float&, const simd::Float&,
+                                                       const simd::Float&, const simd::Float&, simd::Mask);
 
 }  // namespace qdmr

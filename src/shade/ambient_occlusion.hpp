@@ -26,8 +26,9 @@ inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
 
 // Ambient visibility in [0, 1] (1 = open) of the surface point at (u, v) and depth s (0 = polygon, ds = deepest),
 // ds the depth scale, per lane. Jitter rotates the directions by a hash of (floor(pixel_x), floor(pixel_y),
-// desc.seed), nothing else. Inactive lanes return 1. Defined for SingleLayerSurface (and surfaces with its
-// interface, instantiated in ambient_occlusion.cpp).
+// desc.seed), nothing else. Inactive lanes return 1. Instantiated for SingleLayerSurface and BlendedSurface; the
+// taps reach up to desc.radius from (u, v), so a BlendedSurface with per-pixel weights needs its UV box to cover
+// [u - radius, u + radius] x [v - radius, v + radius].
 template <class Surface>
 simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const simd::Float& u, const simd::Float& v,
                               const simd::Float& s, const simd::Float& ds, const simd::Float& pixel_x,
