@@ -85,7 +85,8 @@ struct TextureDesc {
 enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
 
 // Specular reflectance generated from the albedo instead of stored (the talk's terrain saves the texture):
-// specular = scale * pow(invert ? 1 - luminance : luminance, power).
+// specular = scale * pow(invert ? 1 - luminance : luminance, power), luminance = Rec. 709 weights of the linear
+// albedo, clamped to [0, 1].
 struct SpecularFromAlbedo {
   bool enabled = false;  // off: the material's lighting.specular constant
   float power = 1.0f;
@@ -199,13 +200,14 @@ enum class AoMode { Off, Frame, Baked };
 
 struct AoDesc {
   AoMode mode = AoMode::Off;
-  int directions = 8;       // equally spaced horizon directions, 4..16
-  bool jitter = false;      // frame: rotate the directions per pixel by a hash of (pixel, seed)
+  int directions = 8;       // equally spaced horizon directions, 4..16 (clamped)
+  bool jitter = false;      // rotate the directions per pixel (frame) or texel (baked) by a hash of (x, y, seed)
   std::uint32_t seed = 1;
-  float radius = 0.05f;     // horizon search distance in UV units
-  bool coarse = true;       // far samples from coarser max-quadtree levels (log2 of the texels instead of all)
-  float strength = 1.0f;    // ao' = 1 - strength * (1 - ao)
-  int resolution = 0;       // baked: texture side (0 = the height map's)
+  float radius = 0.05f;     // horizon search distance in UV units (below one texel: no occlusion)
+  bool coarse = true;       // taps at 1, 2, 4, ... texels on max-quadtree level 0, 1, 2, ... (conservative, log2 of
+                            // the fetches); false: a tap every texel on the filtered surface (at most 64 per direction)
+  float strength = 1.0f;    // ao' = 1 - strength * (1 - ao); baked maps store ao and apply it when shading
+  int resolution = 0;       // baked: texture width (0 = the height map's size); height keeps the aspect
 };
 
 // Height blending of up to 4 layers (the talk's "Surface Blending" / "Height Blending").
