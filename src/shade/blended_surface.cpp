@@ -30,21 +30,23 @@ BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, Blen
 BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const WeightTexture& weights,
                                const Float& u_lo, const Float& u_hi, const Float& v_lo, const Float& v_hi)
     : layers_(layers), count_(count), op_(op), texture_(weights) {
-  bound_weights(u_lo, u_hi, v_lo, v_hi);
+  // Half a layer texel of padding: box-surface queries read the weights at texel centres.
+  const Float pad_u(0.5f / float(width())), pad_v(0.5f / float(height()));
+  bound_weights(u_lo - pad_u, u_hi + pad_u, v_lo - pad_v, v_hi + pad_v, weights_);
 }
 
 // The largest weight of each layer that bilinear sampling can return inside the box: the maximum over the weight
-// texels whose footprint touches it, read from the max chain at the first level where they fit in 2x2 texels.
-void BlendedSurface::bound_weights(const Float& u_lo, const Float& u_hi, const Float& v_lo, const Float& v_hi) {
+// texels whose footprint touches it (floor of the low end, ceiling of the high end: a sample exactly on a texel
+// centre reads that texel alone), read from the max chain at the first level where they fit in 2x2 texels.
+void BlendedSurface::bound_weights(const Float& u_lo, const Float& u_hi, const Float& v_lo, const Float& v_hi,
+                                   Float* w) const {
   const TextureView& view = *texture_.view;
   const float texels_per_uv_x = float(view.texture().width()) / texture_.scale;
   const float texels_per_uv_y = float(view.texture().height()) / texture_.scale;
-  // A layer texel of padding: box-surface queries read weights at texel centres up to half a texel outside.
-  const float pad_u = 1.0f / float(width()), pad_v = 1.0f / float(height());
-  Int x0 = floor_index((u_lo - Float(pad_u)) * Float(texels_per_uv_x) - Float(0.5f));
-  Int x1 = floor_index((u_hi + Float(pad_u)) * Float(texels_per_uv_x) - Float(0.5f)) + Int(1);
-  Int y0 = floor_index((v_lo - Float(pad_v)) * Float(texels_per_uv_y) - Float(0.5f));
-  Int y1 = floor_index((v_hi + Float(pad_v)) * Float(texels_per_uv_y) - Float(0.5f)) + Int(1);
+  Int x0 = floor_index(u_lo * Float(texels_per_uv_x) - Float(0.5f));
+  Int x1 = Int(0) - floor_index(Float(0.5f) - u_hi * Float(texels_per_uv_x));
+  Int y0 = floor_index(v_lo * Float(texels_per_uv_y) - Float(0.5f));
+  Int y1 = Int(0) - floor_index(Float(0.5f) - v_hi * Float(texels_per_uv_y));
   const int top = view.levels() - 1;
   Int level(0);
   for (int k = 0; k < top; ++k) {
@@ -59,12 +61,12 @@ void BlendedSurface::bound_weights(const Float& u_lo, const Float& u_hi, const F
   const Int size_x = simd::load_i32(view.widths(), level, sampler().fetch);
   const Int size_y = simd::load_i32(view.heights(), level, sampler().fetch);
   const Int mask_x = size_x - Int(1), mask_y = size_y - Int(1);
-  for (int i = 0; i < kMaxLayers; ++i) weights_[i] = Float(0.0f);
+  for (int i = 0; i < kMaxLayers; ++i) w[i] = Float(0.0f);
   for (int corner = 0; corner < 4; ++corner) {
     const Int x = ((corner & 1) ? x1 : x0) & mask_x, y = ((corner & 2) ? y1 : y0) & mask_y;
     Float texel[4];
     load(view, level, x, y, sampler().fetch, texel);
-    for (int i = 0; i < count_; ++i) weights_[i] = xsimd::max(weights_[i], texel[i]);
+    for (int i = 0; i < count_; ++i) w[i] = xsimd::max(w[i], texel[i]);
   }
 }
 
@@ -102,22 +104,33 @@ Float BlendedSurface::height(const Float& u, const Float& v, const Float& lod) c
 
 // Above level 0: the height operator's max(hmax_i * wmax_i); for alpha blending, a weighted average never exceeds
 // the highest layer with any weight (the exact weighted form when the weights are the vertex constants).
-Float BlendedSurface::bound(const Float* hmax) const {
+Float BlendedSurface::bound(const Float* hmax, const Float* wmax) const {
   if (op_ == BlendOperator::Alpha) {
-    if (!texture_.view) return combine(hmax, weights_);
+    if (!texture_.view) return combine(hmax, wmax);
     Float top(0.0f);
-    for (int i = 0; i < count_; ++i) top = xsimd::max(top, xsimd::select(weights_[i] > Float(0.0f), hmax[i], Float(0.0f)));
+    for (int i = 0; i < count_; ++i) top = xsimd::max(top, xsimd::select(wmax[i] > Float(0.0f), hmax[i], Float(0.0f)));
     return top;
   }
-  return combine(hmax, weights_);
+  return combine(hmax, wmax);
 }
 
 Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) const {
   Float hmax[kMaxLayers];
   for (int i = 0; i < count_; ++i) hmax[i] = layers_[i].cell_max(level, cx, cy);
-  Float result = bound(hmax);
+  if (!texture_.view) return bound(hmax, weights_);
+  // Per pixel: the weights' maxima over the cell (from the weight texture's max chain), within those over the
+  // batch's query box — "QDM1 * QDM2", each cell bounded by its own maxima.
+  // The box surface reads weights at the centres of the cell's level-0 texels.
+  const Float cell = xsimd::to_float(Int(1) << level);
+  const Float first_x = xsimd::to_float(cx) * cell + Float(0.5f), first_y = xsimd::to_float(cy) * cell + Float(0.5f);
+  const Float inv_w(1.0f / float(width())), inv_h(1.0f / float(height()));
+  Float wmax[kMaxLayers];
+  bound_weights(first_x * inv_w, (first_x + cell - Float(1.0f)) * inv_w, first_y * inv_h,
+                (first_y + cell - Float(1.0f)) * inv_h, wmax);
+  for (int i = 0; i < count_; ++i) wmax[i] = xsimd::min(wmax[i], weights_[i]);
+  Float result = bound(hmax, wmax);
   const simd::IntMask texel = level == Int(0);
-  if (texture_.view && xsimd::any(texel)) {
+  if (xsimd::any(texel)) {
     // Level 0: the box value with the weights at the texel centre (unwrapped: the weight map does not repeat
     // with the layers).
     Float w[kMaxLayers];
@@ -131,7 +144,7 @@ Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) c
 Float BlendedSurface::cell_max_filtered(const Float& u, const Float& v, const Float& level) const {
   Float hmax[kMaxLayers];
   for (int i = 0; i < count_; ++i) hmax[i] = layers_[i].cell_max_filtered(u, v, level);
-  return bound(hmax);
+  return bound(hmax, weights_);
 }
 
 }  // namespace qdmr

@@ -46,8 +46,10 @@ public:
   simd::Float combine(const simd::Float* h, const simd::Float* w) const;
 
 private:
-  void bound_weights(const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi);
-  simd::Float bound(const simd::Float* hmax) const;
+  // The largest weights bilinear sampling can return at layer-texel centres inside the UV box.
+  void bound_weights(const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi,
+                     simd::Float* w) const;
+  simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
 
   const SingleLayerSurface* layers_;
   int count_;
