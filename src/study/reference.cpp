@@ -144,4 +144,36 @@ ReferenceHit intersect_reference(const HeightField& field, double depth_scale, c
   }
 }
 
+LightVisibility light_visibility(const HeightField& field, double depth_scale, const glm::dvec3& start,
+                                 const glm::dvec2& climb, std::int64_t max_cells) {
+  LightVisibility r;
+  const double x0 = start.x * field.width, y0 = start.y * field.height, s0 = start.z;
+  const double dx = climb.x * field.width, dy = climb.y * field.height;  // texels per unit of depth climbed
+  if ((dx == 0 && x0 == std::floor(x0)) || (dy == 0 && y0 == std::floor(y0))) return r;  // along a wall
+  const int sx = dx > 0 ? 1 : dx < 0 ? -1 : 0, sy = dy > 0 ? 1 : dy < 0 ? -1 : 0;
+  // T0: behind along the light on a boundary (for dx > 0, x0 = i lies in texel i - 1).
+  std::int64_t i = std::int64_t(dx > 0 ? std::ceil(x0) - 1 : std::floor(x0));
+  std::int64_t j = std::int64_t(dy > 0 ? std::ceil(y0) - 1 : std::floor(y0));
+  for (;;) {
+    const double tx = sx == 0 ? kInf : (double(sx > 0 ? i + 1 : i) - x0) / dx;
+    const double ty = sy == 0 ? kInf : (double(sy > 0 ? j + 1 : j) - y0) / dy;
+    const double c = std::min(tx, ty);  // where the ray enters the next texel (diagonally through a corner)
+    if (s0 - c <= 0) return r;          // at or above the polygon (also c = inf: the light overhead)
+    if (tx <= ty) i += sx;
+    if (ty <= tx) j += sy;
+    ++r.cells_visited;
+    if (s0 - c > depth_scale * (1.0 - field.at(i, j))) {
+      r.visible = false;
+      r.blocker_i = i;
+      r.blocker_j = j;
+      r.blocker_climb = c;
+      return r;
+    }
+    if (r.cells_visited >= max_cells) {
+      r.capped = true;
+      return r;
+    }
+  }
+}
+
 }  // namespace qdmr

@@ -19,4 +19,26 @@ namespace qdmr {
 ReferenceHit intersect_reference(const HeightField& field, double depth_scale, const SurfaceRay& ray,
                                  ReferenceSurface surface, std::int64_t max_cells = 1 << 22);
 
+// Whether a point on the Box surface sees a directional light: the hard self-shadow (shade/self_shadow.hpp
+// implements the same rule in fp32). The light ray climbs from start = (u, v, depth): after climbing c it is
+// at (u + climb.x c, v + climb.y c, depth - c), climb being the UV change per unit of depth climbed
+// (light_tangent.xy / light_tangent.z). Each level-0 texel is a column below its top depth
+// depth_scale * (1 - h) (address mode applied); the ray is shadowed iff it passes through the interior of a
+// column other than the start texel T0: it enters a texel (its open square) strictly below that texel's top.
+// Grazing a top face, an edge or a corner, or running along a wall, is lit; at depth <= 0 nothing occludes.
+// T0 holds (u, v); on a texel boundary it is the texel behind along the light direction (a start on a wall
+// is shadowed by the column beyond the wall when the light lies beyond it; the start's own column never
+// shadows it). Texels are walked in ray order with each crossing computed from its integer boundary, as
+// intersect_reference does.
+struct LightVisibility {
+  bool visible = true;
+  bool capped = false;             // max_cells texels were tested without an answer (visible stays true)
+  std::int64_t blocker_i = 0, blocker_j = 0;  // the shadowing texel (address mode not applied)
+  double blocker_climb = 0;        // c where the ray enters it
+  std::int64_t cells_visited = 0;  // texels tested, T0 excluded
+};
+
+LightVisibility light_visibility(const HeightField& field, double depth_scale, const glm::dvec3& start,
+                                 const glm::dvec2& climb, std::int64_t max_cells = 1 << 22);
+
 }  // namespace qdmr
