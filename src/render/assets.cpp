@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "texture/blend_weights.hpp"
@@ -46,6 +47,18 @@ Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   stat.levels = texture.level_count();
   stat.bytes = texture.bytes();
   return texture;
+}
+
+// Level 0 of a stored height texture in fp64, for the exact reference and the bakes.
+HeightField height_field(const Texture& h, AddressMode address) {
+  HeightField field;
+  field.width = h.width();
+  field.height = h.height();
+  field.address = address;
+  field.h.resize(std::size_t(h.width()) * std::size_t(h.height()));
+  for (int y = 0; y < h.height(); ++y)
+    for (int x = 0; x < h.width(); ++x) field.h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
+  return field;
 }
 
 }  // namespace
@@ -131,7 +144,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     const auto texture = [&](int index) { return index >= 0 ? &assets.textures[std::size_t(index)] : nullptr; };
     if (m.technique == TechniqueKind::Normal && !m.blend) {
       assets.programs.push_back(std::make_unique<NormalMappingProgram>(
-          *texture(m.layers[0].albedo), *texture(m.layers[0].normal), m.sampling, m.lighting, lights));
+          *texture(m.layers[0].albedo), *texture(m.layers[0].normal), m.sampling, m.lighting, desc.layers[0].specular, lights));
       continue;
     }
     DisplacementInputs inputs;
@@ -148,20 +161,23 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
             assets.meshes[k].blend_weights = vertex_weights(map, assets.meshes[k].uvs, desc.blend.weights.scale);
       }
     }
+    if (m.ao_map) {
+      // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
+      for (std::size_t l = 0; l < inputs.layers.size(); ++l) {
+        const HeightField field = height_field(*inputs.layers[l].height, m.sampling.address);
+        assets.derived_textures.push_back(std::make_unique<Texture>(make_mip_texture(
+            load_or_bake_ao_map(field, desc.technique.depth_scale, desc.ao, default_cache_dir()), TexelFormat::R16, false,
+            MipReduce::Box)));
+        inputs.layers[l].ao = assets.derived_textures.back().get();
+      }
+    }
     const bool bilinear_patch =
         m.technique == TechniqueKind::Qdm && desc.technique.refinement == QdmRefinement::BilinearPatch && !m.blend;
     // The exact reference of a blend needs the combined surface; it is traced for single layers only.
     const bool reference = reference_aovs && !m.blend && m.technique != TechniqueKind::Normal;
     if (reference || m.cone_map || bilinear_patch) {
       // The exact reference traces the stored heights, in fp64; cone maps are baked from the same values.
-      auto field = std::make_unique<HeightField>();
-      const Texture& h = *inputs.layers[0].height;
-      field->width = h.width();
-      field->height = h.height();
-      field->address = m.sampling.address;
-      field->h.resize(std::size_t(h.width()) * std::size_t(h.height()));
-      for (int y = 0; y < h.height(); ++y)
-        for (int x = 0; x < h.width(); ++x) field->h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
+      auto field = std::make_unique<HeightField>(height_field(*inputs.layers[0].height, m.sampling.address));
       if (m.cone_map) {
         assets.cone_maps.push_back(
             std::make_unique<ConeMap>(load_or_bake_cone_map(*field, m.cone_kind, default_cache_dir())));

@@ -27,6 +27,13 @@ public:
   BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const WeightTexture& weights,
                  const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi);
 
+  // The same surface for queries within another UV box (per-pixel weights: their maxima over that box).
+  BlendedSurface around(const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo,
+                        const simd::Float& v_hi) const {
+    if (!texture_.view) return *this;
+    return BlendedSurface(layers_, count_, op_, texture_, u_lo, u_hi, v_lo, v_hi);
+  }
+
   int width() const { return layers_[0].width(); }
   int height() const { return layers_[0].height(); }
   bool has_hierarchy() const { return layers_[0].has_hierarchy(); }

@@ -6,6 +6,9 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/study/reference.hpp"
+#include "qdmr/core/limits.hpp"
+#include "shade/ambient_occlusion.hpp"
+#include "shade/self_shadow.hpp"
 #include "shade/shading_math.hpp"
 
 namespace qdmr {
@@ -78,15 +81,21 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
                          : kBaseVaryingCount),
       cones_(inputs.cones), reference_(inputs.reference), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
-      technique_(material.technique), lighting_(material.lighting), blend_(material.blend), lights_(lights) {
+      technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
+      shadow_(material.shadow), ao_(material.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
-  for (const LayerInputs& l : inputs.layers) {
-    Layer layer{TextureView(*l.albedo), TextureView(*l.normal), std::nullopt, std::nullopt};
+  for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
+    const LayerInputs& l = inputs.layers[i];
+    Layer layer{TextureView(*l.albedo), TextureView(*l.normal), std::nullopt, std::nullopt, std::nullopt,
+                i < material.layers.size() ? material.layers[i].specular : SpecularFromAlbedo{}};
     if (l.height) layer.height.emplace(*l.height);
     if (l.height_max) layer.height_max.emplace(*l.height_max);
+    if (l.ao) layer.ao.emplace(*l.ao);
     layers_.push_back(std::move(layer));
   }
+  if (ao_.mode == AoMode::Baked && std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
+    throw Error("displacement program", "baked AO needs an AO map per layer");
   if (inputs.weights) weights_.emplace(*inputs.weights);
   if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
     throw Error("displacement program", "per-pixel blending needs a weight texture");
@@ -584,9 +593,20 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
   const Hit hit = trace(surface, setup, ds);
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
-  Float albedo[4], tangent_normal[3];
+  // Baked AO is read per layer and blended like the colours.
+  SamplerState ao_sampler = sampler_;
+  ao_sampler.filter = Filter::Bilinear;
+  const auto baked_ao = [&](const Layer& l) {
+    Float a[4];
+    sample(*l.ao, ao_sampler, hu, hv, Float(0.0f), a);
+    return a[0];
+  };
+  Float albedo[4], tangent_normal[3], specular(0.0f), ao(1.0f);
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
-    layer_colour(layers_[0].albedo, layers_[0].normal, sampler_, d, hu, hv, albedo, tangent_normal);
+    const Layer& l = layers_[0];
+    layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, albedo, tangent_normal);
+    specular = specular_from_albedo(albedo, l.specular, lighting_.specular);
+    if (l.ao) ao = baked_ao(l);
   } else {
     const int count = surface.layer_count();
     Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
@@ -598,17 +618,21 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     blend_factors(blend_.op, blend_.width, count, h, w, f);
     for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
     for (int c = 0; c < 3; ++c) tangent_normal[c] = Float(0.0f);
+    if (ao_.mode == AoMode::Baked) ao = Float(0.0f);
     for (int i = 0; i < count; ++i) {
       if (!xsimd::any(f[i] > Float(0.0f))) continue;  // a layer absent from the whole batch costs no fetch
+      const Layer& l = layers_[std::size_t(i)];
       Float a[4], n[3];
-      layer_colour(layers_[std::size_t(i)].albedo, layers_[std::size_t(i)].normal, sampler_, d, hu, hv, a, n);
+      layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, a, n);
       for (int c = 0; c < 4; ++c) albedo[c] += f[i] * a[c];
       for (int c = 0; c < 3; ++c) tangent_normal[c] += f[i] * n[c];
+      specular += f[i] * specular_from_albedo(a, l.specular, lighting_.specular);
+      if (l.ao) ao += f[i] * baked_ao(l);
     }
   }
   const TangentFrame& frame = setup.frame;
   const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0], tangent_normal[1], tangent_normal[2]}));
-  blinn_phong(shading_normal, frame.n, setup.view, albedo, lighting_, lights_, out.color);
+  light(in, setup, surface, hit, ds, albedo, specular, ao, shading_normal, out);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
@@ -621,7 +645,45 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
   if (technique_.write_depth) displaced_depth(in, d, frame, ray, hit.s, out);
 }
 
+// Self-shadowing per light and ambient occlusion at the hit, then the lighting model.
+template <class Surface>
+void DisplacementProgram::light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
+                                const Float& ds, const Float* albedo, const Float& specular, const Float& baked_ao,
+                                const Vec3& shading_normal, ShadeOutput& out) const {
+  const Ray& ray = setup.ray;
+  const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
+  const Float zero(0.0f);
+  Float visibility[limits::kMaxDirectionalLights];
+  const bool shadows = shadow_.mode != ShadowMode::Off;
+  if (shadows) {
+    const Float lod = lod_from_derivatives(*layers_[0].height, setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
+    for (std::size_t j = 0; j < lights_.directional.size(); ++j) {
+      const glm::vec3& l = lights_.directional[j].direction;
+      const Vec3 lt = setup.frame.to_tangent({Float(l.x), Float(l.y), Float(l.z)});
+      const Mask above = lt.z > zero;  // a light below the polygon leaves the whole relief in shadow
+      const Float lz = xsimd::max(lt.z, Float(1e-6f));
+      const Float du = lt.x / lz, dv = lt.y / lz;
+      const Float u1 = hu + du * hit.s, v1 = hv + dv * hit.s;
+      const Surface towards_light =
+          surface.around(xsimd::min(hu, u1), xsimd::max(hu, u1), xsimd::min(hv, v1), xsimd::max(hv, v1));
+      const ShadowResult r =
+          self_shadow(towards_light, shadow_, ShadowRay{hu, hv, hit.s, du, dv, ds}, lod, setup.active & above);
+      visibility[j] = xsimd::select(above, r.visibility, zero);
+    }
+  }
+  Float ao = baked_ao;
+  if (ao_.mode == AoMode::Frame) {
+    const Float radius(ao_.radius);
+    ao = ambient_occlusion(surface.around(hu - radius, hu + radius, hv - radius, hv + radius), ao_, hu, hv, hit.s, ds,
+                           in.pixel_x, in.pixel_y, setup.active);
+  }
+  if (ao_.mode != AoMode::Off) ao = apply_ao_strength(ao, ao_.strength);
+  shade_lights(shading_normal, setup.frame.n, setup.view, SurfaceSample{albedo, specular, ao},
+               shadows ? visibility : nullptr, lighting_, lights_, out.color);
+}
+
 void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
+
   const Float& u = in.varyings[kU];
   const Float& v = in.varyings[kV];
   Setup setup;

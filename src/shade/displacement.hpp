@@ -11,6 +11,7 @@
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
 #include "shade/lighting.hpp"
+#include "shade/lighting_models.hpp"
 #include "shade/program.hpp"
 #include "shade/shading_math.hpp"
 #include "texture/sampler.hpp"
@@ -22,6 +23,7 @@ struct LayerInputs {
   const Texture* normal = nullptr;      // RGBA8, 0.5 + 0.5 n
   const Texture* height = nullptr;      // box-filtered heights (techniques, height blending)
   const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
+  const Texture* ao = nullptr;          // baked AO of this layer's heights (R16), when the material bakes AO
 };
 
 struct DisplacementInputs {
@@ -51,7 +53,8 @@ public:
 private:
   struct Layer {
     TextureView albedo, normal;
-    std::optional<TextureView> height, height_max;
+    std::optional<TextureView> height, height_max, ao;
+    SpecularFromAlbedo specular;
   };
   // What shade() computes before the surface is known: the frame, the ray and the depth scale.
   struct Setup;
@@ -79,6 +82,10 @@ private:
                              simd::Float& iterations, simd::Mask active) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
                        const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
+  template <class Surface>
+  void light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
+             const simd::Float* albedo, const simd::Float& specular, const simd::Float& baked_ao,
+             const shading::Vec3& shading_normal, ShadeOutput& out) const;
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
 
@@ -93,6 +100,8 @@ private:
   TechniqueDesc technique_;
   LightingDesc lighting_;
   BlendDesc blend_;
+  ShadowDesc shadow_;
+  AoDesc ao_;
   LightRig lights_;
 };
 

@@ -25,6 +25,10 @@ public:
 
   int width() const { return height_->texture().width(); }
   int height() const { return height_->texture().height(); }
+  // The surface for queries within a UV box (blended surfaces bound their weights over it; one layer has none).
+  SingleLayerSurface around(const simd::Float&, const simd::Float&, const simd::Float&, const simd::Float&) const {
+    return *this;
+  }
   bool has_hierarchy() const { return quadtree_ != nullptr; }
   int top_level() const { return quadtree_ ? quadtree_->levels() - 1 : 0; }
   const SamplerState& sampler() const { return sampler_; }

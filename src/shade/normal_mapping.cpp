@@ -1,5 +1,6 @@
 #include "shade/normal_mapping.hpp"
 
+#include "shade/lighting_models.hpp"
 #include "shade/shading_math.hpp"
 
 namespace qdmr {
@@ -19,7 +20,9 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),
                                                         tangent_normal[1] * Float(2.0f) - Float(1.0f),
                                                         tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
-  blinn_phong(shading_normal, frame.n, view_vector(in, lights_), albedo, lighting_, lights_, out.color);
+  shade_lights(shading_normal, frame.n, view_vector(in, lights_),
+               SurfaceSample{albedo, specular_from_albedo(albedo, specular_, lighting_.specular), Float(1.0f)}, nullptr,
+               lighting_, lights_, out.color);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;

@@ -1,6 +1,6 @@
 #pragma once
-// The first shading program: albedo with tangent-space normal mapping, Blinn-Phong from directional
-// lights plus ambient.
+// The first shading program: albedo with tangent-space normal mapping, lit by the material's lighting model
+// (lighting_models.hpp) from directional lights plus ambient.
 #include "shade/lighting.hpp"
 #include "shade/program.hpp"
 #include "texture/sampler.hpp"
@@ -11,9 +11,9 @@ class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
   NormalMappingProgram(const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
-                       const LightingDesc& lighting, const LightRig& lights)
+                       const LightingDesc& lighting, const SpecularFromAlbedo& specular, const LightRig& lights)
       : albedo_(albedo), normal_(normal), sampler_(SamplerState::from(sampling)), lod_mode_(sampling.lod),
-        lighting_(lighting), lights_(lights) {}
+        lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
 
 private:
@@ -21,6 +21,7 @@ private:
   SamplerState sampler_;
   LodMode lod_mode_;
   LightingDesc lighting_;
+  SpecularFromAlbedo specular_;
   LightRig lights_;
 };
 

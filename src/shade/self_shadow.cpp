@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <limits>
 
+#include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
 
 namespace qdmr {
@@ -264,5 +265,7 @@ ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const S
 
 template ShadowResult self_shadow<SingleLayerSurface>(const SingleLayerSurface&, const ShadowDesc&, const ShadowRay&,
                                                       const Float&, Mask);
+template ShadowResult self_shadow<BlendedSurface>(const BlendedSurface&, const ShadowDesc&, const ShadowRay&,
+                                                 const simd::Float&, simd::Mask);
 
 }  // namespace qdmr
