@@ -4,7 +4,7 @@
 // with n.l_i = max(dot(shading normal, l_i), 0) and spec_i gated to 0 when the light is below the polygon
 // (dot(geometric normal, l_i) <= 0). The diffuse term is Lambert with the 1/pi folded into the radiance
 // (radiance 1 head-on lights a white surface to 1), so both specular terms carry the same factor pi.
-//   Blinn-Phong:   spec = max(n.h, 0)^shininess * specular * min(8 n.l, 1)    (exactly shading::blinn_phong)
+//   Blinn-Phong:   spec = max(n.h, 0)^shininess * specular * min(8 n.l, 1)    (as the programs computed it before Cook-Torrance)
 //   Cook-Torrance: spec = pi * D * Vis * F * n.l, the GGX microfacet BRDF with
 //     alpha = roughness^2, D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2),
 //     Vis = G / (4 n.l n.v) = 0.5 / (n.l sqrt((n.v)^2 (1 - alpha^2) + alpha^2) + n.v sqrt((n.l)^2 (1 - alpha^2) + alpha^2))

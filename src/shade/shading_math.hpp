@@ -1,6 +1,6 @@
 #pragma once
 // Vector algebra on batches and the steps every shading program shares: the tangent frame from the
-// varyings, UV derivatives, and Blinn-Phong lighting. Lane-wise IEEE only, so SSE and AVX2 agree.
+// varyings and UV derivatives (lighting: lighting_models.hpp). Lane-wise IEEE only, so SSE and AVX2 agree.
 #include "core/det_math.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
@@ -57,28 +57,6 @@ inline Vec3 view_vector(const Fragments& in, const LightRig& lights) {
   return normalize({Float(lights.camera_position.x) - in.varyings[kWorldX],
                     Float(lights.camera_position.y) - in.varyings[kWorldY],
                     Float(lights.camera_position.z) - in.varyings[kWorldZ]});
-}
-
-// Blinn-Phong from the rig's directional lights plus ambient; `geometric` gates highlights below the polygon.
-inline void blinn_phong(const Vec3& shading_normal, const Vec3& geometric, const Vec3& view, const Float* albedo,
-                        const LightingDesc& lighting, const LightRig& lights, Float* color) {
-  Float diffuse[3] = {Float(lights.ambient.x), Float(lights.ambient.y), Float(lights.ambient.z)};
-  Float specular[3] = {Float(0.0f), Float(0.0f), Float(0.0f)};
-  const Float zero(0.0f);
-  for (const auto& light : lights.directional) {
-    const Vec3 l{Float(light.direction.x), Float(light.direction.y), Float(light.direction.z)};
-    const Float n_dot_l = xsimd::max(dot(shading_normal, l), zero);
-    const Vec3 h = normalize(add(l, view));
-    const Float facing = xsimd::select(dot(geometric, l) > zero, Float(1.0f), zero);
-    const Float spec = detmath::pow(xsimd::max(dot(shading_normal, h), zero), Float(lighting.shininess)) *
-                       Float(lighting.specular) * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
-    const float radiance[3] = {light.radiance.x, light.radiance.y, light.radiance.z};
-    for (int c = 0; c < 3; ++c) {
-      diffuse[c] += n_dot_l * Float(radiance[c]);
-      specular[c] += spec * Float(radiance[c]);
-    }
-  }
-  for (int c = 0; c < 3; ++c) color[c] = albedo[c] * diffuse[c] + specular[c];
 }
 
 }  // namespace qdmr::shading
