@@ -186,6 +186,32 @@ TEST_F(CliBadInput, BadSetPointer) {
   expect_refused(render_args({"--set", "/sky/color=1"}), {"scene.json: /: unknown key 'sky'"});
 }
 
+// What only preparing the material can tell: the textures' sizes and what a technique can march.
+TEST_F(CliBadInput, BlendedLayers) {
+  const std::string second = R"(/materials/rock/layers/-={"height": {"procedural": "noise", "size": 32}})";
+  expect_refused(render_args({"--set", "/materials/rock/technique/name=qdm", "--set", second}),
+                 {"scene.json: /materials/rock/layers/1/height: blended layers need height maps of one size: layer 0 is "
+                  "64x64, this one 32x32"});
+  const std::string same = R"(/materials/rock/layers/-={"height": {"procedural": "noise", "size": 64}})";
+  expect_refused(render_args({"--set", "/materials/rock/technique/name=csm", "--set", same}),
+                 {"scene.json: /materials/rock/technique/name: 'csm' needs a cone map of one height map and cannot march "
+                  "blended layers (use relief, pom or qdm)"});
+  expect_refused(render_args({"--set", "/materials/rock/technique/name=pom", "--set", same, "--set",
+                              "/materials/rock/blend/weights/resolution=100"}),
+                 {"scene.json: /materials/rock/blend/weights/resolution: must be a power of two, got 100"});
+  expect_refused(render_args({"--set", "/materials/rock/layers/-={}", "--set", "/materials/rock/blend/operator=height"}),
+                 {"scene.json: /materials/rock/layers/1/height: height blending needs a height map in every layer"});
+  expect_refused(render_args({"--set", "/materials/rock/layers/-={}", "--set", "/materials/rock/blend/weights/source=file",
+                              "--set", "/materials/rock/blend/weights/file=weights.png"}),
+                 {"scene.json: /materials/rock/blend/weights/file: file not found: " + (dir_ / "weights.png").string()});
+}
+
+TEST_F(CliBadInput, QuadtreeForShadowsNeedsPowerOfTwo) {
+  expect_refused(render_args({"--set", "/materials/rock/layers/0/height/size=48", "--set", "/materials/rock/technique/name=pom",
+                              "--set", "/materials/rock/shadow/mode=qdm_soft"}),
+                 {"scene.json: /materials/rock/layers/0/height/size"});
+}
+
 TEST_F(CliBadInput, UnsupportedOutputType) {
   const fs::path jpg = out_ / "image.jpg";
   expect_refused({"render", scene_.string(), "-o", jpg.string()},
