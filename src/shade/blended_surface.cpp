@@ -25,6 +25,7 @@ SamplerState weight_sampler(const SamplerState& layer) {
 BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const Float* w)
     : layers_(layers), count_(count), op_(op) {
   for (int i = 0; i < kMaxLayers; ++i) weights_[i] = i < count ? w[i] : Float(0.0f);
+  find_present();
 }
 
 BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const WeightTexture& weights,
@@ -33,6 +34,14 @@ BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, Blen
   // Half a layer texel of padding: box-surface queries read the weights at texel centres.
   const Float pad_u(0.5f / float(width())), pad_v(0.5f / float(height()));
   bound_weights(u_lo - pad_u, u_hi + pad_u, v_lo - pad_v, v_hi + pad_v, weights_);
+  find_present();
+}
+
+// A layer whose weight is 0 in every lane adds nothing to either operator: its heights are not fetched.
+void BlendedSurface::find_present() {
+  present_ = 0;
+  for (int i = 0; i < count_; ++i)
+    if (xsimd::any(weights_[i] > Float(0.0f))) present_ |= 1u << i;
 }
 
 // The largest weight of each layer that bilinear sampling can return inside the box: the maximum over the weight
@@ -97,7 +106,7 @@ Float BlendedSurface::combine(const Float* h, const Float* w) const {
 
 Float BlendedSurface::height(const Float& u, const Float& v, const Float& lod) const {
   Float h[kMaxLayers], w[kMaxLayers];
-  for (int i = 0; i < count_; ++i) h[i] = layers_[i].height(u, v, lod);
+  for (int i = 0; i < count_; ++i) h[i] = present(i) ? layers_[i].height(u, v, lod) : Float(0.0f);
   weights_at(u, v, w);
   return combine(h, w);
 }
@@ -116,7 +125,7 @@ Float BlendedSurface::bound(const Float* hmax, const Float* wmax) const {
 
 Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) const {
   Float hmax[kMaxLayers];
-  for (int i = 0; i < count_; ++i) hmax[i] = layers_[i].cell_max(level, cx, cy);
+  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].cell_max(level, cx, cy) : Float(0.0f);
   if (!texture_.view) return bound(hmax, weights_);
   // Per pixel: the weights' maxima over the cell (from the weight texture's max chain), within those over the
   // batch's query box — "QDM1 * QDM2", each cell bounded by its own maxima.
@@ -141,9 +150,15 @@ Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) c
   return result;
 }
 
+Float BlendedSurface::max_height() const {
+  Float hmax[kMaxLayers];
+  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].max_height() : Float(0.0f);
+  return bound(hmax, weights_);
+}
+
 Float BlendedSurface::cell_max_filtered(const Float& u, const Float& v, const Float& level) const {
   Float hmax[kMaxLayers];
-  for (int i = 0; i < count_; ++i) hmax[i] = layers_[i].cell_max_filtered(u, v, level);
+  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].cell_max_filtered(u, v, level) : Float(0.0f);
   return bound(hmax, weights_);
 }
 

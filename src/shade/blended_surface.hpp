@@ -45,6 +45,8 @@ public:
 
   simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const;
   simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
+  // The highest height anywhere the batch's queries go.
+  simd::Float max_height() const;
   simd::Float cell_max_filtered(const simd::Float& u, const simd::Float& v, const simd::Float& level) const;
 
   // The layer weights at (u, v): the vertex weights, or the weight texture sampled bilinearly.
@@ -57,12 +59,15 @@ private:
   void bound_weights(const simd::Float& u_lo, const simd::Float& u_hi, const simd::Float& v_lo, const simd::Float& v_hi,
                      simd::Float* w) const;
   simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
+  void find_present();
+  bool present(int i) const { return (present_ >> i) & 1u; }
 
   const SingleLayerSurface* layers_;
   int count_;
   BlendOperator op_;
   WeightTexture texture_;        // view == nullptr: per-vertex weights
   simd::Float weights_[kMaxLayers];  // per-vertex: the weights; per-pixel: their maxima over the query box
+  unsigned present_ = 0;             // bit i: layer i has weight in some lane
 };
 
 }  // namespace qdmr

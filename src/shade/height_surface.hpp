@@ -54,6 +54,9 @@ public:
     return texel[0];
   }
 
+  // The highest height anywhere (a bound for early exits).
+  simd::Float max_height() const { return cell_max(simd::Int(top_level()), simd::Int(0), simd::Int(0)); }
+
   // LinearMipMapLinear over the max chain at (u, v) on `level` (the talk: "possible but may introduce some
   // artifacts"): smooths the maxima, so it is not conservative.
   simd::Float cell_max_filtered(const simd::Float& u, const simd::Float& v, const simd::Float& level) const {

@@ -87,6 +87,20 @@ void climb_aligned(Int& level, Int& cx, Int& cy, IntMask climbing, const IntMask
 }
 
 // Hard: the first texel after the start texel that the rising ray enters below its top (see the header).
+// The traversals work in the texel space of the repeat holding the start (exact and small numbers); cells are
+// addressed in absolute indices, since a blended surface's weights do not repeat with the layers' heights.
+struct RepeatOrigin {
+  Int base_x, base_y;  // first texel of the start's repeat
+  RepeatOrigin(const Prepared& p, int width, int height) {
+    const Float limit(float((1 << 30) / std::max(width, height)));
+    base_x = xsimd::to_int(xsimd::max(xsimd::min(xsimd::floor(p.u), limit), Float(0.0f) - limit)) * Int(width);
+    base_y = xsimd::to_int(xsimd::max(xsimd::min(xsimd::floor(p.v), limit), Float(0.0f) - limit)) * Int(height);
+  }
+  // Cell c of `level` in the start's repeat (sizes are powers of two: the repeat's first cell is base >> level).
+  Int x(const Int& level, const Int& c) const { return (base_x >> level) + c; }
+  Int y(const Int& level, const Int& c) const { return (base_y >> level) + c; }
+};
+
 template <class Surface>
 ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared& p) {
   const int top = surface.top_level();
@@ -95,6 +109,7 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   // Texel space, the start wrapped into the first repeat (exact: u - floor(u) loses no bits, sizes are
   // powers of two in the quadtree and scale exactly).
   const Float x0 = (p.u - xsimd::floor(p.u)) * width, y0 = (p.v - xsimd::floor(p.v)) * height;
+  const RepeatOrigin origin(p, surface.width(), surface.height());
   const Float dx = p.du * width, dy = p.dv * height;  // texels per unit of depth climbed
   const IntMask step_x_pos = int_mask(dx > zero), step_y_pos = int_mask(dy > zero);
   const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
@@ -117,13 +132,13 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   // (one fetch per batch, not counted: a per-material constant), else the polygon.
   Float floor_depth = zero;
   if ((1 << top) >= std::max(surface.width(), surface.height()))
-    floor_depth = p.ds * (Float(1.0f) - surface.cell_max(Int(top), Int(0), Int(0)));
+    floor_depth = p.ds * (Float(1.0f) - surface.max_height());
 
   Mask active = p.active & !along_wall & !(p.s - c <= floor_depth);
   Mask occluded = zero != zero;
   CappedLoop loop{Int(desc.max_iterations)};
   while (loop.next(active)) {
-    const Float top_depth = p.ds * (Float(1.0f) - surface.cell_max(level, cx, cy));
+    const Float top_depth = p.ds * (Float(1.0f) - surface.cell_max(level, origin.x(level, cx), origin.y(level, cy)));
     // A rising ray is lowest where it enters the cell, at c.
     const Mask below = active & (p.s - c > top_depth);
     const Mask hit = below & float_mask(level == Int(0));
@@ -225,6 +240,7 @@ ShadowResult qdm_soft(const Surface& surface, const ShadowDesc& desc, const Prep
   const Float zero(0.0f);
   const Float width(float(surface.width())), height(float(surface.height()));
   const Float x0 = (p.u - xsimd::floor(p.u)) * width, y0 = (p.v - xsimd::floor(p.v)) * height;
+  const RepeatOrigin origin(p, surface.width(), surface.height());
   const Float dx = p.du * width, dy = p.dv * height;
   const Float texels_per_climb = xsimd::sqrt(dx * dx + dy * dy);  // 0 (light overhead): every tap at c = inf
   const Float c_max = shadow_reach(desc, p);
@@ -238,7 +254,8 @@ ShadowResult qdm_soft(const Surface& surface, const ShadowDesc& desc, const Prep
     const Float px = xsimd::min(xsimd::max(xsimd::select(taken, x0 + dx * c, zero), Float(0.0f) - bound), bound);
     const Float py = xsimd::min(xsimd::max(xsimd::select(taken, y0 + dy * c, zero), Float(0.0f) - bound), bound);
     const Int level(k);
-    const Float hmax = surface.cell_max(level, xsimd::to_int(xsimd::floor(px)) >> k, xsimd::to_int(xsimd::floor(py)) >> k);
+    const Float hmax = surface.cell_max(level, origin.x(level, xsimd::to_int(xsimd::floor(px)) >> k),
+                                        origin.y(level, xsimd::to_int(xsimd::floor(py)) >> k));
     const Float occ = occlusion(p, c, p.ds * (Float(1.0f) - hmax), desc.penumbra);
     profile.add(taken, Float(desc.tap_weights[std::size_t(k)]) * occ);
   }
