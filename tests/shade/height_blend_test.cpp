@@ -8,6 +8,7 @@
 #include <random>
 
 #include "displacement_test_util.hpp"
+#include "shade/self_shadow.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {
@@ -288,6 +289,84 @@ TEST(HeightBlend, VertexWeightsFloatAtHighDepthScalePixelWeightsDoNot) {
       EXPECT_LT(vertex_mean, 0.1);  // ... and negligible at low depth scale (measured 0.008 texels)
     }
   }
+}
+
+}  // namespace
+}  // namespace qdmr::test
+
+namespace qdmr::test {
+namespace {
+
+// Self-shadowing over a blend reads the weights where the light ray is, in whichever texture repeat: the hard
+// shadow over a per-pixel blend whose weights span two repeats equals the exact visibility of the combined box
+// surface over those two repeats, for starts in both.
+TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
+  const int n = 16;
+  std::vector<Image> heights;
+  for (int i = 0; i < kLayers; ++i) heights.push_back(random_heights(n, 500u + std::uint32_t(i)));
+  // Weights over two repeats at one weight texel per layer texel: bilinear weights at a layer texel's centre are
+  // the stored ones, so the combined surface is max_i(w_i h_i) texel by texel.
+  const Texture weights = make_mip_texture(random_weights(2 * n, 77), TexelFormat::RGBA8, false, MipReduce::Max);
+  std::vector<Texture> box, maxima;
+  for (const Image& h : heights) {
+    box.push_back(make_mip_texture(h, TexelFormat::R32F, false, MipReduce::Box));
+    maxima.push_back(make_mip_texture(h, TexelFormat::R32F, false, MipReduce::Max));
+  }
+  std::vector<TextureView> box_views, max_views;
+  for (int i = 0; i < kLayers; ++i) {
+    box_views.emplace_back(box[std::size_t(i)]);
+    max_views.emplace_back(maxima[std::size_t(i)]);
+  }
+  SamplerState sampler;
+  sampler.filter = Filter::Point;
+  std::vector<SingleLayerSurface> layers;
+  for (int i = 0; i < kLayers; ++i) layers.emplace_back(box_views[std::size_t(i)], &max_views[std::size_t(i)], sampler, HeightFetch::Point);
+  const TextureView weight_view(weights);
+
+  HeightField field;  // the two repeats, as one map
+  field.width = field.height = 2 * n;
+  for (int y = 0; y < 2 * n; ++y)
+    for (int x = 0; x < 2 * n; ++x) {
+      float top = 0.0f;
+      for (int i = 0; i < kLayers; ++i) top = std::max(top, weights.texel(0, x, y, i) * heights[std::size_t(i)].at(x % n, y % n, 0));
+      field.h.push_back(top);
+    }
+  const double ds = 0.2;
+  ShadowDesc desc;
+  desc.mode = ShadowMode::Hard;
+  desc.max_iterations = 1 << 12;
+  int checked = 0, wrong = 0;
+  for (double elevation : {60.0, 25.0, 10.0})
+    for (int a = 0; a < 8; ++a) {
+      const double azimuth = 2.0 * std::numbers::pi * (a + 0.3) / 8.0, slope = 1.0 / std::tan(elevation * std::numbers::pi / 180.0);
+      const double du = slope * std::cos(azimuth) * (1.0 / n) * 4.0, dv = slope * std::sin(azimuth) * (1.0 / n) * 4.0;
+      for (int first = 0; first < 4 * n * n; first += simd::kLanes) {
+        alignas(64) float u[simd::kLanes], v[simd::kLanes], s[simd::kLanes];
+        for (int l = 0; l < simd::kLanes; ++l) {
+          const int k = first + l, x = k % (2 * n), y = k / (2 * n);
+          u[l] = (float(x) + 0.5f) / float(n);  // UV of the blend: two repeats
+          v[l] = (float(y) + 0.5f) / float(n);
+          s[l] = float(ds * (1.0 - field.h[std::size_t(k)]));  // on the top face of its texel
+        }
+        const simd::Float fu = simd::Float::load_aligned(u), fv = simd::Float::load_aligned(v), fs = simd::Float::load_aligned(s);
+        const simd::Float fdu = simd::Float(static_cast<float>(du)), fdv = simd::Float(static_cast<float>(dv));
+        const simd::Float u1 = fu + fdu * fs, v1 = fv + fdv * fs;
+        const BlendedSurface surface(layers.data(), kLayers, BlendOperator::Height, WeightTexture{&weight_view, 2.0f},
+                                     xsimd::min(fu, u1), xsimd::max(fu, u1), xsimd::min(fv, v1), xsimd::max(fv, v1));
+        const ShadowResult r = self_shadow(surface, desc, ShadowRay{fu, fv, fs, fdu, fdv, simd::Float(float(ds))}, simd::Float(0.0f),
+                                           simd::Float(0.0f) == simd::Float(0.0f));
+        alignas(64) float vis[simd::kLanes];
+        r.visibility.store_aligned(vis);
+        for (int l = 0; l < simd::kLanes; ++l) {
+          // The combined map spans two repeats, so its UV is half the blend's.
+          const LightVisibility ref =
+              light_visibility(field, ds, {u[l] * 0.5, v[l] * 0.5, double(s[l])}, {du * 0.5, dv * 0.5});
+          ++checked;
+          if ((vis[l] > 0.5f) != ref.visible) ++wrong;
+        }
+      }
+    }
+  EXPECT_EQ(wrong, 0) << "of " << checked << " starts";
 }
 
 }  // namespace
