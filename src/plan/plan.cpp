@@ -324,7 +324,7 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
     const int w = material.ao.resolution > 0 ? material.ao.resolution : h.width;
     const int hh = material.ao.resolution > 0 ? material.ao.resolution : h.height;
     plan.ao_map = true;
-    plan.ao_bytes = chain_bytes(w, hh, TexelFormat::R16);
+    plan.ao_bytes = chain_bytes(w, hh, TexelFormat::R16) * layer_count;  // one map per layer (same sizes)
   }
   if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm) {
     // Cones of the stored heights' level 0 (the box surface); the box-filtered chain serves the refinement.
@@ -380,7 +380,7 @@ std::string FramePlan::describe() const {
       s << "    blend weights: " << (m.weight_mode == WeightMode::Vertex ? "per vertex (interpolated)"
                                                                          : "per pixel, weight texture " + mib(m.weight_bytes))
         << "\n";
-    if (m.ao_map) s << "    ao: baked map, " << mib(m.ao_bytes) << ", baked or from cache\n";
+    if (m.ao_map) s << "    ao: baked map per layer, " << mib(m.ao_bytes) << ", baked or from cache\n";
     if (m.cone_map)
       s << "    cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes) << "\n";
   }

@@ -2,6 +2,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cmath>
+
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/height_texture.hpp"
@@ -150,6 +152,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     DisplacementInputs inputs;
     for (const LayerPlan& l : m.layers)
       inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max)});
+    const bool reference = reference_aovs && m.technique != TechniqueKind::Normal;
     if (m.blend) {
       const Image map = make_weight_map(desc.blend.weights, int(desc.layers.size()), file + ": /materials/" + desc.name + "/blend/weights");
       if (m.weight_mode == WeightMode::Pixel) {
@@ -159,6 +162,27 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         for (std::size_t k = 0; k < objects; ++k)
           if (assets.object_material[k] == i && !scene.objects[k].material.empty())
             assets.meshes[k].blend_weights = vertex_weights(map, assets.meshes[k].uvs, desc.blend.weights.scale);
+      }
+      if (reference) {
+        // The exact reference is the blend with per-pixel weights (so per-vertex errors show the floating).
+        const float scale = desc.blend.weights.scale;
+        const std::string where = file + ": /materials/" + desc.name + "/blend/weights/scale";
+        if (scale != std::floor(scale)) throw Error(where, "error AOVs of a blend need a whole number of repeats");
+        const Texture* weights = inputs.weights;
+        if (!weights) {
+          assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(map, desc.blend.weights.resolution)));
+          weights = assets.derived_textures.back().get();
+        }
+        std::vector<const Texture*> heights;
+        for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
+        const std::uint64_t texels = std::uint64_t(heights[0]->width()) * heights[0]->height() * std::uint64_t(scale * scale);
+        if (texels > (1ull << 26))
+          throw Error(where, "error AOVs of this blend need a reference of " + std::to_string(texels) +
+                                 " texels (the layers' size times scale squared), more than 2^26");
+        auto field = std::make_unique<HeightField>(combined_surface(heights, *weights, int(scale), desc.blend.op));
+        inputs.reference = field.get();
+        inputs.reference_scale = int(scale);
+        assets.reference_fields.push_back(std::move(field));
       }
     }
     if (m.ao_map) {
@@ -173,9 +197,8 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     }
     const bool bilinear_patch =
         m.technique == TechniqueKind::Qdm && desc.technique.refinement == QdmRefinement::BilinearPatch && !m.blend;
-    // The exact reference of a blend needs the combined surface; it is traced for single layers only.
-    const bool reference = reference_aovs && !m.blend && m.technique != TechniqueKind::Normal;
-    if (reference || m.cone_map || bilinear_patch) {
+    const bool single_reference = reference && !m.blend;
+    if (single_reference || m.cone_map || bilinear_patch) {
       // The exact reference traces the stored heights, in fp64; cone maps are baked from the same values.
       auto field = std::make_unique<HeightField>(height_field(*inputs.layers[0].height, m.sampling.address));
       if (m.cone_map) {
@@ -190,8 +213,8 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         inputs.layers[0].height_max = assets.derived_textures.back().get();
         inputs.surface = field.get();
       }
-      if (reference) inputs.reference = field.get();
-      if (reference || bilinear_patch) assets.reference_fields.push_back(std::move(field));
+      if (single_reference) inputs.reference = field.get();
+      if (single_reference || bilinear_patch) assets.reference_fields.push_back(std::move(field));
     }
     assets.programs.push_back(std::make_unique<DisplacementProgram>(inputs, desc, lights));
   }

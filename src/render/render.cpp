@@ -98,6 +98,31 @@ void validate_options(const RenderOptions& options) {
                               std::to_string(limits::kMaxTileSize) + ", got " + std::to_string(options.tile_size));
 }
 
+namespace {
+
+// The error AOVs summarised over the pixels some triangle covers (depth below the clear value), in pixel order.
+void summarise_reference(const Framebuffer& fb, RenderStats& stats) {
+  const PixelBuffer& error = fb.aov[std::size_t(Aov::ErrorTexels)];
+  const PixelBuffer& missed = fb.aov[std::size_t(Aov::Missed)];
+  if (error.empty() && missed.empty()) return;
+  stats.reference = true;
+  double error_sum = 0.0, missed_sum = 0.0;
+  for (std::size_t i = 0; i < fb.depth.size(); ++i) {
+    if (!(fb.depth[i] < 1.0f)) continue;
+    ++stats.reference_pixels;
+    if (!error.empty()) {
+      error_sum += error[i];
+      stats.error_texels_max = std::max(stats.error_texels_max, double(error[i]));
+    }
+    if (!missed.empty()) missed_sum += missed[i];
+  }
+  if (stats.reference_pixels == 0) return;
+  stats.error_texels_mean = error_sum / double(stats.reference_pixels);
+  stats.missed_fraction = missed_sum / double(stats.reference_pixels);
+}
+
+}  // namespace
+
 nlohmann::json RenderStats::to_json() const {
   nlohmann::json j;
   j["time_ms"] = {{"load", load_ms},         {"prepare", prepare_ms},          {"geometry", geometry_ms},
@@ -111,6 +136,9 @@ nlohmann::json RenderStats::to_json() const {
                   {"pixels_depth_failed", pixels_depth_failed}, {"simd_lanes", simd_lanes}, {"simd_arch", simd_arch}};
   j["iterations"] = {{"mean", iterations_mean}, {"p99", iterations_p99}, {"max", iterations_max},
                      {"lane_utilisation", lane_utilisation}};
+  if (reference)
+    j["reference"] = {{"pixels", reference_pixels}, {"error_texels_mean", error_texels_mean},
+                      {"error_texels_max", error_texels_max}, {"missed_fraction", missed_fraction}};
   j["threads"] = threads;
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes},
                  {"mesh_bytes", mesh_bytes}, {"peak_rss_bytes", peak_rss_bytes}};
@@ -230,6 +258,7 @@ Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
     if (total.iterations_executed > 0)
       stats.lane_utilisation = double(total.iterations_useful) / double(total.iterations_executed);
 
+    summarise_reference(fb, stats);
     frame.width = fb.width;
     frame.height = fb.height;
     frame.color = std::move(fb.color);

@@ -79,7 +79,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     : ShadingProgram(inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      cones_(inputs.cones), reference_(inputs.reference), surface_(inputs.surface),
+      cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
@@ -480,11 +480,13 @@ void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, cons
   for (int l = 0; l < kLanes; ++l) {
     error[l] = missed[l] = 0.0f;
     if (!((lanes >> l) & 1u)) continue;
-    const SurfaceRay r{{u0[l], v0[l], 0.0}, {du[l], dv[l], 1.0}};
+    // The reference may span several texture repeats (a blend's weights): its UV is the layers' / scale.
+    const double k = 1.0 / reference_scale_;
+    const SurfaceRay r{{u0[l] * k, v0[l] * k, 0.0}, {du[l] * k, dv[l] * k, 1.0}};
     const ReferenceHit ref = intersect_reference(*reference_, depth[l], r, surface, 1 << 16);
     if (!ref.hit) continue;
-    const double eu = (double(u0[l]) + double(du[l]) * s[l] - ref.point.x) * reference_->width;
-    const double ev = (double(v0[l]) + double(dv[l]) * s[l] - ref.point.y) * reference_->height;
+    const double eu = ((double(u0[l]) + double(du[l]) * s[l]) * k - ref.point.x) * reference_->width;
+    const double ev = ((double(v0[l]) + double(dv[l]) * s[l]) * k - ref.point.y) * reference_->height;
     error[l] = float(std::sqrt(eu * eu + ev * ev));
     missed[l] = error[l] > 1.0f ? 1.0f : 0.0f;
   }

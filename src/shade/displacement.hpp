@@ -31,6 +31,7 @@ struct DisplacementInputs {
   const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
   const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
+  int reference_scale = 1;                // texture repeats the reference spans (a blend's combined surface)
   // qdm with bilinear-patch refinement: the fp64 heights solved exactly, and height_max built from
   // bilinear_upper_bound() of them (conservative for the bilinear surface).
   const HeightField* surface = nullptr;
@@ -93,6 +94,7 @@ private:
   std::optional<TextureView> weights_;
   const ConeMap* cones_;
   const HeightField* reference_;
+  int reference_scale_;
   const HeightField* surface_;
   SamplerState sampler_;
   LodMode lod_mode_;

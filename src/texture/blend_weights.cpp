@@ -137,4 +137,35 @@ std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::v
   return out;
 }
 
+HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
+                             BlendOperator op) {
+  const int w = heights[0]->width(), h = heights[0]->height();
+  const int rw = weights.width(), rh = weights.height();
+  HeightField field;
+  field.width = w * scale;
+  field.height = h * scale;
+  field.h.resize(std::size_t(field.width) * std::size_t(field.height));
+  const auto weight = [&](int x, int y, int c) { return double(weights.texel(0, ((x % rw) + rw) % rw, ((y % rh) + rh) % rh, c)); };
+  for (int y = 0; y < field.height; ++y)
+    for (int x = 0; x < field.width; ++x) {
+      // Bilinear weights at the texel centre: weight-texture coordinates of (x + 0.5) / (w scale).
+      const double wx = (x + 0.5) / field.width * rw - 0.5, wy = (y + 0.5) / field.height * rh - 0.5;
+      const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
+      const double fx = wx - x0, fy = wy - y0;
+      double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
+      for (std::size_t i = 0; i < heights.size(); ++i) {
+        const int c = int(i);
+        const double wi = (weight(x0, y0, c) * (1 - fx) + weight(x0 + 1, y0, c) * fx) * (1 - fy) +
+                          (weight(x0, y0 + 1, c) * (1 - fx) + weight(x0 + 1, y0 + 1, c) * fx) * fy;
+        const double hi = heights[i]->texel(0, x % w, y % h, 0);
+        top = std::max(top, wi * hi);
+        sum_wh += wi * hi;
+        sum_w += wi;
+      }
+      field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] =
+          op == BlendOperator::Alpha ? (sum_w > 0.0 ? sum_wh / sum_w : 0.0) : top;
+    }
+  return field;
+}
+
 }  // namespace qdmr

@@ -9,6 +9,7 @@
 
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/image.hpp"
+#include "qdmr/study/heightfield.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
@@ -25,5 +26,11 @@ Texture make_weight_texture(const Image& map, int resolution);
 
 // Per-vertex weights: the map sampled bilinearly (wrapping) at uv / scale.
 std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::vec2>& uvs, float scale);
+
+// The box surface of a blend with per-pixel weights (BlendedSurface's level 0) over the `scale` texture repeats
+// the weight texture spans, in fp64, for the exact reference: texel (x, y) combines the layers' level-0 texel
+// (x mod W, y mod H) with the weights sampled bilinearly at its centre. `scale` is a whole number of repeats.
+HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
+                             BlendOperator op);
 
 }  // namespace qdmr

@@ -62,6 +62,10 @@ struct RenderStats {
   // Intersection iterations per written pixel (0 for normal mapping); p99 and max from a histogram capped at
   // 1024 (a max of 1024 means "1024 or more"). Lane utilisation: useful lane-iterations / executed ones.
   double iterations_mean = 0, iterations_p99 = 0, iterations_max = 0, lane_utilisation = 1;
+  // Against the exact reference, over the covered pixels, when the error_texels or missed AOV is rendered.
+  bool reference = false;
+  std::uint64_t reference_pixels = 0;
+  double error_texels_mean = 0, error_texels_max = 0, missed_fraction = 0;
   int threads = 0, tile_size = 0, simd_lanes = 0;
   std::string simd_arch;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
