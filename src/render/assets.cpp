@@ -155,24 +155,27 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     const bool reference = reference_aovs && m.technique != TechniqueKind::Normal;
     if (m.blend) {
       const Image map = make_weight_map(desc.blend.weights, int(desc.layers.size()), file + ": /materials/" + desc.name + "/blend/weights");
-      if (m.weight_mode == WeightMode::Pixel) {
-        assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(map, desc.blend.weights.resolution)));
-        inputs.weights = assets.derived_textures.back().get();
-      } else {
-        for (std::size_t k = 0; k < objects; ++k)
-          if (assets.object_material[k] == i && !scene.objects[k].material.empty())
-            assets.meshes[k].blend_weights = vertex_weights(map, assets.meshes[k].uvs, desc.blend.weights.scale);
+      const WeightsDesc& w = desc.blend.weights;
+      Image level0 = resample_weight_map(map, w.resolution);
+      for (std::size_t k = 0; k < objects; ++k) {
+        if (assets.object_material[k] != i || scene.objects[k].material.empty()) continue;
+        MeshData& mesh = assets.meshes[k];
+        std::vector<glm::vec4> at_vertices = vertex_weights(map, mesh.uvs, w.scale);
+        if (m.weight_mode == WeightMode::Vertex)
+          mesh.blend_weights = std::move(at_vertices);
+        else if (w.from_vertices)
+          rasterize_vertex_weights(mesh.uvs, mesh.indices, at_vertices, w.scale, level0);
+      }
+      if (m.weight_mode == WeightMode::Pixel || reference) {
+        assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(level0)));
+        if (m.weight_mode == WeightMode::Pixel) inputs.weights = assets.derived_textures.back().get();
       }
       if (reference) {
         // The exact reference is the blend with per-pixel weights (so per-vertex errors show the floating).
         const float scale = desc.blend.weights.scale;
         const std::string where = file + ": /materials/" + desc.name + "/blend/weights/scale";
         if (scale != std::floor(scale)) throw Error(where, "error AOVs of a blend need a whole number of repeats");
-        const Texture* weights = inputs.weights;
-        if (!weights) {
-          assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(map, desc.blend.weights.resolution)));
-          weights = assets.derived_textures.back().get();
-        }
+        const Texture* weights = assets.derived_textures.back().get();  // the weight texture made above
         std::vector<const Texture*> heights;
         for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
         const std::uint64_t texels = std::uint64_t(heights[0]->width()) * heights[0]->height() * std::uint64_t(scale * scale);

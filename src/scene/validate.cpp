@@ -329,8 +329,8 @@ AoDesc read_ao(const Value& value) {
 }
 
 WeightsDesc read_weights(const Value& value) {
-  const Object object(value, {"mode", "source", "scale", "resolution", "seed", "cells", "sharpness", "height", "low",
-                              "slope", "relief", "file"});
+  const Object object(value, {"mode", "source", "scale", "resolution", "from_vertices", "seed", "cells", "sharpness",
+                              "height", "low", "slope", "relief", "file"});
   WeightsDesc d;
   if (auto v = object.find("mode")) d.mode = v->choice<WeightMode>({{"vertex", WeightMode::Vertex}, {"pixel", WeightMode::Pixel}});
   if (auto v = object.find("source"))
@@ -338,6 +338,7 @@ WeightsDesc read_weights(const Value& value) {
         {{"noise", WeightSource::Noise}, {"terrain", WeightSource::Terrain}, {"file", WeightSource::File}});
   if (auto v = object.find("scale")) d.scale = static_cast<float>(v->number_in(1e-3, 1e5));
   if (auto v = object.find("resolution")) d.resolution = static_cast<int>(v->integer(1, limits::kMaxTextureSide));
+  if (auto v = object.find("from_vertices")) d.from_vertices = v->boolean();
   if (auto v = object.find("seed")) d.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
   if (auto v = object.find("cells")) d.cells = static_cast<int>(v->integer(1, 4096));
   if (auto v = object.find("sharpness")) d.sharpness = static_cast<int>(v->integer(1, 32));

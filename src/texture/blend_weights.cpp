@@ -119,13 +119,46 @@ Image make_weight_map(const WeightsDesc& desc, int layers, const std::string& wh
   return {};
 }
 
-Texture make_weight_texture(const Image& map, int resolution) {
+Image resample_weight_map(const Image& map, int resolution) {
   Image level0(resolution, resolution, 4);
   for (int y = 0; y < resolution; ++y)
     for (int x = 0; x < resolution; ++x)
       for (int c = 0; c < 4; ++c)
         level0.at(x, y, c) = bilinear(map, (x + 0.5) * map.width / resolution, (y + 0.5) * map.height / resolution, c);
+  return level0;
+}
+
+Texture make_weight_texture(const Image& level0) {
   return make_mip_texture(level0, TexelFormat::RGBA8, false, MipReduce::Max);
+}
+
+void rasterize_vertex_weights(const std::vector<glm::vec2>& uvs, const std::vector<std::uint32_t>& indices,
+                              const std::vector<glm::vec4>& weights, float scale, Image& texture) {
+  const double sx = texture.width / double(scale), sy = texture.height / double(scale);
+  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    glm::dvec2 p[3];
+    for (int k = 0; k < 3; ++k) p[k] = glm::dvec2(uvs[indices[t + std::size_t(k)]].x * sx, uvs[indices[t + std::size_t(k)]].y * sy);
+    const double area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[2].x - p[0].x) * (p[1].y - p[0].y);
+    if (!(std::abs(area) > 0.0) || !std::isfinite(area)) continue;
+    const double lo_x = std::min({p[0].x, p[1].x, p[2].x}), hi_x = std::max({p[0].x, p[1].x, p[2].x});
+    const double lo_y = std::min({p[0].y, p[1].y, p[2].y}), hi_y = std::max({p[0].y, p[1].y, p[2].y});
+    if (hi_x - lo_x > 4.0 * texture.width || hi_y - lo_y > 4.0 * texture.height) continue;  // wraps many times: skip
+    for (int j = int(std::ceil(lo_y - 0.5)); j + 0.5 <= hi_y; ++j)
+      for (int i = int(std::ceil(lo_x - 0.5)); i + 0.5 <= hi_x; ++i) {
+        const glm::dvec2 c(i + 0.5, j + 0.5);
+        // Barycentrics by edge functions; centres on an edge belong to both triangles (the later one wins).
+        const double b0 = ((p[1].x - c.x) * (p[2].y - c.y) - (p[2].x - c.x) * (p[1].y - c.y)) / area;
+        const double b1 = ((p[2].x - c.x) * (p[0].y - c.y) - (p[0].x - c.x) * (p[2].y - c.y)) / area;
+        const double b2 = 1.0 - b0 - b1;
+        if (b0 < 0.0 || b1 < 0.0 || b2 < 0.0) continue;
+        const int x = ((i % texture.width) + texture.width) % texture.width;
+        const int y = ((j % texture.height) + texture.height) % texture.height;
+        const glm::vec4& w0 = weights[indices[t]];
+        const glm::vec4& w1 = weights[indices[t + 1]];
+        const glm::vec4& w2 = weights[indices[t + 2]];
+        for (int ch = 0; ch < 4; ++ch) texture.at(x, y, ch) = float(b0 * w0[ch] + b1 * w1[ch] + b2 * w2[ch]);
+      }
+  }
 }
 
 std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::vec2>& uvs, float scale) {

@@ -20,12 +20,20 @@ namespace qdmr {
 // Throws qdmr::Error(where + "/...", ...) on unreadable inputs.
 Image make_weight_map(const WeightsDesc& desc, int layers, const std::string& where);
 
-// The per-pixel weight texture: the map resampled (bilinear, wrapping) to resolution x resolution, RGBA8
-// linear, with a max chain so coarse levels bound the weights of regions.
-Texture make_weight_texture(const Image& map, int resolution);
-
 // Per-vertex weights: the map sampled bilinearly (wrapping) at uv / scale.
 std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::vec2>& uvs, float scale);
+
+// The talk's "small texture from vertex blend weights": the triangles (3 indices each) rasterized in weight-map
+// space (uv / scale, wrapping) at the texture's resolution, each texel centre inside a triangle taking the
+// interpolated vertex weights; texels no triangle covers keep their value. Later triangles overwrite.
+void rasterize_vertex_weights(const std::vector<glm::vec2>& uvs, const std::vector<std::uint32_t>& indices,
+                              const std::vector<glm::vec4>& weights, float scale, Image& texture);
+
+// The per-pixel weight texture from its level 0 (resampled or rasterized): RGBA8 linear, with a max chain so
+// coarse levels bound the weights of regions.
+Texture make_weight_texture(const Image& level0);
+// The map resampled (bilinear, wrapping) to resolution x resolution.
+Image resample_weight_map(const Image& map, int resolution);
 
 // The box surface of a blend with per-pixel weights (BlendedSurface's level 0) over the `scale` texture repeats
 // the weight texture spans, in fp64, for the exact reference: texel (x, y) combines the layers' level-0 texel

@@ -222,6 +222,7 @@ struct WeightsDesc {
   WeightSource source = WeightSource::Noise;
   float scale = 1.0f;       // the weight map spans this many texture repeats (set it to the mesh's uv_scale)
   int resolution = 256;     // pixel mode: side of the weight texture made from the map
+  bool from_vertices = false;  // pixel mode: rasterize the weight texture from the meshes' vertex weights (the talk)
   // noise: one smooth noise field per layer at `cells` per side, sharpened; the strongest layer gets weight 1
   std::uint32_t seed = 1;
   int cells = 4;
