@@ -1,6 +1,7 @@
 #include "qdmr/plan/plan.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -318,6 +319,25 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
     if ((r & (r - 1)) != 0)
       throw Error(where + "/blend/weights/resolution", "must be a power of two, got " + std::to_string(r));
     plan.weight_bytes = rgba8_chain_bytes(r);
+    const BlendQuadtree choice = material.blend.quadtree;
+    if (kind == TechniqueKind::Qdm && choice != BlendQuadtree::Product) {
+      // The combined tree spans the weights' repeats: a whole number of them, and not too many texels.
+      const float scale = material.blend.weights.scale;
+      const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
+      const std::uint64_t side_x = std::uint64_t(h.width) * std::uint64_t(scale) / 2;
+      const std::uint64_t side_y = std::uint64_t(h.height) * std::uint64_t(scale) / 2;
+      const bool whole = scale == std::floor(scale) && scale >= 1.0f;
+      const bool fits = whole && side_x * side_y <= (1ull << 22);
+      if (choice == BlendQuadtree::Combined && !fits)
+        throw Error(where + "/blend/quadtree",
+                    whole ? "the combined quadtree would have " + std::to_string(side_x * side_y) +
+                                " texels at its first level, more than 2^22 (use 'product')"
+                          : "'combined' needs blend/weights/scale to be a whole number of repeats (use 'product')");
+      if (fits) {
+        plan.combined_quadtree = true;
+        plan.combined_bytes = chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
+      }
+    }
   }
   if (material.ao.mode == AoMode::Baked) {
     const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
@@ -355,7 +375,7 @@ FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
   for (const MaterialPlan& m : plan.materials) {
     plan.cone_map_bytes += m.cone_bytes;
-    plan.derived_bytes += m.weight_bytes + m.ao_bytes;
+    plan.derived_bytes += m.weight_bytes + m.combined_bytes + m.ao_bytes;
   }
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
@@ -379,6 +399,7 @@ std::string FramePlan::describe() const {
     if (m.blend)
       s << "    blend weights: " << (m.weight_mode == WeightMode::Vertex ? "per vertex (interpolated)"
                                                                          : "per pixel, weight texture " + mib(m.weight_bytes))
+        << (m.combined_quadtree ? ", combined quadtree " + mib(m.combined_bytes) : std::string())
         << "\n";
     if (m.ao_map) s << "    ao: baked map per layer, " << mib(m.ao_bytes) << ", baked or from cache\n";
     if (m.cone_map)

@@ -170,12 +170,20 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(level0)));
         if (m.weight_mode == WeightMode::Pixel) inputs.weights = assets.derived_textures.back().get();
       }
+      if (m.combined_quadtree) {
+        std::vector<const Texture*> heights;
+        for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
+        assets.derived_textures.push_back(std::make_unique<Texture>(
+            combined_quadtree(heights, *inputs.weights, int(w.scale), desc.blend.op)));
+        inputs.combined = assets.derived_textures.back().get();
+        inputs.combined_period = heights[0]->width() * int(w.scale);
+      }
       if (reference) {
         // The exact reference is the blend with per-pixel weights (so per-vertex errors show the floating).
         const float scale = desc.blend.weights.scale;
         const std::string where = file + ": /materials/" + desc.name + "/blend/weights/scale";
         if (scale != std::floor(scale)) throw Error(where, "error AOVs of a blend need a whole number of repeats");
-        const Texture* weights = assets.derived_textures.back().get();  // the weight texture made above
+        const Texture* weights = inputs.weights ? inputs.weights : assets.derived_textures.back().get();
         std::vector<const Texture*> heights;
         for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
         const std::uint64_t texels = std::uint64_t(heights[0]->width()) * heights[0]->height() * std::uint64_t(scale * scale);

@@ -358,12 +358,15 @@ WeightsDesc read_weights(const Value& value) {
 }
 
 BlendDesc read_blend(const Value& value) {
-  const Object object(value, {"operator", "width", "weights"});
+  const Object object(value, {"operator", "width", "quadtree", "weights"});
   BlendDesc d;
   if (auto v = object.find("operator"))
     d.op = v->choice<BlendOperator>(
         {{"alpha", BlendOperator::Alpha}, {"height", BlendOperator::Height}, {"height_width", BlendOperator::HeightWidth}});
   if (auto v = object.find("width")) d.width = static_cast<float>(v->number_in(1e-4, 1.0));
+  if (auto v = object.find("quadtree"))
+    d.quadtree = v->choice<BlendQuadtree>(
+        {{"auto", BlendQuadtree::Auto}, {"combined", BlendQuadtree::Combined}, {"product", BlendQuadtree::Product}});
   if (auto v = object.find("weights")) d.weights = read_weights(*v);
   return d;
 }

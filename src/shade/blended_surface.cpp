@@ -20,6 +20,14 @@ SamplerState weight_sampler(const SamplerState& layer) {
   return s;
 }
 
+// Cell index i of a level whose period is p cells, wrapped into [0, p) (|i| < 2^24, as in the traversals).
+Int wrap_cell(const Int& i, const Int& p) {
+  const Int q = xsimd::to_int(xsimd::floor(xsimd::to_float(i) / xsimd::to_float(p)));
+  Int r = i - q * p;
+  r = xsimd::select(r < Int(0), r + p, r);
+  return xsimd::select(r >= p, r - p, r);
+}
+
 }  // namespace
 
 BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const Float* w)
@@ -123,7 +131,29 @@ Float BlendedSurface::bound(const Float* hmax, const Float* wmax) const {
   return combine(hmax, wmax);
 }
 
+Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const Int& cy) const {
+  const simd::IntMask coarse = level >= Int(1);
+  Float result(0.0f);
+  if (xsimd::any(coarse)) {
+    const Int period = Int(texture_.period) >> level;
+    Float texel[4];
+    load(*texture_.combined, xsimd::max(level - Int(1), Int(0)), wrap_cell(cx, period), wrap_cell(cy, period),
+         sampler().fetch, texel);
+    result = texel[0];
+  }
+  if (!xsimd::all(coarse)) {
+    // Level 0: the exact box value, as the combined tree was built from.
+    Float h[kMaxLayers], w[kMaxLayers];
+    for (int i = 0; i < count_; ++i) h[i] = present(i) ? layers_[i].cell_max(Int(0), cx, cy) : Float(0.0f);
+    weights_at((xsimd::to_float(cx) + Float(0.5f)) / Float(float(width())),
+               (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height())), w);
+    result = xsimd::select(simd::float_mask(coarse), result, combine(h, w));
+  }
+  return result;
+}
+
 Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) const {
+  if (texture_.combined) return combined_cell_max(level, cx, cy);
   Float hmax[kMaxLayers];
   for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].cell_max(level, cx, cy) : Float(0.0f);
   if (!texture_.view) return bound(hmax, weights_);

@@ -15,6 +15,11 @@ namespace qdmr {
 struct WeightTexture {
   const TextureView* view = nullptr;  // RGBA8 linear, power-of-two, max chain; level 0 sampled bilinearly (wrap)
   float scale = 1.0f;                 // weight-map UV = layer UV / scale
+  // Optional precomputed combined quadtree: level k holds the maxima of the blended box surface over cells of
+  // level k + 1, over one period of `period` level-0 texels per side (the layers' size times the whole number
+  // of repeats the weights span); values rounded up, so it stays conservative.
+  const TextureView* combined = nullptr;
+  int period = 0;
 };
 
 class BlendedSurface {
@@ -60,6 +65,7 @@ private:
                      simd::Float* w) const;
   simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
   void find_present();
+  simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
   bool present(int i) const { return (present_ >> i) & 1u; }
 
   const SingleLayerSurface* layers_;

@@ -97,6 +97,10 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   if (ao_.mode == AoMode::Baked && std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
     throw Error("displacement program", "baked AO needs an AO map per layer");
   if (inputs.weights) weights_.emplace(*inputs.weights);
+  if (inputs.combined) {
+    combined_.emplace(*inputs.combined);
+    combined_period_ = inputs.combined_period;
+  }
   if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
     throw Error("displacement program", "per-pixel blending needs a weight texture");
   const Texture* height0 = inputs.layers[0].height;
@@ -722,7 +726,8 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
-  const BlendedSurface surface(surfaces, count, blend_.op, WeightTexture{&*weights_, blend_.weights.scale},
+  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_};
+  const BlendedSurface surface(surfaces, count, blend_.op, weights,
                                xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
                                xsimd::max(ray.v0, v1));
   shade_surface(in, setup, surface, out);

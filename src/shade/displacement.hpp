@@ -29,6 +29,8 @@ struct LayerInputs {
 struct DisplacementInputs {
   std::vector<LayerInputs> layers;        // 1 .. 4
   const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
+  const Texture* combined = nullptr;      // blending per pixel: the precomputed combined quadtree (optional)
+  int combined_period = 0;                // its period in level-0 texels (layers' size x repeats of the weights)
   const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
   int reference_scale = 1;                // texture repeats the reference spans (a blend's combined surface)
@@ -92,6 +94,8 @@ private:
 
   std::vector<Layer> layers_;
   std::optional<TextureView> weights_;
+  std::optional<TextureView> combined_;
+  int combined_period_ = 0;
   const ConeMap* cones_;
   const HeightField* reference_;
   int reference_scale_;

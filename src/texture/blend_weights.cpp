@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/parallel_for.h>
+
 #include "qdmr/texture/texture.hpp"
 
 namespace qdmr {
@@ -170,35 +172,69 @@ std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::v
   return out;
 }
 
+namespace {
+
+// The blended box value of level-0 texel (x, y) of the period: the layers' texel (x mod W, y mod H) combined
+// with the weights sampled bilinearly at its centre, in fp64.
+struct BlendedBox {
+  const std::vector<const Texture*>& heights;
+  const Texture& weights;
+  BlendOperator op;
+  int width, height;  // of the period, in level-0 texels
+
+  double weight(int x, int y, int c) const {
+    const int rw = weights.width(), rh = weights.height();
+    return double(weights.texel(0, ((x % rw) + rw) % rw, ((y % rh) + rh) % rh, c));
+  }
+  double at(int x, int y) const {
+    const int rw = weights.width(), rh = weights.height();
+    const double wx = (x + 0.5) / width * rw - 0.5, wy = (y + 0.5) / height * rh - 0.5;
+    const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
+    const double fx = wx - x0, fy = wy - y0;
+    double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
+    for (std::size_t i = 0; i < heights.size(); ++i) {
+      const int c = int(i);
+      const double wi = (weight(x0, y0, c) * (1 - fx) + weight(x0 + 1, y0, c) * fx) * (1 - fy) +
+                        (weight(x0, y0 + 1, c) * (1 - fx) + weight(x0 + 1, y0 + 1, c) * fx) * fy;
+      const double hi = heights[i]->texel(0, x % heights[i]->width(), y % heights[i]->height(), 0);
+      top = std::max(top, wi * hi);
+      sum_wh += wi * hi;
+      sum_w += wi;
+    }
+    if (op != BlendOperator::Alpha) return top;
+    return sum_w > 0.0 ? sum_wh / sum_w : 0.0;
+  }
+};
+
+}  // namespace
+
 HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
                              BlendOperator op) {
-  const int w = heights[0]->width(), h = heights[0]->height();
-  const int rw = weights.width(), rh = weights.height();
+  const BlendedBox box{heights, weights, op, heights[0]->width() * scale, heights[0]->height() * scale};
   HeightField field;
-  field.width = w * scale;
-  field.height = h * scale;
+  field.width = box.width;
+  field.height = box.height;
   field.h.resize(std::size_t(field.width) * std::size_t(field.height));
-  const auto weight = [&](int x, int y, int c) { return double(weights.texel(0, ((x % rw) + rw) % rw, ((y % rh) + rh) % rh, c)); };
-  for (int y = 0; y < field.height; ++y)
-    for (int x = 0; x < field.width; ++x) {
-      // Bilinear weights at the texel centre: weight-texture coordinates of (x + 0.5) / (w scale).
-      const double wx = (x + 0.5) / field.width * rw - 0.5, wy = (y + 0.5) / field.height * rh - 0.5;
-      const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
-      const double fx = wx - x0, fy = wy - y0;
-      double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
-      for (std::size_t i = 0; i < heights.size(); ++i) {
-        const int c = int(i);
-        const double wi = (weight(x0, y0, c) * (1 - fx) + weight(x0 + 1, y0, c) * fx) * (1 - fy) +
-                          (weight(x0, y0 + 1, c) * (1 - fx) + weight(x0 + 1, y0 + 1, c) * fx) * fy;
-        const double hi = heights[i]->texel(0, x % w, y % h, 0);
-        top = std::max(top, wi * hi);
-        sum_wh += wi * hi;
-        sum_w += wi;
-      }
-      field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] =
-          op == BlendOperator::Alpha ? (sum_w > 0.0 ? sum_wh / sum_w : 0.0) : top;
-    }
+  tbb::parallel_for(0, field.height, [&](int y) {
+    for (int x = 0; x < field.width; ++x) field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] = box.at(x, y);
+  });
   return field;
+}
+
+Texture combined_quadtree(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
+                          BlendOperator op) {
+  const BlendedBox box{heights, weights, op, heights[0]->width() * scale, heights[0]->height() * scale};
+  Image level1(box.width / 2, box.height / 2, 1);
+  tbb::parallel_for(0, level1.height, [&](int y) {
+    for (int x = 0; x < level1.width; ++x) {
+      const double top = std::max(std::max(box.at(2 * x, 2 * y), box.at(2 * x + 1, 2 * y)),
+                                  std::max(box.at(2 * x, 2 * y + 1), box.at(2 * x + 1, 2 * y + 1)));
+      // Rounded up to a 16-bit step, with a margin over the shader's fp32 arithmetic (errors ~1e-7), so the
+      // quantisation in make_mip_texture keeps it: the tree stays above the surface.
+      level1.at(x, y, 0) = float(std::min(1.0, std::ceil((top + 1e-6) * 65535.0) / 65535.0));
+    }
+  });
+  return make_mip_texture(level1, TexelFormat::R16, false, MipReduce::Max);
 }
 
 }  // namespace qdmr

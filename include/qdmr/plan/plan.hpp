@@ -46,6 +46,8 @@ struct MaterialPlan {
   bool blend = false;
   WeightMode weight_mode = WeightMode::Pixel;
   std::uint64_t weight_bytes = 0;  // pixel mode: RGBA8 weight texture with its max chain
+  bool combined_quadtree = false;  // pixel mode, qdm: the precomputed max-quadtree of the blended surface
+  std::uint64_t combined_bytes = 0;
   bool ao_map = false;       // baked AO: one float per texel, baked or from the cache
   std::uint64_t ao_bytes = 0;
   bool cone_map = false;     // csm, rcsm: a cone map of the height's level 0, baked or from the cache

@@ -236,9 +236,17 @@ struct WeightsDesc {
   std::filesystem::path file;  // file: RGBA image, channel i = weight of layer i (linear, not sRGB)
 };
 
+// The max-quadtree QDM walks over a blend with per-pixel weights: `product` bounds each cell on the fly by
+// max(hmax_i * wmax_i) from the layers' and the weights' max chains (the talk's "QDM1 * QDM2"); `combined` is
+// precomputed: the max-quadtree of the blended box surface over the repeats the weights span (one fetch per
+// step, exact per cell); `auto` takes combined when the weight span is a whole number of repeats and its tree
+// has at most 2^22 texels per level, else product.
+enum class BlendQuadtree { Auto, Combined, Product };
+
 struct BlendDesc {
   BlendOperator op = BlendOperator::Height;
   float width = 0.2f;       // height_width: transition width in height units
+  BlendQuadtree quadtree = BlendQuadtree::Auto;
   WeightsDesc weights;
 };
 
