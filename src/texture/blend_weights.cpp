@@ -175,42 +175,57 @@ std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::v
 namespace {
 
 // The blended box value of level-0 texel (x, y) of the period: the layers' texel (x mod W, y mod H) combined
-// with the weights sampled bilinearly at its centre, in fp64.
-struct BlendedBox {
-  const std::vector<const Texture*>& heights;
-  const Texture& weights;
-  BlendOperator op;
-  int width, height;  // of the period, in level-0 texels
-
-  double weight(int x, int y, int c) const {
-    const int rw = weights.width(), rh = weights.height();
-    return double(weights.texel(0, ((x % rw) + rw) % rw, ((y % rh) + rh) % rh, c));
+// with the weights sampled bilinearly at its centre, in fp64. Level 0 of the textures decoded once.
+class BlendedBox {
+public:
+  BlendedBox(const std::vector<const Texture*>& heights, const Texture& weights, BlendOperator op, int scale)
+      : op_(op), layers_(int(heights.size())), lw_(heights[0]->width()), lh_(heights[0]->height()), rw_(weights.width()),
+        rh_(weights.height()), width(lw_ * scale), height(lh_ * scale) {
+    heights_.resize(std::size_t(layers_) * std::size_t(lw_) * std::size_t(lh_));
+    for (int i = 0; i < layers_; ++i)
+      for (int y = 0; y < lh_; ++y)
+        for (int x = 0; x < lw_; ++x) heights_[(std::size_t(i) * lh_ + y) * lw_ + x] = heights[std::size_t(i)]->texel(0, x, y, 0);
+    weights_.resize(std::size_t(rw_) * std::size_t(rh_) * 4);
+    for (int y = 0; y < rh_; ++y)
+      for (int x = 0; x < rw_; ++x)
+        for (int c = 0; c < 4; ++c) weights_[(std::size_t(y) * rw_ + x) * 4 + c] = weights.texel(0, x, y, c);
   }
+
   double at(int x, int y) const {
-    const int rw = weights.width(), rh = weights.height();
-    const double wx = (x + 0.5) / width * rw - 0.5, wy = (y + 0.5) / height * rh - 0.5;
+    const double wx = (x + 0.5) / width * rw_ - 0.5, wy = (y + 0.5) / height * rh_ - 0.5;
     const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
     const double fx = wx - x0, fy = wy - y0;
+    const int xa = wrap_index(x0, rw_), xb = wrap_index(x0 + 1, rw_), ya = wrap_index(y0, rh_), yb = wrap_index(y0 + 1, rh_);
     double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
-    for (std::size_t i = 0; i < heights.size(); ++i) {
-      const int c = int(i);
-      const double wi = (weight(x0, y0, c) * (1 - fx) + weight(x0 + 1, y0, c) * fx) * (1 - fy) +
-                        (weight(x0, y0 + 1, c) * (1 - fx) + weight(x0 + 1, y0 + 1, c) * fx) * fy;
-      const double hi = heights[i]->texel(0, x % heights[i]->width(), y % heights[i]->height(), 0);
+    for (int i = 0; i < layers_; ++i) {
+      const double wi = (weight(xa, ya, i) * (1 - fx) + weight(xb, ya, i) * fx) * (1 - fy) +
+                        (weight(xa, yb, i) * (1 - fx) + weight(xb, yb, i) * fx) * fy;
+      const double hi = heights_[(std::size_t(i) * lh_ + std::size_t(y % lh_)) * lw_ + std::size_t(x % lw_)];
       top = std::max(top, wi * hi);
       sum_wh += wi * hi;
       sum_w += wi;
     }
-    if (op != BlendOperator::Alpha) return top;
+    if (op_ != BlendOperator::Alpha) return top;
     return sum_w > 0.0 ? sum_wh / sum_w : 0.0;
   }
+
+private:
+  static int wrap_index(int i, int n) { return ((i % n) + n) % n; }
+  double weight(int x, int y, int c) const { return weights_[(std::size_t(y) * rw_ + x) * 4 + std::size_t(c)]; }
+
+  BlendOperator op_;
+  int layers_, lw_, lh_, rw_, rh_;
+  std::vector<float> heights_, weights_;
+
+public:
+  const int width, height;  // of the period, in level-0 texels
 };
 
 }  // namespace
 
 HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
                              BlendOperator op) {
-  const BlendedBox box{heights, weights, op, heights[0]->width() * scale, heights[0]->height() * scale};
+  const BlendedBox box(heights, weights, op, scale);
   HeightField field;
   field.width = box.width;
   field.height = box.height;
@@ -223,7 +238,7 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
 
 Texture combined_quadtree(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
                           BlendOperator op) {
-  const BlendedBox box{heights, weights, op, heights[0]->width() * scale, heights[0]->height() * scale};
+  const BlendedBox box(heights, weights, op, scale);
   Image level1(box.width / 2, box.height / 2, 1);
   tbb::parallel_for(0, level1.height, [&](int y) {
     for (int x = 0; x < level1.width; ++x) {
