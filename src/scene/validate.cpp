@@ -289,7 +289,7 @@ LayerDesc read_layer(const Value& value) {
 
 ShadowDesc read_shadow(const Value& value) {
   const Object object(value, {"mode", "strength", "max_iterations", "samples", "length", "profile", "penumbra",
-                              "tap_weights"});
+                              "tap_weights", "bias"});
   ShadowDesc d;
   if (auto v = object.find("mode"))
     d.mode = v->choice<ShadowMode>({{"off", ShadowMode::Off},
@@ -304,6 +304,7 @@ ShadowDesc read_shadow(const Value& value) {
     d.profile = v->choice<ProfileOperator>(
         {{"max", ProfileOperator::Max}, {"min", ProfileOperator::Min}, {"average", ProfileOperator::Average}});
   if (auto v = object.find("penumbra")) d.penumbra = static_cast<float>(v->number_in(0.0, 1e6));
+  if (auto v = object.find("bias")) d.bias = static_cast<float>(v->number_in(0.0, 1.0));
   if (auto v = object.find("tap_weights")) {
     const std::vector<Value> items = v->array();
     v->require(!items.empty() && items.size() <= 16, "expected 1 to 16 weights, got " + std::to_string(items.size()));

@@ -139,7 +139,7 @@ DisplacementProgram::Hit DisplacementProgram::relief(const Surface& surface, con
     hi = xsimd::select(searching & below, mid, hi);
     lo = xsimd::select(searching & !below, mid, lo);
   }
-  return {hi, iterations};
+  return {hi, iterations, Float(0.0f)};
 }
 
 // Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
@@ -175,7 +175,7 @@ DisplacementProgram::Hit DisplacementProgram::pom(const Surface& surface, const 
     prev_s = s;
     prev_gap = gap;
   }
-  return {s_hit, iterations};
+  return {s_hit, iterations, Float(0.0f)};
 }
 
 // Quadtree displacement mapping (Drobot 2009) over the max-quadtree: from the root, advance to the nearer of
@@ -283,7 +283,7 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const 
     cx = xsimd::select(up, cx >> 1, cx);
     cy = xsimd::select(up, cy >> 1, cy);
   }
-  return {xsimd::min(s, ds), loop.iterations()};
+  return {xsimd::min(s, ds), loop.iterations(), Float(0.0f)};
 }
 
 void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, Float& ratio) const {
@@ -379,7 +379,7 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
     }
     s = xsimd::select(search, hi, s);
   }
-  return {xsimd::min(s, ds), iterations};
+  return {xsimd::min(s, ds), iterations, Float(0.0f)};
 }
 
 // Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
@@ -513,11 +513,12 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
   const Ray& ray = setup.ray;
   const TextureView& height0 = *layers_[0].height;
   const Mask active = setup.active;
-  Hit hit{Float(0.0f), Float(0.0f)};
+  Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
   switch (technique_.kind) {
     case TechniqueKind::Normal: break;
     case TechniqueKind::Relief:
       hit = relief(surface, ray, ds, lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy), active);
+      hit.box_s = hit.s;
       break;
     case TechniqueKind::Pom: {
       const Float lod = lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy);
@@ -527,11 +528,13 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
           Float(1.0f));
       ds = ds * (Float(1.0f) - fade);
       hit = pom(surface, ray, ds, lod, setup.view_tangent.z, active);
+      hit.box_s = hit.s;
       break;
     }
     case TechniqueKind::Csm:
     case TechniqueKind::Rcsm:
       hit = cone_step(ray, ds, active);
+      hit.box_s = hit.s;
       hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
       break;
     case TechniqueKind::Qdm: {
@@ -546,6 +549,7 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
                             Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
       }
       hit = qdm(surface, ray, ds, stop, cap, active);
+      hit.box_s = hit.s;
       hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
       break;
     }
@@ -657,6 +661,12 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
                                 const Float& ds, const Float* albedo, const Float& specular, const Float& baked_ao,
                                 const Vec3& shading_normal, ShadeOutput& out) const {
   const Ray& ray = setup.ray;
+  // Hard shadows trace the box surface, so they start from the hit on it: a refined hit between texel centres
+  // can lie below a neighbouring column's top and would be shadowed by it (staircase acne).
+  // The bias lifts the start along the light ray (towards depth 0) by a fraction of the depth scale.
+  const Float s_hit = shadow_.mode == ShadowMode::Hard ? hit.box_s : hit.s;
+  const Float lift = xsimd::min(Float(shadow_.bias) * ds, s_hit);
+  const Float su_hit = ray.u0 + ray.du * s_hit, sv_hit = ray.v0 + ray.dv * s_hit;
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   const Float zero(0.0f);
   Float visibility[limits::kMaxDirectionalLights];
@@ -669,11 +679,12 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
       const Mask above = lt.z > zero;  // a light below the polygon leaves the whole relief in shadow
       const Float lz = xsimd::max(lt.z, Float(1e-6f));
       const Float du = lt.x / lz, dv = lt.y / lz;
-      const Float u1 = hu + du * hit.s, v1 = hv + dv * hit.s;
+      const Float su = su_hit + du * lift, sv = sv_hit + dv * lift, s0 = s_hit - lift;
+      const Float u1 = su + du * s0, v1 = sv + dv * s0;
       const Surface towards_light =
-          surface.around(xsimd::min(hu, u1), xsimd::max(hu, u1), xsimd::min(hv, v1), xsimd::max(hv, v1));
+          surface.around(xsimd::min(su, u1), xsimd::max(su, u1), xsimd::min(sv, v1), xsimd::max(sv, v1));
       const ShadowResult r =
-          self_shadow(towards_light, shadow_, ShadowRay{hu, hv, hit.s, du, dv, ds}, lod, setup.active & above);
+          self_shadow(towards_light, shadow_, ShadowRay{su, sv, s0, du, dv, ds}, lod, setup.active & above);
       visibility[j] = xsimd::select(above, r.visibility, zero);
     }
   }

@@ -51,6 +51,7 @@ public:
   struct Hit {
     simd::Float s;           // depth of the hit
     simd::Float iterations;  // loop iterations per lane
+    simd::Float box_s;       // qdm, csm, rcsm: the hit on the level-0 box surface, before refinement; else s
   };
 
 private:

@@ -193,6 +193,8 @@ struct ShadowDesc {
   ProfileOperator profile = ProfileOperator::Max;
   float penumbra = 1.0f;          // horizon, qdm_soft: softening growing with the blocker's distance
   std::vector<float> tap_weights{1.0f, 1.0f, 1.0f, 1.0f, 1.0f};  // qdm_soft: artist weight per tap, near to far
+  float bias = 0.0f;              // the light ray starts this fraction of the depth scale above the hit (acne on
+                                  // smooth slopes, where the box surface's terraces shadow each other)
 };
 
 // Ambient occlusion of the displaced surface from horizon queries (applied to the ambient light).
