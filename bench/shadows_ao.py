@@ -5,7 +5,8 @@ Every variant changes one thing against the scene's own baseline (shadow off, AO
 has qdm_soft shadows and baked AO): each shadow mode (hard, horizon, qdm_soft, defaults but the scene's
 strength), each AO mode (frame with jitter, the same with coarse=false, baked), the scene as stored, and
 QDM over one layer: a temporary copy of the scene with only layers[0] (rock) and no blend, shadow and AO off,
-against the baseline (QDM over the 4-layer height blend = QDMHB). Baked AO is baked once into a temporary
+against the baseline (QDM over the 4-layer height blend = QDMHB, with its precomputed combined quadtree), and
+QDMHB bounding cells on the fly (the product bound) or with per-vertex weights. Baked AO is baked once into a temporary
 QDMR_CACHE_DIR by a warm-up render, so the timed runs read the cache. Runs alternate inside each round;
 medians of the raster+shade stage from --stats; iterations are the intersection search's (not the
 shadow's or AO's fetches), from the last run.
@@ -34,6 +35,8 @@ VARIANTS = [  # (label, scene: None = terrain.json, "single" = the one-layer cop
      OFF + [(f"{M}/ao/mode", "frame"), (f"{M}/ao/jitter", "true"), (f"{M}/ao/coarse", "false")]),
     ("AO baked", None, OFF + [(f"{M}/ao/mode", "baked")]),
     ("as stored: qdm_soft + baked AO", None, []),
+    ("QDMHB, product bound (blend/quadtree=product)", None, OFF + [(f"{M}/blend/quadtree", "product")]),
+    ("QDMHB, per-vertex weights", None, OFF + [(f"{M}/blend/weights/mode", "vertex")]),
     ("QDM, one layer (rock), shadow off, AO off", "single", OFF),
 ]
 TALK = {"shadow qdm_soft": "0.5 (QDM self-shadowing, full screen)"}
