@@ -1,15 +1,15 @@
 #include "shade/blended_surface.hpp"
 
+#include "shade/traversal.hpp"
+
 namespace qdmr {
 namespace {
 
 using simd::Float;
 using simd::Int;
 
-// Texel coordinates are clamped before they become integers (beyond this the query box is the whole map).
-constexpr float kMaxCoordinate = 4194304.0f;
 Int floor_index(const Float& x) {
-  return xsimd::to_int(xsimd::floor(xsimd::max(xsimd::min(x, Float(kMaxCoordinate)), Float(-kMaxCoordinate))));
+  return xsimd::to_int(xsimd::floor(xsimd::max(xsimd::min(x, Float(kMaxTexelCoordinate)), Float(-kMaxTexelCoordinate))));
 }
 
 SamplerState weight_sampler(const SamplerState& layer) {

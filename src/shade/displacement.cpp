@@ -10,6 +10,7 @@
 #include "shade/ambient_occlusion.hpp"
 #include "shade/self_shadow.hpp"
 #include "shade/shading_math.hpp"
+#include "shade/traversal.hpp"
 
 namespace qdmr {
 namespace {
@@ -24,32 +25,12 @@ using simd::count;
 using simd::float_mask;
 using simd::int_mask;
 
-// The iteration budget of a capped SIMD loop, as a GPU wave runs it: a lane stops when it is done or when
-// its own count reaches the cap; the loop ends when no lane is left.
-struct CappedLoop {
-  Int cap;
-  Int done = Int(0);
-
-  // Drops the lanes that used up their budget and counts one more iteration for the others.
-  bool next(Mask& active) {
-    const IntMask running = int_mask(active) & (done < cap);
-    active = float_mask(running);
-    if (!xsimd::any(active)) return false;
-    done += xsimd::select(running, Int(1), Int(0));
-    return true;
-  }
-  Float iterations() const { return xsimd::to_float(done); }
-};
 
 // Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
 Float texel_step(const DisplacementProgram::Ray& ray, float width, float height) {
   const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));
   return Float(1.0f) / xsimd::max(reach, Float(1e-6f));
 }
-
-// Texel coordinates are clamped to +-2^22 before they become indices: beyond that fp32 positions are meaningless
-// anyway, and indices (plus at most 2^20 capped steps) stay exact in fp32 for address_texel.
-constexpr float kMaxTexelCoordinate = 4194304.0f;
 
 // The texel a ray at texel coordinate p is over: the one ahead along the ray (direction dir) when p lies on a
 // texel boundary, so a step that ends on a wall moves on. Finite for any p (a NaN clamps to the bound).

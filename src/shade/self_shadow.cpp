@@ -6,6 +6,7 @@
 
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
+#include "shade/traversal.hpp"
 
 namespace qdmr {
 namespace {
@@ -19,25 +20,6 @@ using simd::count;
 using simd::float_mask;
 using simd::int_mask;
 
-// The iteration budget of a capped SIMD loop, as a GPU wave runs it (the pattern of displacement.cpp): a lane
-// stops when it is done or when its own count reaches the cap; the loop ends when no lane is left.
-struct CappedLoop {
-  Int cap;
-  Int done = Int(0);
-
-  bool next(Mask& active) {
-    const IntMask running = int_mask(active) & (done < cap);
-    active = float_mask(running);
-    if (!xsimd::any(active)) return false;
-    done += xsimd::select(running, Int(1), Int(0));
-    return true;
-  }
-  Float iterations() const { return xsimd::to_float(done); }
-};
-
-// Texel coordinates are clamped to +-2^22 before they become indices (as in displacement.cpp): fp32 positions
-// beyond are meaningless, and the indices stay exact in fp32.
-constexpr float kMaxTexelCoordinate = 4194304.0f;
 
 Mask finite(const Float& x) { return xsimd::abs(x) <= Float(std::numeric_limits<float>::max()); }
 

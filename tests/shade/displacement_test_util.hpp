@@ -110,6 +110,48 @@ private:
   std::optional<std::string> previous_;
 };
 
+// Runs `program` on per-lane rays on a flat tangent frame (t = +x, b = +y, n = +z): each lane's world point
+// sits at -direction * 10 from a camera at the origin, so the view vector in tangent space is (-du, -dv, 1).
+// weights: per ray, the interpolated vertex blend weights (programs that blend per vertex), or empty.
+inline std::vector<TechniqueResult> trace_rays(const DisplacementProgram& program, const std::vector<TechniqueRay>& rays,
+                                               const std::vector<std::array<float, 4>>& weights = {}) {
+  std::vector<TechniqueResult> results;
+  for (std::size_t first = 0; first < rays.size(); first += simd::kLanes) {
+    alignas(64) float var[kVaryingCount][simd::kLanes] = {};
+    std::uint32_t covered = 0;
+    for (int l = 0; l < simd::kLanes; ++l) {
+      const std::size_t k = std::min(first + std::size_t(l), rays.size() - 1);
+      const TechniqueRay& r = rays[k];
+      if (first + std::size_t(l) < rays.size()) covered |= 1u << l;
+      var[kWorldX][l] = float(r.du) * 10.0f;
+      var[kWorldY][l] = float(r.dv) * 10.0f;
+      var[kWorldZ][l] = -10.0f;
+      var[kNormalZ][l] = 1.0f;
+      var[kTangentX][l] = 1.0f;
+      var[kTangentW][l] = 1.0f;
+      var[kU][l] = float(r.u0);
+      var[kV][l] = float(r.v0);
+      if (!weights.empty())
+        for (int i = 0; i < 4; ++i) var[kWeight0 + i][l] = weights[k][std::size_t(i)];
+    }
+    Fragments in;
+    for (int k = 0; k < kVaryingCount; ++k) in.varyings[k] = simd::Float::load_aligned(var[k]);
+    in.pixel_x = in.pixel_y = simd::Float(0.0f);
+    in.view_depth = simd::Float(10.0f);
+    in.covered = simd::from_bits(covered);
+    ShadeOutput out;
+    program.shade(in, out);
+    alignas(64) float hu[simd::kLanes], hv[simd::kLanes], hd[simd::kLanes], it[simd::kLanes];
+    out.hit_u.store_aligned(hu);
+    out.hit_v.store_aligned(hv);
+    out.hit_depth.store_aligned(hd);
+    out.iterations.store_aligned(it);
+    for (int l = 0; l < simd::kLanes && first + std::size_t(l) < rays.size(); ++l)
+      results.push_back({hu[l], hv[l], hd[l], it[l]});
+  }
+  return results;
+}
+
 class TechniqueHarness {
 public:
   // heights: level 0 of a power-of-two height map in [0,1], stored R32F so the technique and the reference
@@ -140,44 +182,11 @@ public:
     inputs.layers.push_back({&flat_, &flat_, &height_, &height_max_});
     if (!cones_.ratio.empty()) inputs.cones = &cones_;
     if (material_.technique.refinement == QdmRefinement::BilinearPatch) inputs.surface = &field_;
-    std::vector<TechniqueResult> results;
-    for (std::size_t first = 0; first < rays.size(); first += simd::kLanes) {
-      LightRig rig;
-      // One camera per batch is not enough for per-lane directions: the view vector is built from world
-      // positions instead, each lane's world point sitting at -direction from a camera at the origin.
-      rig.camera_position = glm::vec3(0.0f);
-      DisplacementProgram program(inputs, material_, rig);
-      alignas(64) float var[kVaryingCount][simd::kLanes] = {};
-      std::uint32_t covered = 0;
-      for (int l = 0; l < simd::kLanes; ++l) {
-        const TechniqueRay& r = rays[std::min(first + std::size_t(l), rays.size() - 1)];
-        if (first + std::size_t(l) < rays.size()) covered |= 1u << l;
-        // View vector (towards the camera) in tangent space: (-du, -dv, 1), normalised by the program.
-        var[kWorldX][l] = float(r.du) * 10.0f;
-        var[kWorldY][l] = float(r.dv) * 10.0f;
-        var[kWorldZ][l] = -10.0f;
-        var[kNormalZ][l] = 1.0f;
-        var[kTangentX][l] = 1.0f;
-        var[kTangentW][l] = 1.0f;
-        var[kU][l] = float(r.u0);
-        var[kV][l] = float(r.v0);
-      }
-      Fragments in;
-      for (int k = 0; k < kVaryingCount; ++k) in.varyings[k] = simd::Float::load_aligned(var[k]);
-      in.pixel_x = in.pixel_y = simd::Float(0.0f);
-      in.view_depth = simd::Float(10.0f);
-      in.covered = simd::from_bits(covered);
-      ShadeOutput out;
-      program.shade(in, out);
-      alignas(64) float hu[simd::kLanes], hv[simd::kLanes], hd[simd::kLanes], it[simd::kLanes];
-      out.hit_u.store_aligned(hu);
-      out.hit_v.store_aligned(hv);
-      out.hit_depth.store_aligned(hd);
-      out.iterations.store_aligned(it);
-      for (int l = 0; l < simd::kLanes && first + std::size_t(l) < rays.size(); ++l)
-        results.push_back({hu[l], hv[l], hd[l], it[l]});
-    }
-    return results;
+    // One camera per batch is not enough for per-lane directions: the view vector is built from world
+    // positions instead (see trace_rays).
+    LightRig rig;
+    rig.camera_position = glm::vec3(0.0f);
+    return trace_rays(DisplacementProgram(inputs, material_, rig), rays);
   }
 
 private:

@@ -59,42 +59,7 @@ public:
     }
     LightRig rig;
     rig.camera_position = glm::vec3(0.0f);
-    const DisplacementProgram program(inputs, material_, rig);
-    std::vector<TechniqueResult> results;
-    for (std::size_t first = 0; first < rays.size(); first += simd::kLanes) {
-      alignas(64) float var[kVaryingCount][simd::kLanes] = {};
-      std::uint32_t covered = 0;
-      for (int l = 0; l < simd::kLanes; ++l) {
-        const std::size_t k = std::min(first + std::size_t(l), rays.size() - 1);
-        const TechniqueRay& r = rays[k];
-        if (first + std::size_t(l) < rays.size()) covered |= 1u << l;
-        var[kWorldX][l] = float(r.du) * 10.0f;
-        var[kWorldY][l] = float(r.dv) * 10.0f;
-        var[kWorldZ][l] = -10.0f;
-        var[kNormalZ][l] = 1.0f;
-        var[kTangentX][l] = 1.0f;
-        var[kTangentW][l] = 1.0f;
-        var[kU][l] = float(r.u0);
-        var[kV][l] = float(r.v0);
-        if (!vertex_weights.empty())
-          for (int i = 0; i < kLayers; ++i) var[kWeight0 + i][l] = vertex_weights[k][std::size_t(i)];
-      }
-      Fragments in;
-      for (int k = 0; k < kVaryingCount; ++k) in.varyings[k] = simd::Float::load_aligned(var[k]);
-      in.pixel_x = in.pixel_y = simd::Float(0.0f);
-      in.view_depth = simd::Float(10.0f);
-      in.covered = simd::from_bits(covered);
-      ShadeOutput out;
-      program.shade(in, out);
-      alignas(64) float hu[simd::kLanes], hv[simd::kLanes], hd[simd::kLanes], it[simd::kLanes];
-      out.hit_u.store_aligned(hu);
-      out.hit_v.store_aligned(hv);
-      out.hit_depth.store_aligned(hd);
-      out.iterations.store_aligned(it);
-      for (int l = 0; l < simd::kLanes && first + std::size_t(l) < rays.size(); ++l)
-        results.push_back({hu[l], hv[l], hd[l], it[l]});
-    }
-    return results;
+    return trace_rays(DisplacementProgram(inputs, material_, rig), rays, vertex_weights);
   }
 
 private:
