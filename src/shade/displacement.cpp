@@ -192,24 +192,9 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const 
     const IntMask at_stop = level <= stop;
     const Mask hit = below & float_mask(at_stop);
     active = active & !hit;
-    // Below the cell's top but not at the last level: descend into the child that holds the ray. The child is
-    // chosen by comparing s with the depth where the ray crosses the parent's mid line, computed exactly as wall
-    // crossings are, so a ray standing on a wall is never put back into the cell it just left.
+    // Below the cell's top but not at the last level: descend into the child that holds the ray.
     const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) {
-      const Int child_level = xsimd::max(level - Int(1), Int(0));
-      const Float child_cell = xsimd::to_float(Int(1) << child_level);
-      const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
-      const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
-      const Float zero(0.0f);
-      const Mask high_x = ((dx > zero) & (s >= (mid_x - x0) / dx)) | ((dx < zero) & (s < (mid_x - x0) / dx)) |
-                          ((dx == zero) & (x0 >= mid_x));
-      const Mask high_y = ((dy > zero) & (s >= (mid_y - y0) / dy)) | ((dy < zero) & (s < (mid_y - y0) / dy)) |
-                          ((dy == zero) & (y0 >= mid_y));
-      cx = xsimd::select(descend, cx * Int(2) + xsimd::select(int_mask(high_x), Int(1), Int(0)), cx);
-      cy = xsimd::select(descend, cy * Int(2) + xsimd::select(int_mask(high_y), Int(1), Int(0)), cy);
-      level = xsimd::select(descend, child_level, level);
-    }
+    if (xsimd::any(descend)) descend_to_child(descend, s, x0, y0, dx, dy, level, cx, cy);
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
     const Mask above = active & !below;
     if (!xsimd::any(above)) continue;

@@ -126,22 +126,9 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     const Mask hit = below & float_mask(level == Int(0));
     occluded = occluded | hit;
     active = active & !hit;
-    // Below the cell's maximum above level 0: descend into the child that holds the ray at c, chosen by
-    // comparing c with the crossing of the parent's mid line computed as wall crossings are (QDM's rule).
+    // Below the cell's maximum above level 0: descend into the child that holds the ray at c (QDM's rule).
     const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) {
-      const Int child_level = xsimd::max(level - Int(1), Int(0));
-      const Float child_cell = xsimd::to_float(Int(1) << child_level);
-      const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
-      const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
-      const Mask high_x = ((dx > zero) & (c >= (mid_x - x0) / dx)) | ((dx < zero) & (c < (mid_x - x0) / dx)) |
-                          ((dx == zero) & (x0 >= mid_x));
-      const Mask high_y = ((dy > zero) & (c >= (mid_y - y0) / dy)) | ((dy < zero) & (c < (mid_y - y0) / dy)) |
-                          ((dy == zero) & (y0 >= mid_y));
-      cx = xsimd::select(descend, cx * Int(2) + xsimd::select(int_mask(high_x), Int(1), Int(0)), cx);
-      cy = xsimd::select(descend, cy * Int(2) + xsimd::select(int_mask(high_y), Int(1), Int(0)), cy);
-      level = xsimd::select(descend, child_level, level);
-    }
+    if (xsimd::any(descend)) descend_to_child(descend, c, x0, y0, dx, dy, level, cx, cy);
     // At or above the cell's maximum where it enters: above it all the way through; on to the next cell.
     const Mask advance = active & !below;
     if (!xsimd::any(advance)) continue;

@@ -26,4 +26,26 @@ struct CappedLoop {
   simd::Float iterations() const { return xsimd::to_float(done); }
 };
 
+// Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray x(t) = x0 + dx t,
+// y(t) = y0 + dy t (texel units) at t: t is compared with where the ray crosses the parent's mid lines, computed
+// exactly as wall crossings are, so a ray standing on a wall is never put back into the cell it just left.
+inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const simd::Float& x0,
+                             const simd::Float& y0, const simd::Float& dx, const simd::Float& dy, simd::Int& level,
+                             simd::Int& cx, simd::Int& cy) {
+  using simd::Float;
+  using simd::Int;
+  const Int child_level = xsimd::max(level - Int(1), Int(0));
+  const Float child_cell = xsimd::to_float(Int(1) << child_level);
+  const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
+  const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
+  const Float zero(0.0f);
+  const simd::Mask high_x = ((dx > zero) & (t >= (mid_x - x0) / dx)) | ((dx < zero) & (t < (mid_x - x0) / dx)) |
+                            ((dx == zero) & (x0 >= mid_x));
+  const simd::Mask high_y = ((dy > zero) & (t >= (mid_y - y0) / dy)) | ((dy < zero) & (t < (mid_y - y0) / dy)) |
+                            ((dy == zero) & (y0 >= mid_y));
+  cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
+  cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
+  level = xsimd::select(descend, child_level, level);
+}
+
 }  // namespace qdmr
