@@ -50,16 +50,26 @@ inline std::string scene_name(const testing::TestParamInfo<ShippedScene>& info) 
 }
 inline void PrintTo(const ShippedScene& scene, std::ostream* out) { *out << scene.name; }
 
-// The scene file and the --set overrides it needs. real_rocks.json names ../../shared/data/...: point its
-// three maps at test::data_dir() so a non-default QDMR_DATA_DIR works.
-inline std::vector<std::string> scene_args(const ShippedScene& scene) {
-  std::vector<std::string> args{(source_dir() / "scenes" / (scene.name + ".json")).string()};
-  if (scene.name == "real_rocks") {
-    const std::filesystem::path maps = data_dir() / "materials" / "ambientcg_rocks007";
-    for (const char* map : {"albedo", "normal", "height"})
-      args.insert(args.end(), {"--set", std::string("/materials/rocks/layers/0/") + map + "=" +
-                                            nlohmann::json((maps / (std::string(map) + ".jpg")).string()).dump()});
+// Every string of `value` that names a file under ../../shared/data/, as --set overrides pointing it at the same
+// file under test::data_dir() instead, so a non-default QDMR_DATA_DIR works.
+inline void relocate_data_paths(const nlohmann::json& value, const std::string& pointer, std::vector<std::string>& args) {
+  static const std::string prefix = "../../shared/data/";
+  if (value.is_string()) {
+    const std::string text = value.get<std::string>();
+    if (text.rfind(prefix, 0) == 0)
+      args.insert(args.end(), {"--set", pointer + "=" + nlohmann::json((data_dir() / text.substr(prefix.size())).string()).dump()});
+  } else if (value.is_object()) {
+    for (const auto& [key, item] : value.items()) relocate_data_paths(item, pointer + "/" + key, args);
+  } else if (value.is_array()) {
+    for (std::size_t i = 0; i < value.size(); ++i) relocate_data_paths(value[i], pointer + "/" + std::to_string(i), args);
   }
+}
+
+// The scene file and the --set overrides it needs: the real_* scenes' data paths relocated.
+inline std::vector<std::string> scene_args(const ShippedScene& scene) {
+  const std::filesystem::path file = source_dir() / "scenes" / (scene.name + ".json");
+  std::vector<std::string> args{file.string()};
+  if (scene.needs_data) relocate_data_paths(nlohmann::json::parse(read_file(file)), "", args);
   return args;
 }
 

@@ -62,6 +62,9 @@ shot lighting_cook_torrance "$blend" --set $M/lighting/model=cook_torrance --set
 # The default scene as stored: QDMHB over four layers, per-pixel terrain weights, qdm_soft shadows, baked AO.
 shot terrain "$terrain"
 
+# The same on real data (../shared/data beside the repository; skipped without it).
+if [ -d "$root/../shared/data" ]; then shot real_terrain "$root/scenes/real_terrain.json"; fi
+
 python3 - "$tmp" <<'EOF'
 import json, pathlib, sys
 print("| image | frame ms (1920x1080, one render) | iterations mean / p99 |")
