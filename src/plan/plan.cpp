@@ -438,7 +438,8 @@ nlohmann::json FramePlan::to_json() const {
       layers.push_back({{"albedo", l.albedo}, {"normal", l.normal}, {"height", l.height}, {"height_max", l.height_max}});
     j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"layers", layers},
                               {"cone_map", m.cone_map ? nlohmann::json(cone_kind_name(m.cone_kind)) : nlohmann::json()},
-                              {"cone_bytes", m.cone_bytes}, {"weight_bytes", m.weight_bytes}, {"ao_bytes", m.ao_bytes}});
+                              {"cone_bytes", m.cone_bytes}, {"weight_bytes", m.weight_bytes},
+                              {"combined_quadtree_bytes", m.combined_bytes}, {"ao_bytes", m.ao_bytes}});
   }
   for (const TextureRequest& t : textures)
     j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
