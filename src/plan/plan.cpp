@@ -339,7 +339,15 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
       }
     }
   }
-  if (material.ao.mode == AoMode::Baked) {
+  const float weight_scale = material.blend.weights.scale;
+  if (material.ao.mode == AoMode::Baked && plan.blend && weight_scale == std::floor(weight_scale)) {
+    // One map of the blended surface over the weights span (side: the setting, else that span's texels up to 2048).
+    const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
+    const std::uint64_t span = std::uint64_t(h.width) * std::uint64_t(weight_scale);
+    plan.ao_map = plan.blend_ao = true;
+    plan.ao_resolution = material.ao.resolution > 0 ? material.ao.resolution : int(std::min<std::uint64_t>(span, 2048));
+    plan.ao_bytes = chain_bytes(plan.ao_resolution, plan.ao_resolution, TexelFormat::R16);
+  } else if (material.ao.mode == AoMode::Baked) {
     const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
     const int w = material.ao.resolution > 0 ? material.ao.resolution : h.width;
     const int hh = material.ao.resolution > 0 ? material.ao.resolution : h.height;
@@ -401,7 +409,9 @@ std::string FramePlan::describe() const {
                                                                          : "per pixel, weight texture " + mib(m.weight_bytes))
         << (m.combined_quadtree ? ", combined quadtree " + mib(m.combined_bytes) : std::string())
         << "\n";
-    if (m.ao_map) s << "    ao: baked map per layer, " << mib(m.ao_bytes) << ", baked or from cache\n";
+    if (m.ao_map)
+      s << "    ao: baked map " << (m.blend_ao ? "of the blended surface" : "per layer") << ", " << mib(m.ao_bytes)
+        << ", baked or from cache\n";
     if (m.cone_map)
       s << "    cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes) << "\n";
   }

@@ -153,6 +153,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
     for (const LayerPlan& l : m.layers)
       inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max)});
     const bool reference = reference_aovs && m.technique != TechniqueKind::Normal;
+    const Texture* weight_texture = nullptr;  // blends: the per-pixel weights (also made for references and AO)
     if (m.blend) {
       const Image map = make_weight_map(desc.blend.weights, int(desc.layers.size()), file + ": /materials/" + desc.name + "/blend/weights");
       const WeightsDesc& w = desc.blend.weights;
@@ -166,9 +167,10 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         else if (w.from_vertices)
           rasterize_vertex_weights(mesh.uvs, mesh.indices, at_vertices, w.scale, level0);
       }
-      if (m.weight_mode == WeightMode::Pixel || reference) {
+      if (m.weight_mode == WeightMode::Pixel || reference || m.blend_ao) {
         assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(level0)));
-        if (m.weight_mode == WeightMode::Pixel) inputs.weights = assets.derived_textures.back().get();
+        weight_texture = assets.derived_textures.back().get();
+        if (m.weight_mode == WeightMode::Pixel) inputs.weights = weight_texture;
       }
       if (m.combined_quadtree) {
         std::vector<const Texture*> heights;
@@ -183,7 +185,7 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         const float scale = desc.blend.weights.scale;
         const std::string where = file + ": /materials/" + desc.name + "/blend/weights/scale";
         if (scale != std::floor(scale)) throw Error(where, "error AOVs of a blend need a whole number of repeats");
-        const Texture* weights = inputs.weights ? inputs.weights : assets.derived_textures.back().get();
+        const Texture* weights = weight_texture;
         std::vector<const Texture*> heights;
         for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
         const std::uint64_t texels = std::uint64_t(heights[0]->width()) * heights[0]->height() * std::uint64_t(scale * scale);
@@ -196,7 +198,21 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         assets.reference_fields.push_back(std::move(field));
       }
     }
-    if (m.ao_map) {
+    if (m.blend_ao) {
+      // The AO of the blended surface itself, over the repeats the weights span, sampled at UV / scale.
+      const int scale = int(desc.blend.weights.scale);
+      std::vector<const Texture*> heights;
+      for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
+      const HeightField field = combined_surface(heights, *weight_texture, scale, desc.blend.op);
+      AoDesc ao = desc.ao;
+      ao.radius /= float(scale);  // the field's UV spans `scale` repeats
+      ao.resolution = m.ao_resolution;
+      assets.derived_textures.push_back(std::make_unique<Texture>(make_mip_texture(
+          load_or_bake_ao_map(field, desc.technique.depth_scale, ao, default_cache_dir()), TexelFormat::R16, false,
+          MipReduce::Box)));
+      inputs.blend_ao = assets.derived_textures.back().get();
+      inputs.blend_ao_scale = scale;
+    } else if (m.ao_map) {
       // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
       for (std::size_t l = 0; l < inputs.layers.size(); ++l) {
         const HeightField field = height_field(*inputs.layers[l].height, m.sampling.address);

@@ -75,8 +75,13 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     if (l.ao) layer.ao.emplace(*l.ao);
     layers_.push_back(std::move(layer));
   }
-  if (ao_.mode == AoMode::Baked && std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
-    throw Error("displacement program", "baked AO needs an AO map per layer");
+  if (inputs.blend_ao) {
+    blend_ao_.emplace(*inputs.blend_ao);
+    blend_ao_scale_ = inputs.blend_ao_scale;
+  }
+  if (ao_.mode == AoMode::Baked && !blend_ao_ &&
+      std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
+    throw Error("displacement program", "baked AO needs an AO map per layer or one of the blend");
   if (inputs.weights) weights_.emplace(*inputs.weights);
   if (inputs.combined) {
     combined_.emplace(*inputs.combined);
@@ -594,7 +599,14 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     blend_factors(blend_.op, blend_.width, count, h, w, f);
     for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
     for (int c = 0; c < 3; ++c) tangent_normal[c] = Float(0.0f);
-    if (ao_.mode == AoMode::Baked) ao = Float(0.0f);
+    if (blend_ao_) {
+      const Float inv(1.0f / float(blend_ao_scale_));
+      Float a[4];
+      sample(*blend_ao_, ao_sampler, hu * inv, hv * inv, Float(0.0f), a);
+      ao = a[0];
+    } else if (ao_.mode == AoMode::Baked) {
+      ao = Float(0.0f);
+    }
     for (int i = 0; i < count; ++i) {
       if (!xsimd::any(f[i] > Float(0.0f))) continue;  // a layer absent from the whole batch costs no fetch
       const Layer& l = layers_[std::size_t(i)];

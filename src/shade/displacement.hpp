@@ -31,6 +31,8 @@ struct DisplacementInputs {
   const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
   const Texture* combined = nullptr;      // blending per pixel: the precomputed combined quadtree (optional)
   int combined_period = 0;                // its period in level-0 texels (layers' size x repeats of the weights)
+  const Texture* blend_ao = nullptr;      // baked AO of a blend's combined surface over the weights span (R16)
+  int blend_ao_scale = 1;                 // ... sampled at UV / this (the whole number of repeats it spans)
   const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
   int reference_scale = 1;                // texture repeats the reference spans (a blend's combined surface)
@@ -97,6 +99,8 @@ private:
   std::optional<TextureView> weights_;
   std::optional<TextureView> combined_;
   int combined_period_ = 0;
+  std::optional<TextureView> blend_ao_;
+  int blend_ao_scale_ = 1;
   const ConeMap* cones_;
   const HeightField* reference_;
   int reference_scale_;

@@ -23,6 +23,21 @@ TEST(CliShadingOptions, NeutralSettingsGiveTheSameBitsAsOff) {
   EXPECT_EQ(render_hash({"/materials/blend/shadow/mode=hard", "/materials/blend/shadow/bias=1"}), off);
   // AO at strength 0 is 1 - 0 (1 - ao) = 1 exactly.
   EXPECT_EQ(render_hash({"/materials/blend/ao/mode=frame", "/materials/blend/ao/strength=0"}), off);
+  // Baked AO of a blend is the AO of the combined surface: layers of one constant height alpha-blend to a flat
+  // surface, whose AO is 1 (the map stores 1 exactly: 16 bits hide the rounding of the blend), so the image is
+  // the AO-off one.
+  {
+    const TemporaryConeCache cache;  // the bake goes to a temporary cache
+    std::vector<std::string> flat{"/materials/blend/blend/operator=alpha"};
+    for (int i = 0; i < 4; ++i) {
+      const std::string layer = "/materials/blend/layers/" + std::to_string(i);
+      flat.push_back(layer + R"(/height={"procedural": "flat", "size": 512})");
+      flat.push_back(layer + "/height_scale=1");
+    }
+    const std::uint64_t flat_off = render_hash(flat);
+    flat.push_back("/materials/blend/ao/mode=baked");
+    EXPECT_EQ(render_hash(flat), flat_off);
+  }
   // Specular generated from the albedo with scale 0 is the constant specular 0.
   const std::uint64_t no_specular = render_hash({"/materials/blend/lighting/specular=0"});
   EXPECT_EQ(render_hash({"/materials/blend/lighting/specular=0", "/materials/blend/layers/0/specular/scale=0"}),

@@ -48,7 +48,9 @@ struct MaterialPlan {
   std::uint64_t weight_bytes = 0;  // pixel mode: RGBA8 weight texture with its max chain
   bool combined_quadtree = false;  // pixel mode, qdm: the precomputed max-quadtree of the blended surface
   std::uint64_t combined_bytes = 0;
-  bool ao_map = false;       // baked AO: one float per texel, baked or from the cache
+  bool ao_map = false;       // baked AO: one map per layer, or one of the blended surface (blend_ao)
+  bool blend_ao = false;     // baked AO of a blend: of the combined surface over the weights span
+  int ao_resolution = 0;     // blend_ao: the map's side
   std::uint64_t ao_bytes = 0;
   bool cone_map = false;     // csm, rcsm: a cone map of the height's level 0, baked or from the cache
   ConeKind cone_kind = ConeKind::Conservative;
