@@ -9,15 +9,13 @@ mapping time", per-vertex blend with 4 surfaces: relief 3 ms, POM 2.5 ms, POM wi
 
     bench/blend.py [-n RUNS] [-B BUILD_DIR] [--width W --height H]
 """
-import argparse
-import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from bench_util import ROOT, arguments, render
+
 SCENE = os.path.join(ROOT, "scenes", "surface_blend_4layers.json")
 M = "/materials/blend"
 VARIANTS = [  # (label, --set pairs, the talk's ms over normal mapping)
@@ -28,24 +26,8 @@ VARIANTS = [  # (label, --set pairs, the talk's ms over normal mapping)
 ]
 
 
-def render(qdmr, scene, sets, width, height, tmp):
-    stats = os.path.join(tmp, "stats.json")
-    cmd = [qdmr, "render", scene, "-o", os.path.join(tmp, "image.exr"), "--stats", stats,
-           "--width", str(width), "--height", str(height)]
-    for pointer, value in sets:
-        cmd += ["--set", f"{pointer}={value}"]
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    with open(stats) as f:
-        return json.load(f)
-
-
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("-n", type=int, default=3)
-    parser.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
-    parser.add_argument("--width", type=int, default=1920)
-    parser.add_argument("--height", type=int, default=1080)
-    args = parser.parse_args()
+    args = arguments(__doc__.splitlines()[0]).parse_args()
     qdmr = os.path.join(args.B, "qdmr")
     times = {label: [] for label, _, _ in VARIANTS}
     iters = {}

@@ -13,15 +13,14 @@ shadow's or AO's fetches), from the last run.
 
     bench/shadows_ao.py [-n RUNS] [-B BUILD_DIR] [--width W --height H]
 """
-import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from bench_util import ROOT, arguments, render
+
 SCENE = os.path.join(ROOT, "scenes", "terrain.json")
 M = "/materials/ground"
 OFF = [(f"{M}/shadow/mode", "off"), (f"{M}/ao/mode", "off")]
@@ -42,17 +41,6 @@ VARIANTS = [  # (label, scene: None = terrain.json, "single" = the one-layer cop
 TALK = {"shadow qdm_soft": "0.5 (QDM self-shadowing, full screen)"}
 
 
-def render(qdmr, scene, sets, width, height, tmp, env):
-    stats = os.path.join(tmp, "stats.json")
-    cmd = [qdmr, "render", scene, "-o", os.path.join(tmp, "image.exr"), "--stats", stats,
-           "--width", str(width), "--height", str(height)]
-    for pointer, value in sets:
-        cmd += ["--set", f"{pointer}={value}"]
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
-    with open(stats) as f:
-        return json.load(f)
-
-
 def single_layer_scene(tmp):
     with open(SCENE) as f:
         scene = json.load(f)
@@ -66,22 +54,17 @@ def single_layer_scene(tmp):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("-n", type=int, default=3)
-    parser.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
-    parser.add_argument("--width", type=int, default=1920)
-    parser.add_argument("--height", type=int, default=1080)
-    args = parser.parse_args()
+    args = arguments(__doc__.splitlines()[0]).parse_args()
     qdmr = os.path.join(args.B, "qdmr")
     times = {label: [] for label, _, _ in VARIANTS}
     iters = {}
     with tempfile.TemporaryDirectory() as tmp:
         env = dict(os.environ, QDMR_CACHE_DIR=os.path.join(tmp, "cache"))
         scenes = {None: SCENE, "single": single_layer_scene(tmp)}
-        render(qdmr, SCENE, OFF + [(f"{M}/ao/mode", "baked")], 320, 180, tmp, env)  # bakes the AO maps
+        render(qdmr, SCENE, OFF + [(f"{M}/ao/mode", "baked")], 320, 180, tmp, env=env)  # bakes the AO maps
         for _ in range(args.n):
             for label, scene, sets in VARIANTS:
-                stats = render(qdmr, scenes[scene], sets, args.width, args.height, tmp, env)
+                stats = render(qdmr, scenes[scene], sets, args.width, args.height, tmp, env=env)
                 times[label].append(stats["time_ms"]["raster_shade"])
                 iters[label] = stats["iterations"]
     med = {label: statistics.median(v) for label, v in times.items()}

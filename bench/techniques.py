@@ -9,7 +9,6 @@ raster+shade stage from --stats) and prints a markdown table.
 
     bench/techniques.py [-n RUNS] [-B BUILD_DIR] [--width W --height H] [SCENE ...]
 """
-import argparse
 import json
 import os
 import statistics
@@ -17,7 +16,8 @@ import subprocess
 import sys
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from bench_util import ROOT, arguments, render
+
 SCENES = ["pom_vs_qdm_depth_1.0", "pom_vs_qdm_depth_1.5", "pom_vs_qdm_depth_5.0", "extreme_grazing_2048"]
 TALK_MS = {"pom_vs_qdm_depth_1.0": (5.0, 5.66), "pom_vs_qdm_depth_1.5": (6.66, 6.7),
            "pom_vs_qdm_depth_5.0": (18.87, 9.0), "extreme_grazing_2048": (73.0, 14.0)}
@@ -29,18 +29,9 @@ def materials(scene):
         return list(json.load(f)["materials"].keys())
 
 
-def render(qdmr, scene, sets, width, height, tmp, aov=None):
-    out = os.path.join(tmp, "image.exr")
-    stats = os.path.join(tmp, "stats.json")
-    cmd = [qdmr, "render", os.path.join(ROOT, "scenes", scene + ".json"), "-o", out, "--stats", stats,
-           "--width", str(width), "--height", str(height)]
-    for pointer, value in sets:
-        cmd += ["--set", f"{pointer}={value}"]
-    if aov:
-        cmd += ["--aov", f"missed={os.path.join(tmp, 'missed.exr')}"]
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    with open(stats) as f:
-        return json.load(f)
+def render_scene(qdmr, scene, sets, width, height, tmp, aov=None):
+    extra = ["--aov", f"missed={os.path.join(tmp, 'missed.exr')}"] if aov else []
+    return render(qdmr, os.path.join(ROOT, "scenes", scene + ".json"), sets, width, height, tmp, extra=extra)
 
 
 def missed_fraction(stats, tmp, width, height):
@@ -68,7 +59,7 @@ def tune(qdmr, scene, technique, tmp, start, limit):
             start = max([start] + [m["technique"].get("min_steps", 8) for m in json.load(f)["materials"].values()])
     value = start
     while True:
-        stats = render(qdmr, scene, technique_sets(scene, technique, value), 480, 270, tmp, aov=True)
+        stats = render_scene(qdmr, scene, technique_sets(scene, technique, value), 480, 270, tmp, aov=True)
         missed = missed_fraction(stats, tmp, 480, 270)
         if missed < 0.001 or value >= limit:
             return value, missed
@@ -76,11 +67,7 @@ def tune(qdmr, scene, technique, tmp, start, limit):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("-n", type=int, default=3)
-    parser.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
-    parser.add_argument("--width", type=int, default=1920)
-    parser.add_argument("--height", type=int, default=1080)
+    parser = arguments(__doc__.splitlines()[0])
     parser.add_argument("scenes", nargs="*", default=SCENES)
     args = parser.parse_args()
     qdmr = os.path.join(args.B, "qdmr")
@@ -95,7 +82,7 @@ def main():
             for _ in range(args.n):
                 for t in ("normal", "pom", "qdm"):
                     sets = technique_sets(scene, t, settings[t][0] if t in settings else None)
-                    stats = render(qdmr, scene, sets, args.width, args.height, tmp)
+                    stats = render_scene(qdmr, scene, sets, args.width, args.height, tmp)
                     times[t].append(stats["time_ms"]["raster_shade"])
                     iters[t] = stats["iterations"]
             med = {t: statistics.median(v) for t, v in times.items()}

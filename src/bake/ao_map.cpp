@@ -5,15 +5,14 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bake/content_hash.hpp"
-#include "io/atomic_file.hpp"
+#include "bake/float_cache.hpp"
 #include "qdmr/core/error.hpp"
 #include "shade/ao_pattern.hpp"
 
@@ -21,8 +20,9 @@ namespace qdmr {
 namespace {
 
 // Bump when the definition, the rounding or the file layout of an AO map changes: old files stop matching.
-constexpr std::uint32_t kAoFormatVersion = 1;
-constexpr char kMagic[8] = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
+// Version 2: the shared bake-cache header (bake/float_cache.hpp).
+constexpr std::uint32_t kAoFormatVersion = 2;
+constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
 
 struct MapSize {
   int width, height;
@@ -111,64 +111,6 @@ double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double dept
   return visible / double(n);
 }
 
-// The fixed-size header in front of the float values of a cache file (host byte order: the cache is local).
-struct CacheHeader {
-  char magic[8];
-  std::uint32_t version;
-  std::int32_t width, height;
-  std::uint32_t reserved;
-  std::uint64_t key;
-  std::uint64_t payload_hash;  // FNV-1a of the values' bytes
-};
-
-std::uint64_t payload_hash(const std::vector<float>& values) {
-  Fnv1a f;
-  f.bytes(values.data(), values.size() * sizeof(float));
-  return f.hash;
-}
-
-// The cached map, or nothing when the file is missing, foreign, truncated or corrupt.
-std::optional<Image> read_cache(const std::filesystem::path& file, std::uint64_t key, MapSize size) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::size_t count = std::size_t(size.width) * std::size_t(size.height);
-  std::error_code ec;
-  if (std::filesystem::file_size(file, ec) != sizeof(CacheHeader) + count * sizeof(float) || ec) return std::nullopt;
-  CacheHeader header{};
-  if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return std::nullopt;
-  if (std::memcmp(header.magic, kMagic, sizeof kMagic) != 0 || header.version != kAoFormatVersion ||
-      header.width != size.width || header.height != size.height || header.key != key)
-    return std::nullopt;
-  Image map(size.width, size.height, 1);
-  if (!in.read(reinterpret_cast<char*>(map.texels.data()), std::streamsize(count * sizeof(float)))) return std::nullopt;
-  if (payload_hash(map.texels) != header.payload_hash) return std::nullopt;
-  for (float a : map.texels)
-    if (!(a >= 0.0f && a <= 1.0f)) return std::nullopt;
-  return map;
-}
-
-void write_cache(const std::filesystem::path& file, std::uint64_t key, const Image& map) {
-  std::error_code ec;
-  std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) return;
-  CacheHeader header{};
-  std::memcpy(header.magic, kMagic, sizeof kMagic);
-  header.version = kAoFormatVersion;
-  header.width = map.width;
-  header.height = map.height;
-  header.key = key;
-  header.payload_hash = payload_hash(map.texels);
-  try {  // the cache is best effort: an unwritable folder only costs a rebake next time
-    write_atomically(file, "ao map cache", [&](const std::filesystem::path& temporary) -> std::string {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(reinterpret_cast<const char*>(&header), sizeof header);
-      out.write(reinterpret_cast<const char*>(map.texels.data()), std::streamsize(map.bytes()));
-      return out.flush() ? "" : "write failed";
-    });
-  } catch (const Error&) {
-  }
-}
-
 }  // namespace
 
 Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc) {
@@ -211,9 +153,15 @@ Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const Ao
   if (field.width <= 0 || field.height <= 0) return bake_ao_map(field, depth_scale, desc);  // throws
   const std::uint64_t key = ao_map_key(field, depth_scale, desc);
   const std::filesystem::path file = cache_dir / ("ao-" + hex(key) + ".bin");
-  if (std::optional<Image> cached = read_cache(file, key, map_size(field, desc))) return std::move(*cached);
+  const MapSize size = map_size(field, desc);
+  const FloatCacheId id{kMagic, kAoFormatVersion, 0, size.width, size.height, key};
+  if (std::optional<std::vector<float>> cached = read_float_cache(file, id, 0.0f, 1.0f)) {
+    Image map(size.width, size.height, 1);
+    map.texels = std::move(*cached);
+    return map;
+  }
   Image map = bake_ao_map(field, depth_scale, desc);
-  write_cache(file, key, map);
+  write_float_cache(file, id, map.texels);
   return map;
 }
 

@@ -241,8 +241,6 @@ const char* blend_name(BlendOperator op) {
   return "?";
 }
 
-std::uint64_t rgba8_chain_bytes(int side) { return chain_bytes(side, side, TexelFormat::RGBA8); }
-
 }  // namespace
 
 MaterialPlan plan_material(const MaterialDesc& material, const std::string& where,
@@ -318,7 +316,7 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
     const int r = material.blend.weights.resolution;
     if ((r & (r - 1)) != 0)
       throw Error(where + "/blend/weights/resolution", "must be a power of two, got " + std::to_string(r));
-    plan.weight_bytes = rgba8_chain_bytes(r);
+    plan.weight_bytes = chain_bytes(r, r, TexelFormat::RGBA8);
     const BlendQuadtree choice = material.blend.quadtree;
     if (kind == TechniqueKind::Qdm && choice != BlendQuadtree::Product) {
       // The combined tree spans the weights' repeats: a whole number of them, and not too many texels.

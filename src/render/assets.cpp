@@ -167,52 +167,47 @@ Assets prepare_assets(const SceneDesc& scene, const LightRig& lights, const Rend
         else if (w.from_vertices)
           rasterize_vertex_weights(mesh.uvs, mesh.indices, at_vertices, w.scale, level0);
       }
-      if (m.weight_mode == WeightMode::Pixel || reference || m.blend_ao) {
+      if (m.weight_mode == WeightMode::Pixel || m.combined_quadtree || reference || m.blend_ao) {
         assets.derived_textures.push_back(std::make_unique<Texture>(make_weight_texture(level0)));
         weight_texture = assets.derived_textures.back().get();
         if (m.weight_mode == WeightMode::Pixel) inputs.weights = weight_texture;
       }
-      if (m.combined_quadtree) {
-        std::vector<const Texture*> heights;
-        for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
-        assets.derived_textures.push_back(std::make_unique<Texture>(
-            combined_quadtree(heights, *inputs.weights, int(w.scale), desc.blend.op)));
-        inputs.combined = assets.derived_textures.back().get();
-        inputs.combined_period = heights[0]->width() * int(w.scale);
-      }
-      if (reference) {
-        // The exact reference is the blend with per-pixel weights (so per-vertex errors show the floating).
-        const float scale = desc.blend.weights.scale;
+      if (m.combined_quadtree || reference || m.blend_ao) {
+        // The blended box surface with per-pixel weights over the repeats the weights span, made once for the
+        // combined quadtree, the exact reference (per-vertex errors then show the floating) and the baked AO.
+        const float scale = w.scale;
         const std::string where = file + ": /materials/" + desc.name + "/blend/weights/scale";
         if (scale != std::floor(scale)) throw Error(where, "error AOVs of a blend need a whole number of repeats");
-        const Texture* weights = weight_texture;
         std::vector<const Texture*> heights;
         for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
         const std::uint64_t texels = std::uint64_t(heights[0]->width()) * heights[0]->height() * std::uint64_t(scale * scale);
-        if (texels > (1ull << 26))
+        if (reference && texels > (1ull << 26))
           throw Error(where, "error AOVs of this blend need a reference of " + std::to_string(texels) +
                                  " texels (the layers' size times scale squared), more than 2^26");
-        auto field = std::make_unique<HeightField>(combined_surface(heights, *weights, int(scale), desc.blend.op));
-        inputs.reference = field.get();
-        inputs.reference_scale = int(scale);
-        assets.reference_fields.push_back(std::move(field));
+        auto combined = std::make_unique<HeightField>(combined_surface(heights, *weight_texture, int(scale), desc.blend.op));
+        if (m.combined_quadtree) {
+          assets.derived_textures.push_back(std::make_unique<Texture>(combined_quadtree(*combined)));
+          inputs.combined = assets.derived_textures.back().get();
+          inputs.combined_period = combined->width;
+        }
+        if (m.blend_ao) {
+          AoDesc ao = desc.ao;
+          ao.radius /= scale;  // the field's UV spans `scale` repeats
+          ao.resolution = m.ao_resolution;
+          assets.derived_textures.push_back(std::make_unique<Texture>(make_mip_texture(
+              load_or_bake_ao_map(*combined, desc.technique.depth_scale, ao, default_cache_dir()), TexelFormat::R16,
+              false, MipReduce::Box)));
+          inputs.blend_ao = assets.derived_textures.back().get();
+          inputs.blend_ao_scale = int(scale);
+        }
+        if (reference) {
+          inputs.reference = combined.get();
+          inputs.reference_scale = int(scale);
+          assets.reference_fields.push_back(std::move(combined));
+        }
       }
     }
-    if (m.blend_ao) {
-      // The AO of the blended surface itself, over the repeats the weights span, sampled at UV / scale.
-      const int scale = int(desc.blend.weights.scale);
-      std::vector<const Texture*> heights;
-      for (const LayerInputs& l : inputs.layers) heights.push_back(l.height);
-      const HeightField field = combined_surface(heights, *weight_texture, scale, desc.blend.op);
-      AoDesc ao = desc.ao;
-      ao.radius /= float(scale);  // the field's UV spans `scale` repeats
-      ao.resolution = m.ao_resolution;
-      assets.derived_textures.push_back(std::make_unique<Texture>(make_mip_texture(
-          load_or_bake_ao_map(field, desc.technique.depth_scale, ao, default_cache_dir()), TexelFormat::R16, false,
-          MipReduce::Box)));
-      inputs.blend_ao = assets.derived_textures.back().get();
-      inputs.blend_ao_scale = scale;
-    } else if (m.ao_map) {
+    if (m.ao_map && !m.blend_ao) {
       // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
       for (std::size_t l = 0; l < inputs.layers.size(); ++l) {
         const HeightField field = height_field(*inputs.layers[l].height, m.sampling.address);

@@ -476,23 +476,23 @@ struct DisplacementProgram::Setup {
   Float ds;  // depth scale after the distance fade
   Ray ray;
   Mask active;  // the covered lanes (helper lanes are not traced)
+  Float height_lod = Float(0.0f);  // mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows
 };
 
 template <class Surface>
 DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup, Float& ds) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
-  const TextureView& height0 = *layers_[0].height;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
   switch (technique_.kind) {
     case TechniqueKind::Normal: break;
     case TechniqueKind::Relief:
-      hit = relief(surface, ray, ds, lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy), active);
+      hit = relief(surface, ray, ds, setup.height_lod, active);
       hit.box_s = hit.s;
       break;
     case TechniqueKind::Pom: {
-      const Float lod = lod_from_derivatives(height0, d.dudx, d.dvdx, d.dudy, d.dvdy);
+      const Float& lod = setup.height_lod;
       // Far away (high LOD) POM fades to normal mapping.
       const Float fade = xsimd::min(
           xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
@@ -592,8 +592,7 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     const int count = surface.layer_count();
     Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
     if (blend_.op != BlendOperator::Alpha) {
-      const Float lod = lod_from_derivatives(*layers_[0].height, d.dudx, d.dvdx, d.dudy, d.dvdy);
-      for (int i = 0; i < count; ++i) h[i] = surface.layer(i).height(hu, hv, lod);
+      for (int i = 0; i < count; ++i) h[i] = surface.layer(i).height(hu, hv, setup.height_lod);
     }
     surface.weights_at(hu, hv, w);
     blend_factors(blend_.op, blend_.width, count, h, w, f);
@@ -650,7 +649,6 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
   Float visibility[limits::kMaxDirectionalLights];
   const bool shadows = shadow_.mode != ShadowMode::Off;
   if (shadows) {
-    const Float lod = lod_from_derivatives(*layers_[0].height, setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
     for (std::size_t j = 0; j < lights_.directional.size(); ++j) {
       const glm::vec3& l = lights_.directional[j].direction;
       const Vec3 lt = setup.frame.to_tangent({Float(l.x), Float(l.y), Float(l.z)});
@@ -662,7 +660,7 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
       const Surface towards_light =
           surface.around(xsimd::min(su, u1), xsimd::max(su, u1), xsimd::min(sv, v1), xsimd::max(sv, v1));
       const ShadowResult r =
-          self_shadow(towards_light, shadow_, ShadowRay{su, sv, s0, du, dv, ds}, lod, setup.active & above);
+          self_shadow(towards_light, shadow_, ShadowRay{su, sv, s0, du, dv, ds}, setup.height_lod, setup.active & above);
       visibility[j] = xsimd::select(above, r.visibility, zero);
     }
   }
@@ -697,6 +695,8 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const Float vz = xsimd::max(setup.view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
   setup.ray = Ray{u, v, (Float(0.0f) - setup.view_tangent.x) / vz, (Float(0.0f) - setup.view_tangent.y) / vz};
   setup.active = in.covered;
+  if (layers_[0].height)
+    setup.height_lod = lod_from_derivatives(*layers_[0].height, setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
 
   const int count = int(layers_.size());
   if (count == 1) {

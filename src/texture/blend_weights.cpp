@@ -172,78 +172,56 @@ std::vector<glm::vec4> vertex_weights(const Image& map, const std::vector<glm::v
   return out;
 }
 
-namespace {
-
-// The blended box value of level-0 texel (x, y) of the period: the layers' texel (x mod W, y mod H) combined
-// with the weights sampled bilinearly at its centre, in fp64. Level 0 of the textures decoded once.
-class BlendedBox {
-public:
-  BlendedBox(const std::vector<const Texture*>& heights, const Texture& weights, BlendOperator op, int scale)
-      : op_(op), layers_(int(heights.size())), lw_(heights[0]->width()), lh_(heights[0]->height()), rw_(weights.width()),
-        rh_(weights.height()), width(lw_ * scale), height(lh_ * scale) {
-    heights_.resize(std::size_t(layers_) * std::size_t(lw_) * std::size_t(lh_));
-    for (int i = 0; i < layers_; ++i)
-      for (int y = 0; y < lh_; ++y)
-        for (int x = 0; x < lw_; ++x) heights_[(std::size_t(i) * lh_ + y) * lw_ + x] = heights[std::size_t(i)]->texel(0, x, y, 0);
-    weights_.resize(std::size_t(rw_) * std::size_t(rh_) * 4);
-    for (int y = 0; y < rh_; ++y)
-      for (int x = 0; x < rw_; ++x)
-        for (int c = 0; c < 4; ++c) weights_[(std::size_t(y) * rw_ + x) * 4 + c] = weights.texel(0, x, y, c);
-  }
-
-  double at(int x, int y) const {
-    const double wx = (x + 0.5) / width * rw_ - 0.5, wy = (y + 0.5) / height * rh_ - 0.5;
-    const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
-    const double fx = wx - x0, fy = wy - y0;
-    const int xa = wrap_index(x0, rw_), xb = wrap_index(x0 + 1, rw_), ya = wrap_index(y0, rh_), yb = wrap_index(y0 + 1, rh_);
-    double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
-    for (int i = 0; i < layers_; ++i) {
-      const double wi = (weight(xa, ya, i) * (1 - fx) + weight(xb, ya, i) * fx) * (1 - fy) +
-                        (weight(xa, yb, i) * (1 - fx) + weight(xb, yb, i) * fx) * fy;
-      const double hi = heights_[(std::size_t(i) * lh_ + std::size_t(y % lh_)) * lw_ + std::size_t(x % lw_)];
-      top = std::max(top, wi * hi);
-      sum_wh += wi * hi;
-      sum_w += wi;
-    }
-    if (op_ != BlendOperator::Alpha) return top;
-    return sum_w > 0.0 ? sum_wh / sum_w : 0.0;
-  }
-
-private:
-  static int wrap_index(int i, int n) { return ((i % n) + n) % n; }
-  double weight(int x, int y, int c) const { return weights_[(std::size_t(y) * rw_ + x) * 4 + std::size_t(c)]; }
-
-  BlendOperator op_;
-  int layers_, lw_, lh_, rw_, rh_;
-  std::vector<float> heights_, weights_;
-
-public:
-  const int width, height;  // of the period, in level-0 texels
-};
-
-}  // namespace
-
 HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
                              BlendOperator op) {
-  const BlendedBox box(heights, weights, op, scale);
+  // Level 0 of the textures decoded once: the layers' heights and the RGBA weights.
+  const int lw = heights[0]->width(), lh = heights[0]->height(), layers = int(heights.size());
+  std::vector<float> h(std::size_t(layers) * std::size_t(lw) * std::size_t(lh));
+  for (int i = 0; i < layers; ++i)
+    for (int y = 0; y < lh; ++y)
+      for (int x = 0; x < lw; ++x) h[(std::size_t(i) * lh + y) * lw + x] = heights[std::size_t(i)]->texel(0, x, y, 0);
+  Image w(weights.width(), weights.height(), 4);
+  for (int y = 0; y < w.height; ++y)
+    for (int x = 0; x < w.width; ++x)
+      for (int c = 0; c < 4; ++c) w.at(x, y, c) = weights.texel(0, x, y, c);
+  const auto wrap_index = [](int i, int n) { return ((i % n) + n) % n; };
+
   HeightField field;
-  field.width = box.width;
-  field.height = box.height;
+  field.width = lw * scale;
+  field.height = lh * scale;
   field.h.resize(std::size_t(field.width) * std::size_t(field.height));
   tbb::parallel_for(0, field.height, [&](int y) {
-    for (int x = 0; x < field.width; ++x) field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] = box.at(x, y);
+    for (int x = 0; x < field.width; ++x) {
+      // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
+      // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic).
+      const double wx = (x + 0.5) / field.width * w.width - 0.5, wy = (y + 0.5) / field.height * w.height - 0.5;
+      const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
+      const double fx = wx - x0, fy = wy - y0;
+      const int xa = wrap_index(x0, w.width), xb = wrap_index(x0 + 1, w.width);
+      const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);
+      double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
+      for (int i = 0; i < layers; ++i) {
+        const double wi = (double(w.at(xa, ya, i)) * (1 - fx) + double(w.at(xb, ya, i)) * fx) * (1 - fy) +
+                          (double(w.at(xa, yb, i)) * (1 - fx) + double(w.at(xb, yb, i)) * fx) * fy;
+        const double hi = h[(std::size_t(i) * lh + std::size_t(y % lh)) * lw + std::size_t(x % lw)];
+        top = std::max(top, wi * hi);
+        sum_wh += wi * hi;
+        sum_w += wi;
+      }
+      field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] =
+          op != BlendOperator::Alpha ? top : (sum_w > 0.0 ? sum_wh / sum_w : 0.0);
+    }
   });
   return field;
 }
 
-Texture combined_quadtree(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
-                          BlendOperator op) {
-  const BlendedBox box(heights, weights, op, scale);
-  Image level1(box.width / 2, box.height / 2, 1);
+Texture combined_quadtree(const HeightField& surface) {
+  Image level1(surface.width / 2, surface.height / 2, 1);
+  const auto at = [&](int x, int y) { return surface.h[std::size_t(y) * std::size_t(surface.width) + std::size_t(x)]; };
   tbb::parallel_for(0, level1.height, [&](int y) {
     for (int x = 0; x < level1.width; ++x) {
-      const double top = std::max(std::max(box.at(2 * x, 2 * y), box.at(2 * x + 1, 2 * y)),
-                                  std::max(box.at(2 * x, 2 * y + 1), box.at(2 * x + 1, 2 * y + 1)));
+      const double top = std::max(std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)),
+                                  std::max(at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
       // Rounded up to a 16-bit step, with a margin over the shader's fp32 arithmetic (errors ~1e-7), so the
       // quantisation in make_mip_texture keeps it: the tree stays above the surface.
       level1.at(x, y, 0) = float(std::min(1.0, std::ceil((top + 1e-6) * 65535.0) / 65535.0));

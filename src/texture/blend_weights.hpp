@@ -41,9 +41,8 @@ Image resample_weight_map(const Image& map, int resolution);
 HeightField combined_surface(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
                              BlendOperator op);
 
-// The precomputed combined quadtree of that surface (WeightTexture::combined): level k = the maxima over cells of
-// level k + 1, R16 rounded up (conservative for the fp32 box values the shader computes). `scale` whole.
-Texture combined_quadtree(const std::vector<const Texture*>& heights, const Texture& weights, int scale,
-                          BlendOperator op);
+// The precomputed combined quadtree of such a surface (WeightTexture::combined): level k = the maxima over cells
+// of level k + 1, R16 rounded up (conservative for the fp32 box values the shader computes).
+Texture combined_quadtree(const HeightField& surface);
 
 }  // namespace qdmr

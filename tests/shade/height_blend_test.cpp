@@ -39,7 +39,7 @@ public:
     if (combined) {
       std::vector<const Texture*> layers;
       for (const Texture& h : heights_) layers.push_back(&h);
-      combined_ = combined_quadtree(layers, weights_, int(scale), op);
+      combined_ = combined_quadtree(combined_surface(layers, weights_, int(scale), op));
       period_ = heights[0].width * int(scale);
     }
   }
@@ -310,7 +310,7 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
   const TextureView weight_view(weights);
   std::vector<const Texture*> box_pointers;
   for (const Texture& t : box) box_pointers.push_back(&t);
-  const Texture combined = combined_quadtree(box_pointers, weights, 2, BlendOperator::Height);
+  const Texture combined = combined_quadtree(combined_surface(box_pointers, weights, 2, BlendOperator::Height));
   const TextureView combined_view(combined);
 
   HeightField field;  // the two repeats, as one map

@@ -1,0 +1,30 @@
+"""What the bench scripts share: their command line and one render through the qdmr command, read back from
+its --stats JSON."""
+import argparse
+import json
+import os
+import subprocess
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def arguments(description):
+    """The options every bench script takes: -n runs, -B build folder, --width/--height; add more, then parse."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("-n", type=int, default=3)
+    parser.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
+    parser.add_argument("--width", type=int, default=1920)
+    parser.add_argument("--height", type=int, default=1080)
+    return parser
+
+
+def render(qdmr, scene, sets, width, height, tmp, env=None, extra=()):
+    """Renders `scene` (a path) with --set pointer=value pairs into tmp; returns the stats JSON."""
+    stats = os.path.join(tmp, "stats.json")
+    cmd = [qdmr, "render", scene, "-o", os.path.join(tmp, "image.exr"), "--stats", stats,
+           "--width", str(width), "--height", str(height)]
+    for pointer, value in sets:
+        cmd += ["--set", f"{pointer}={value}"]
+    subprocess.run(cmd + list(extra), check=True, stdout=subprocess.DEVNULL, env=env)
+    with open(stats) as f:
+        return json.load(f)

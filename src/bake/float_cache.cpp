@@ -1,0 +1,75 @@
+#include "bake/float_cache.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include "bake/content_hash.hpp"
+#include "io/atomic_file.hpp"
+#include "qdmr/core/error.hpp"
+
+namespace qdmr {
+namespace {
+
+struct Header {
+  char magic[8];
+  std::uint32_t version;
+  std::uint32_t tag;
+  std::int32_t width, height;
+  std::uint64_t key;
+  std::uint64_t payload_hash;  // FNV-1a of the values' bytes
+};
+static_assert(sizeof(Header) == 40);
+
+std::uint64_t payload_hash(const std::vector<float>& values) {
+  Fnv1a f;
+  f.bytes(values.data(), values.size() * sizeof(float));
+  return f.hash;
+}
+
+}  // namespace
+
+std::optional<std::vector<float>> read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo,
+                                                   float hi) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::size_t count = std::size_t(id.width) * std::size_t(id.height);
+  std::error_code ec;
+  if (std::filesystem::file_size(file, ec) != sizeof(Header) + count * sizeof(float) || ec) return std::nullopt;
+  Header header{};
+  if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return std::nullopt;
+  if (std::memcmp(header.magic, id.magic.data(), sizeof header.magic) != 0 || header.version != id.version ||
+      header.tag != id.tag || header.width != id.width || header.height != id.height || header.key != id.key)
+    return std::nullopt;
+  std::vector<float> values(count);
+  if (!in.read(reinterpret_cast<char*>(values.data()), std::streamsize(count * sizeof(float)))) return std::nullopt;
+  if (payload_hash(values) != header.payload_hash) return std::nullopt;
+  for (float v : values)
+    if (!(v >= lo && v <= hi)) return std::nullopt;
+  return values;
+}
+
+void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, const std::vector<float>& values) {
+  std::error_code ec;
+  std::filesystem::create_directories(file.parent_path(), ec);
+  if (ec) return;
+  Header header{};
+  std::memcpy(header.magic, id.magic.data(), sizeof header.magic);
+  header.version = id.version;
+  header.tag = id.tag;
+  header.width = id.width;
+  header.height = id.height;
+  header.key = id.key;
+  header.payload_hash = payload_hash(values);
+  try {
+    write_atomically(file, "bake cache", [&](const std::filesystem::path& temporary) -> std::string {
+      std::ofstream out(temporary, std::ios::binary);
+      out.write(reinterpret_cast<const char*>(&header), sizeof header);
+      out.write(reinterpret_cast<const char*>(values.data()), std::streamsize(values.size() * sizeof(float)));
+      return out.flush() ? "" : "write failed";
+    });
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace qdmr

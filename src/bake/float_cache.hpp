@@ -1,0 +1,26 @@
+#pragma once
+// The on-disk format of the bake caches (cone maps, AO maps): a fixed 40-byte header in host byte order (the cache
+// is local) and width x height floats. A file is used only if its size, magic, version, tag, size, key and payload
+// checksum all match and every value lies in [lo, hi]; writing goes through a temporary file and a rename, and a
+// cache that cannot be written is skipped (it only costs a rebake next time).
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace qdmr {
+
+struct FloatCacheId {
+  std::array<char, 8> magic;  // what kind of map the file holds
+  std::uint32_t version;      // bumped when the definition, rounding or layout changes
+  std::uint32_t tag;          // a variant of the map (the cone kind), or 0
+  std::int32_t width, height;
+  std::uint64_t key;          // content hash of what the map was baked from
+};
+
+std::optional<std::vector<float>> read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo,
+                                                   float hi);
+void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, const std::vector<float>& values);
+
+}  // namespace qdmr
