@@ -16,10 +16,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "qdmr/scene/load.hpp"
+#include "draw/draw.hpp"
+#include "qdmr/load/load.hpp"
+#include "qdmr/plan/plan.hpp"
 #include "raster/binner.hpp"
 #include "raster/tile_raster.hpp"
-#include "render/assets.hpp"
 
 namespace {
 
@@ -28,7 +29,9 @@ using namespace qdmr;
 // Everything before the draw stages, built once per scene: assets, draw items, camera matrices.
 struct Workload {
   SceneDesc scene;
+  FramePlan plan;
   Assets assets;
+  std::vector<std::unique_ptr<Program>> programs;
   std::vector<DrawItem> draws;
   glm::mat4 view{1.0f}, projection{1.0f};
   Viewport viewport;
@@ -37,8 +40,11 @@ struct Workload {
 Workload make_workload(const std::vector<SceneOverride>& overrides) {
   Workload w;
   w.scene = load_scene(std::string(QDMR_SOURCE_DIR) + "/scenes/plane.json", overrides);
-  w.assets = prepare_assets(w.scene, LightRig::from_scene(w.scene), RenderOptions{});
-  w.draws = w.assets.draw_items();  // the plane scene's single object has the identity transform
+  w.plan = plan_frame(w.scene);
+  w.assets = prepare(w.plan);
+  w.programs = make_programs(w.plan, w.assets, kernel_for(Isa::QDMR_ISA_ENUM));  // this benchmark's own kernel
+  // The plane scene's single object has the identity transform.
+  w.draws.push_back({w.assets.meshes[0].get(), glm::mat4(1.0f), w.plan.meshes[0].material, {}});
   const CameraDesc& cam = w.scene.camera;
   w.viewport = {w.scene.output.width, w.scene.output.height};
   w.view = glm::lookAt(cam.position, cam.target, cam.up);
@@ -99,7 +105,7 @@ void BM_SetupBinning(benchmark::State& state, int which) {
   state.counters["B/triangle_setup"] = double(sizeof(TriangleSetup));
 }
 
-// As render_frame does it: clear the colour and depth targets, then rasterize and shade every tile.
+// As a draw does it: clear the colour and depth targets, then rasterize and shade every tile.
 void BM_RasterShade(benchmark::State& state, int which) {
   const Workload& w = workload(which);
   const int threads = int(state.range(0));
@@ -120,7 +126,7 @@ void BM_RasterShade(benchmark::State& state, int which) {
     context.geometry = &geometry;
     context.setups = &setups;
     context.framebuffer = &fb;
-    for (const auto& program : w.assets.programs) context.programs.push_back(program.get());
+    for (const auto& program : w.programs) context.programs.push_back(program.get());
     std::vector<TileCounters> counters(std::size_t(grid.count()));
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {

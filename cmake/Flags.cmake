@@ -1,14 +1,19 @@
 # Flags for project code only (dependencies are compiled by Debian).
-function(qdmr_project_flags target simd)
-  # -ffp-contract=off: no fused multiply-add behind our back, so SSE and AVX2 builds give the same bits.
+#
+# qdmr_project_flags(target ISA): ISA is "baseline" (x86-64: everything outside the draw kernels), or the ISA of
+# a draw kernel ("sse4.2", "avx2"), which also puts the code into the namespace qdmr::<isa> (core/isa_namespace.hpp).
+function(qdmr_project_flags target isa)
+  # -ffp-contract=off: no fused multiply-add behind our back, so every ISA gives the same bits.
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror -ffp-contract=off -fno-fast-math)
-  if(simd STREQUAL "avx2")
+  if(isa STREQUAL "avx2")
     # AVX2 without FMA: xsimd's default arch becomes avx2, not fma3<avx2> (which fuses inside its math).
     target_compile_options(${target} PRIVATE -mavx2 -mno-fma -mf16c -mpopcnt)
-  elseif(simd STREQUAL "sse4.2")
+    target_compile_definitions(${target} PRIVATE QDMR_ISA=avx2 QDMR_ISA_ENUM=Avx2)
+  elseif(isa STREQUAL "sse4.2")
     target_compile_options(${target} PRIVATE -msse4.2 -mno-avx -mno-fma -mpopcnt)
-  else()
-    message(FATAL_ERROR "QDMR_SIMD must be avx2 or sse4.2, not '${simd}'")
+    target_compile_definitions(${target} PRIVATE QDMR_ISA=sse42 QDMR_ISA_ENUM=Sse42)
+  elseif(NOT isa STREQUAL "baseline")
+    message(FATAL_ERROR "qdmr_project_flags: ISA must be baseline, sse4.2 or avx2, not '${isa}'")
   endif()
   if(QDMR_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)

@@ -14,7 +14,7 @@
 #include "bake/content_hash.hpp"
 #include "bake/float_cache.hpp"
 #include "qdmr/core/error.hpp"
-#include "shade/ao_pattern.hpp"
+#include "bake/ao_pattern.hpp"
 
 namespace qdmr {
 namespace {

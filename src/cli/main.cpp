@@ -13,12 +13,14 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/bench.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
-#include "qdmr/scene/load.hpp"
+#include "qdmr/load/load.hpp"
 #include "qdmr/texture/image.hpp"
+#include "qdmr/write/write.hpp"
 
 namespace {
 
@@ -35,6 +37,7 @@ struct RenderArgs {
   std::optional<int> width, height;  // absent: the scene's; checked like the scene's values
   int threads = -1;  // absent: every core
   int tile = qdmr::RenderOptions{}.tile_size;
+  std::string isa = "auto";
   std::string stats;
 };
 
@@ -67,13 +70,21 @@ void check_output_path(const std::string& option, const std::filesystem::path& o
 }
 
 
-int run_render(const SceneArgs& args, const RenderArgs& render) {
-  using Clock = std::chrono::steady_clock;
+qdmr::RenderOptions render_options(const RenderArgs& render) {
   qdmr::RenderOptions options;
   if (render.threads == 0) throw qdmr::Error("--threads", "must be at least 1 (omit it to use every core)");
   options.threads = render.threads < 0 ? 0 : render.threads;
   options.tile_size = render.tile;
+  const std::optional<qdmr::Isa> isa = qdmr::parse_isa(render.isa);
+  if (!isa) throw qdmr::Error("--isa", "unknown ISA '" + render.isa + "' (valid: auto, sse4.2, avx2, avx512)");
+  options.isa = *isa;
   qdmr::validate_options(options);
+  return options;
+}
+
+int run_render(const SceneArgs& args, const RenderArgs& render) {
+  using Clock = std::chrono::steady_clock;
+  qdmr::RenderOptions options = render_options(render);
   check_output_path("-o", render.output, args.scene);
   std::vector<std::pair<qdmr::Aov, std::filesystem::path>> aov_files;
   std::set<std::string> seen;
@@ -106,7 +117,10 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
       if (fraction >= 1.0 && std::string_view(stage) == "raster") std::fprintf(stderr, "\r%15s\r", "");
       std::fflush(stderr);
     };
-  qdmr::Frame frame = qdmr::render_frame(scene, options);
+  // load -> plan -> prepare (set_scene) -> draw -> write.
+  qdmr::Renderer renderer(options);
+  renderer.set_scene(scene, options.aovs);
+  qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
 
   start = Clock::now();
@@ -118,13 +132,13 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
               frame.width, frame.height, static_cast<unsigned long long>(s.triangles_rasterized),
               static_cast<unsigned long long>(s.pixels_shaded),
-              s.load_ms + s.prepare_ms + s.geometry_ms + s.binning_ms + s.raster_shade_ms + s.write_ms, s.threads,
+              s.load_ms + s.plan_ms + s.prepare_ms + s.draw_ms() + s.write_ms, s.threads,
               s.simd_arch.c_str());
   return 0;
 }
 
 int run_plan(const SceneArgs& args, bool as_json) {
-  qdmr::RenderOptions options;
+  qdmr::PlanOptions options;
   std::set<std::string> seen;
   for (const std::string& name : args.aovs) {
     if (!seen.insert(name).second) throw qdmr::Error("--aov " + name, "AOV given twice");
@@ -192,7 +206,8 @@ int main(int argc, char** argv) {
       "Renders a JSON scene to an image, the same bits on any machine and thread count.\n\n"
       "  qdmr render scenes/plane.json -o plane.png\n"
       "  qdmr render scenes/terrain.json -o t.exr --set /camera/fov_deg=30 --aov depth=depth.exr --stats stats.json\n"
-      "  qdmr plan scenes/terrain.json\n\n"
+      "  qdmr plan scenes/terrain.json\n"
+      "  qdmr bench scenes/terrain.json --frames 20 --json bench.json\n\n"
       "The scene format is described in docs/scene-format.md."};
   app.require_subcommand(1);
 
@@ -206,6 +221,9 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--height", render.height, "Override /output/height (pixels)");
   render_cmd->add_option("--threads", render.threads, "Worker threads (default: every core)");
   render_cmd->add_option("--tile", render.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
+  render_cmd->add_option("--isa", render.isa,
+                         "Draw kernel: auto (default: $QDMR_ISA, else the best this CPU has), sse4.2, avx2 or avx512. "
+                         "Every ISA gives the same bits");
   render_cmd->add_option("--set", render_scene.sets,
                          "Override a scene value before validation: /json/pointer=VALUE (VALUE is JSON; a bare word is a "
                          "string). Repeatable, e.g. --set /camera/fov_deg=30");
@@ -219,6 +237,22 @@ int main(int argc, char** argv) {
   plan_cmd->add_option("--set", plan_scene.sets, "Override a scene value: /json/pointer=VALUE (repeatable)");
   plan_cmd->add_option("--aov", plan_scene.aovs, "AOV names to plan for (repeatable)");
   plan_cmd->add_flag("--json", plan_json, "Print the plan as JSON");
+
+  qdmr::cli::BenchArgs bench;
+  CLI::App* bench_cmd = app.add_subcommand(
+      "bench", "Time warm frames of a scene with one persistent renderer: load, plan, prepare once, draw N frames");
+  bench_cmd->add_option("scene", bench.scene, "Scene file (JSON)")->required();
+  bench_cmd->add_option("--frames", bench.frames, "Timed frames (default 10)");
+  bench_cmd->add_option("--warmup", bench.warmup, "Untimed frames first (default 2)");
+  bench_cmd->add_option("--threads", bench.threads, "Worker threads (default: every core)");
+  bench_cmd->add_option("--tile", bench.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
+  bench_cmd->add_option("--isa", bench.isa, "Draw kernel: auto (default), sse4.2, avx2 or avx512");
+  bench_cmd->add_option("--width", bench.width, "Override /output/width (pixels)");
+  bench_cmd->add_option("--height", bench.height, "Override /output/height (pixels)");
+  bench_cmd->add_option("--set", bench.sets, "Override a scene value: /json/pointer=VALUE (repeatable)");
+  bench_cmd->add_option("--aov", bench.aovs, "Also render this AOV in every frame (repeatable)");
+  bench_cmd->add_option("--json", bench.json, "Write the results as JSON to this file");
+  bench_cmd->add_option("--image", bench.image, "Write the last frame here (timed once as write_ms; default: a temporary file)");
 
   ConeArgs cone;
   CLI::App* bake_cmd = app.add_subcommand("bake", "Bake derived data of a height map");
@@ -249,6 +283,7 @@ int main(int argc, char** argv) {
   try {
     if (render_cmd->parsed()) return run_render(render_scene, render);
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);
+    if (bench_cmd->parsed()) return qdmr::cli::run_bench(bench);
     if (cone_cmd->parsed()) return run_bake_cone(cone);
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());

@@ -8,7 +8,7 @@
 
 #include "core/simd.hpp"
 
-namespace qdmr::detmath {
+namespace qdmr::QDMR_ISA_NAMESPACE::detmath {
 
 namespace detail {
 inline constexpr float kInvLn2x2 = 2.8853900817779268f;  // 2 / ln 2
@@ -79,4 +79,4 @@ inline simd::Float pow(const simd::Float& x, const simd::Float& y) {
   return xsimd::select(x > simd::Float(0.0f), exp2(y * log2(x)), simd::Float(0.0f));
 }
 
-}  // namespace qdmr::detmath
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::detmath

@@ -11,7 +11,7 @@
 #include <immintrin.h>
 #endif
 
-namespace qdmr::simd {
+namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 
 enum class FetchPath : std::uint8_t { Gather, Portable };
 
@@ -60,4 +60,4 @@ inline Float load_f32(const float* table, const Int& index, FetchPath path) {
   return Float::load_aligned(value);
 }
 
-}  // namespace qdmr::simd
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::simd

@@ -5,7 +5,9 @@
 
 #include <xsimd/xsimd.hpp>
 
-namespace qdmr::simd {
+#include "core/isa_namespace.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 
 using Arch = xsimd::default_arch;
 using Float = xsimd::batch<float, Arch>;
@@ -88,4 +90,4 @@ inline Float pixel_ddy(const Float& v) {
   return Float::load_aligned(d);
 }
 
-}  // namespace qdmr::simd
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::simd

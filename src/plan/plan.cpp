@@ -1,6 +1,7 @@
 #include "qdmr/plan/plan.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -9,23 +10,13 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
+#include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/mesh/mesh.hpp"
 #include "qdmr/texture/height_texture.hpp"
 
 namespace qdmr {
 namespace {
-
-const char* filter_name(Filter f) {
-  switch (f) {
-    case Filter::Point: return "point";
-    case Filter::Bilinear: return "bilinear";
-    case Filter::Trilinear: return "trilinear";
-    case Filter::PointMipPoint: return "point_mip_point";
-    case Filter::PointMipLinear: return "point_mip_linear";
-    case Filter::LinearMipPoint: return "linear_mip_point";
-  }
-  return "?";
-}
 
 std::string source_key(const TextureDesc& d) {
   std::ostringstream k;
@@ -151,21 +142,10 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   return int(textures.size() - 1);
 }
 
-std::uint64_t count_obj_lines(const std::filesystem::path& file, std::uint64_t& faces) {
-  std::ifstream in(file);
-  std::string line;
-  std::uint64_t vertices = 0;
-  faces = 0;
-  while (std::getline(in, line)) {
-    if (line.rfind("v ", 0) == 0) ++vertices;
-    else if (line.rfind("f ", 0) == 0) ++faces;
-  }
-  return vertices;
-}
-
-MeshPlan plan_mesh(const ObjectDesc& object) {
+MeshPlan plan_mesh(const ObjectDesc& object, const std::string& mesh_key) {
   MeshPlan m;
   m.object = object.name;
+  m.key = mesh_key;
   const MeshDesc& d = object.mesh;
   switch (d.kind) {
     case MeshKind::Plane: m.kind = "plane"; m.vertices = 4; m.triangles = 2; break;
@@ -182,18 +162,59 @@ MeshPlan plan_mesh(const ObjectDesc& object) {
       m.vertices = (std::uint64_t(d.resolution) + 1) * (std::uint64_t(d.resolution) + 1);
       m.triangles = 2ull * std::uint64_t(d.resolution) * std::uint64_t(d.resolution);
       break;
-    case MeshKind::Obj: {
+    case MeshKind::Obj:
       m.kind = "obj " + d.file.filename().string();
-      std::uint64_t faces = 0;
-      m.vertices = count_obj_lines(d.file, faces);
-      m.triangles = faces;
-      m.estimated = true;
+      m.vertices = object.obj_mesh ? object.obj_mesh->vertex_count() : 0;
+      m.triangles = object.obj_mesh ? object.obj_mesh->triangle_count() : 0;
       break;
-    }
   }
   // position, normal, tangent, uv per vertex; three indices and a material id per triangle
   m.bytes = m.vertices * (3 + 3 + 4 + 2) * sizeof(float) + m.triangles * 4 * sizeof(std::uint32_t);
   return m;
+}
+
+// Content keys: every value that changes what is built, printed exactly (floats as their bits).
+struct Key {
+  std::ostringstream s;
+  Key& operator()(const char* name) { s << name << "="; return *this; }
+  Key& v(float x) { s << std::bit_cast<std::uint32_t>(x) << ";"; return *this; }
+  Key& v(int x) { s << x << ";"; return *this; }
+  Key& v(std::uint32_t x) { s << x << ";"; return *this; }
+  Key& v(bool x) { s << (x ? 1 : 0) << ";"; return *this; }
+  Key& v(const std::string& x) { s << x.size() << ":" << x << ";"; return *this; }
+  Key& v(glm::vec2 x) { return v(x.x).v(x.y); }
+  std::string str() const { return s.str(); }
+};
+
+std::string mesh_key(const ObjectDesc& object) {
+  const MeshDesc& d = object.mesh;
+  Key k;
+  k("kind").v(int(d.kind));
+  switch (d.kind) {
+    case MeshKind::Obj: k("file").v(d.file.string())("uv_scale").v(d.uv_scale); break;
+    case MeshKind::Grid:
+      k("size").v(d.size)("uv_scale").v(d.uv_scale)("resolution").v(d.resolution)("height").v(d.height)("map")
+          .v(source_key(d.height_map));
+      break;
+    default: k("size").v(d.size)("uv_scale").v(d.uv_scale)("segments").v(d.segments); break;
+  }
+  return k.str();
+}
+
+std::string weights_key(const WeightsDesc& w, int layers) {
+  Key k;
+  k("layers").v(layers)("mode").v(int(w.mode))("source").v(int(w.source))("scale").v(w.scale)("resolution").v(w.resolution)(
+       "from_vertices")
+      .v(w.from_vertices)("seed").v(w.seed)("cells").v(w.cells)("sharpness").v(w.sharpness)("height")
+      .v(source_key(w.height))("low").v(w.low)("slope").v(w.slope)("relief").v(w.relief)("file").v(w.file.string());
+  return k.str();
+}
+
+std::string ao_key(const AoDesc& ao, float depth_scale) {
+  Key k;
+  k("depth_scale").v(depth_scale)("directions").v(ao.directions)("jitter").v(ao.jitter)("seed").v(ao.seed)("radius")
+      .v(ao.radius)("coarse").v(ao.coarse)("strength").v(ao.strength)("resolution").v(ao.resolution);
+  return k.str();
 }
 
 std::string mib(std::uint64_t bytes) {
@@ -206,50 +227,160 @@ std::string mib(std::uint64_t bytes) {
 
 }  // namespace
 
-const char* technique_name(TechniqueKind k) {
-  switch (k) {
-    case TechniqueKind::Normal: return "normal";
-    case TechniqueKind::Relief: return "relief";
-    case TechniqueKind::Pom: return "pom";
-    case TechniqueKind::Csm: return "csm";
-    case TechniqueKind::Rcsm: return "rcsm";
-    case TechniqueKind::Qdm: return "qdm";
+const char* derived_kind_name(DerivedKind kind) {
+  switch (kind) {
+    case DerivedKind::WeightTexture: return "weight_texture";
+    case DerivedKind::CombinedSurface: return "combined_surface";
+    case DerivedKind::CombinedQuadtree: return "combined_quadtree";
+    case DerivedKind::BlendAoMap: return "blend_ao_map";
+    case DerivedKind::HeightField: return "height_field";
+    case DerivedKind::LayerAoMap: return "layer_ao_map";
+    case DerivedKind::ConeMap: return "cone_map";
+    case DerivedKind::BilinearBound: return "bilinear_bound";
   }
   return "?";
 }
 
 namespace {
 
-const char* lighting_name(LightingModel m) { return m == LightingModel::CookTorrance ? "cook_torrance" : "blinn_phong"; }
+// Plans a frame: materials on first use, their textures and derived data, deduplicated by content key.
+class Planner {
+public:
+  Planner(const SceneDesc& scene, FramePlan& plan) : scene_(scene), plan_(plan), file_(scene.file.string()) {}
 
-const char* shadow_name(ShadowMode m) {
-  switch (m) {
-    case ShadowMode::Off: return "off";
-    case ShadowMode::Hard: return "hard";
-    case ShadowMode::Horizon: return "horizon";
-    case ShadowMode::QdmSoft: return "qdm_soft";
+  // `where` names the field that uses the material; MTL materials are named after it, scene materials by
+  // their own JSON pointer.
+  std::uint32_t material(const std::string& name, const std::string& where, bool from_mtl) {
+    for (std::size_t i = 0; i < plan_.materials.size(); ++i)
+      if (plan_.materials[i].name == name) return std::uint32_t(i);
+    const MaterialDesc* desc = scene_.find_material(name);
+    if (!desc) throw Error(where, "unknown material '" + name + "'");
+    choices_.emplace_back();
+    plan_.materials.push_back(plan_material(
+        *desc, from_mtl ? where + ": MTL material '" + name + "'" : file_ + ": /materials/" + name, choices_.back()));
+    return std::uint32_t(plan_.materials.size() - 1);
   }
-  return "?";
-}
 
-const char* blend_name(BlendOperator op) {
-  switch (op) {
-    case BlendOperator::Alpha: return "alpha";
-    case BlendOperator::Height: return "height";
-    case BlendOperator::HeightWidth: return "height_width";
+  // Derived data of materials, once every object is known (blend weights read the meshes using them).
+  void derived(std::uint32_t index) {
+    MaterialPlan& m = plan_.materials[index];
+    const Choices& c = choices_[index];
+    const MaterialDesc& desc = m.desc;
+    const std::string& where = m.where;
+    const bool displaced = m.technique != TechniqueKind::Normal;
+    m.reference = displaced && std::any_of(plan_.aovs.begin(), plan_.aovs.end(), is_reference_aov);
+    const std::string address = "address=" + std::to_string(int(desc.sampling.address));
+    const auto field_of = [&](std::size_t layer) {
+      LayerPlan& l = m.layers[layer];
+      if (l.field < 0)
+        l.field = add(DerivedKind::HeightField, "field|" + plan_.textures[std::size_t(l.height)].key + "|" + address,
+                      where + "/layers/" + std::to_string(layer) + "/height", {}, index,
+                      std::uint64_t(plan_.textures[std::size_t(l.height)].width) *
+                          std::uint64_t(plan_.textures[std::size_t(l.height)].height) * sizeof(double),
+                      l.height);
+      return l.field;
+    };
+    std::string heights;
+    for (const LayerPlan& l : m.layers) heights += (l.height >= 0 ? plan_.textures[std::size_t(l.height)].key : "-") + "|";
+
+    if (m.blend) {
+      const WeightsDesc& w = desc.blend.weights;
+      std::string wkey = "weights|" + weights_key(w, int(m.layers.size()));
+      if (w.from_vertices)
+        for (std::size_t o : m.objects) wkey += "|mesh:" + plan_.meshes[o].key;
+      const bool whole = w.scale == std::floor(w.scale) && w.scale >= 1.0f;
+      const bool needs_combined = c.combined_quadtree || m.reference || c.blend_ao;
+      if (m.weight_mode == WeightMode::Pixel || needs_combined)
+        m.weights = add(DerivedKind::WeightTexture, wkey, where + "/blend/weights", {}, index,
+                        chain_bytes(w.resolution, w.resolution, TexelFormat::RGBA8));
+      if (needs_combined) {
+        if (!whole)
+          throw Error(where + "/blend/weights/scale", m.reference ? "error AOVs of a blend need a whole number of repeats"
+                                                                 : "must be a whole number of repeats here");
+        const TextureRequest& h = plan_.textures[std::size_t(m.layers[0].height)];
+        m.weights_scale = int(w.scale);
+        const std::uint64_t texels = std::uint64_t(h.width) * std::uint64_t(h.height) * std::uint64_t(m.weights_scale) *
+                                     std::uint64_t(m.weights_scale);
+        if (m.reference && texels > (1ull << 26))
+          throw Error(where + "/blend/weights/scale", "error AOVs of this blend need a reference of " +
+                                                          std::to_string(texels) +
+                                                          " texels (the layers' size times scale squared), more than 2^26");
+        Key op;
+        op("op").v(int(desc.blend.op))("width").v(desc.blend.width);
+        m.combined_surface = add(DerivedKind::CombinedSurface, "combined|" + heights + wkey + "|" + op.str(),
+                                 where + "/blend", {m.weights}, index, texels * sizeof(double));
+        const std::string& combined_key = plan_.derived[std::size_t(m.combined_surface)].key;
+        if (c.combined_quadtree)
+          m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + combined_key, where + "/blend/quadtree",
+                                    {m.combined_surface}, index, c.combined_bytes);
+        if (c.blend_ao) {
+          AoDesc ao = desc.ao;
+          ao.resolution = c.ao_side;
+          m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + combined_key + "|" + ao_key(ao, desc.technique.depth_scale),
+                           where + "/ao", {m.combined_surface}, index,
+                           chain_bytes(c.ao_side, c.ao_side, TexelFormat::R16), -1, c.ao_side);
+        }
+      }
+    }
+    if (desc.ao.mode == AoMode::Baked && !c.blend_ao) {
+      for (std::size_t l = 0; l < m.layers.size(); ++l) {
+        const int field = field_of(l);
+        const TextureRequest& h = plan_.textures[std::size_t(m.layers[l].height)];
+        const int side_w = desc.ao.resolution > 0 ? desc.ao.resolution : h.width;
+        const int side_h = desc.ao.resolution > 0 ? std::max(1, int(std::int64_t(desc.ao.resolution) * h.height / h.width))
+                                                  : h.height;
+        m.layers[l].ao = add(DerivedKind::LayerAoMap,
+                             "ao|" + plan_.derived[std::size_t(field)].key + "|" + ao_key(desc.ao, desc.technique.depth_scale),
+                             where + "/ao", {field}, index, chain_bytes(side_w, side_h, TexelFormat::R16), -1, side_w);
+      }
+    }
+    const bool bilinear_patch =
+        m.technique == TechniqueKind::Qdm && desc.technique.refinement == QdmRefinement::BilinearPatch && !m.blend;
+    if (m.cone_map || bilinear_patch || (m.reference && !m.blend)) {
+      const int field = field_of(0);
+      const TextureRequest& h = plan_.textures[std::size_t(m.layers[0].height)];
+      const std::string& field_key = plan_.derived[std::size_t(field)].key;
+      if (m.cone_map)
+        m.cones = add(DerivedKind::ConeMap, "cones|" + std::to_string(int(m.cone_kind)) + "|" + field_key,
+                      where + "/technique", {field}, index,
+                      std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float));
+      if (bilinear_patch)
+        m.bilinear_bound = add(DerivedKind::BilinearBound, "bilinear_bound|" + field_key, where + "/technique/refinement",
+                               {field}, index, chain_bytes(h.width, h.height, TexelFormat::R32F));
+    }
   }
-  return "?";
-}
 
-}  // namespace
+private:
+  int add(DerivedKind kind, const std::string& key, const std::string& where, std::vector<int> inputs, std::uint32_t material,
+          std::uint64_t bytes, int texture = -1, int side = 0) {
+    const std::string full = std::string(derived_kind_name(kind)) + "|" + key;
+    for (std::size_t i = 0; i < plan_.derived.size(); ++i)
+      if (plan_.derived[i].key == full) return int(i);
+    plan_.derived.push_back({kind, full, where, std::move(inputs), texture, int(material), side, bytes});
+    return int(plan_.derived.size() - 1);
+  }
 
-MaterialPlan plan_material(const MaterialDesc& material, const std::string& where,
-                           std::vector<TextureRequest>& textures) {
+  // What plan_material decided that derived() turns into items.
+  struct Choices {
+    bool combined_quadtree = false, blend_ao = false;
+    std::uint64_t combined_bytes = 0;
+    int ao_side = 0;
+  };
+  MaterialPlan plan_material(const MaterialDesc& material, const std::string& where, Choices& choices);
+
+  const SceneDesc& scene_;
+  FramePlan& plan_;
+  std::string file_;
+  std::vector<Choices> choices_;  // parallel to plan_.materials
+};
+
+MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::string& where, Choices& choices) {
+  std::vector<TextureRequest>& textures = plan_.textures;
   MaterialPlan plan;
   plan.name = material.name;
+  plan.where = where;
+  plan.desc = material;
   plan.technique = material.technique.kind;
-  plan.sampling = material.sampling;
-  plan.lighting = material.lighting;
   const TechniqueKind kind = material.technique.kind;
   const std::size_t layer_count = material.layers.size();
   plan.blend = layer_count > 1;
@@ -259,15 +390,7 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
   // The max-quadtree serves QDM, and self-shadowing and AO queries that read coarse levels.
   const bool hierarchy = kind == TechniqueKind::Qdm || material.shadow.mode == ShadowMode::QdmSoft ||
                          (material.ao.mode != AoMode::Off && material.ao.coarse);
-  plan.program = (kind == TechniqueKind::Normal && !plan.blend ? std::string("normal_mapping")
-                                                               : std::string("displacement:") + technique_name(kind));
-  if (plan.blend)
-    plan.program += std::string(" | blend ") + blend_name(material.blend.op) + " x" + std::to_string(layer_count) +
-                    (material.blend.weights.mode == WeightMode::Vertex ? " per vertex" : " per pixel");
-  if (material.shadow.mode != ShadowMode::Off) plan.program += std::string(" | shadow ") + shadow_name(material.shadow.mode);
-  if (material.ao.mode != AoMode::Off)
-    plan.program += std::string(" | ao ") + (material.ao.mode == AoMode::Baked ? "baked" : "frame");
-  plan.program += std::string(" | ") + lighting_name(material.lighting.model) + " | " + filter_name(material.sampling.filter);
+  plan.variant = program_variant(material);
 
   if (plan.blend && (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm))
     throw Error(where + "/technique/name", std::string("'") + technique_name(kind) +
@@ -316,7 +439,6 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
     const int r = material.blend.weights.resolution;
     if ((r & (r - 1)) != 0)
       throw Error(where + "/blend/weights/resolution", "must be a power of two, got " + std::to_string(r));
-    plan.weight_bytes = chain_bytes(r, r, TexelFormat::RGBA8);
     const BlendQuadtree choice = material.blend.quadtree;
     if (kind == TechniqueKind::Qdm && choice != BlendQuadtree::Product) {
       // The combined tree spans the weights' repeats: a whole number of them, and not too many texels.
@@ -332,61 +454,84 @@ MaterialPlan plan_material(const MaterialDesc& material, const std::string& wher
                                 " texels at its first level, more than 2^22 (use 'product')"
                           : "'combined' needs blend/weights/scale to be a whole number of repeats (use 'product')");
       if (fits) {
-        plan.combined_quadtree = true;
-        plan.combined_bytes = chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
+        choices.combined_quadtree = true;
+        choices.combined_bytes = chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
       }
     }
   }
   const float weight_scale = material.blend.weights.scale;
-  if (material.ao.mode == AoMode::Baked && plan.blend && weight_scale == std::floor(weight_scale)) {
+  if (material.ao.mode == AoMode::Baked && plan.blend && weight_scale == std::floor(weight_scale) && weight_scale >= 1.0f) {
     // One map of the blended surface over the weights span (side: the setting, else that span's texels up to 2048).
     const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
     const std::uint64_t span = std::uint64_t(h.width) * std::uint64_t(weight_scale);
-    plan.ao_map = plan.blend_ao = true;
-    plan.ao_resolution = material.ao.resolution > 0 ? material.ao.resolution : int(std::min<std::uint64_t>(span, 2048));
-    plan.ao_bytes = chain_bytes(plan.ao_resolution, plan.ao_resolution, TexelFormat::R16);
-  } else if (material.ao.mode == AoMode::Baked) {
-    const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
-    const int w = material.ao.resolution > 0 ? material.ao.resolution : h.width;
-    const int hh = material.ao.resolution > 0 ? material.ao.resolution : h.height;
-    plan.ao_map = true;
-    plan.ao_bytes = chain_bytes(w, hh, TexelFormat::R16) * layer_count;  // one map per layer (same sizes)
+    choices.blend_ao = true;
+    choices.ao_side = material.ao.resolution > 0 ? material.ao.resolution : int(std::min<std::uint64_t>(span, 2048));
   }
   if (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm) {
     // Cones of the stored heights' level 0 (the box surface); the box-filtered chain serves the refinement.
-    const TextureRequest& h = textures[std::size_t(plan.layers[0].height)];
     plan.cone_map = true;
     plan.cone_kind = kind == TechniqueKind::Csm ? ConeKind::Conservative : ConeKind::Relaxed;
-    plan.cone_bytes = std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float);
   }
   return plan;
 }
 
-FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options) {
+}  // namespace
+
+FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
   FramePlan plan;
+  plan.scene = scene;
+  plan.options = options;
   plan.width = scene.output.width;
   plan.height = scene.output.height;
   plan.aovs = options.aovs;
   const std::string file = scene.file.string();
-  for (const ObjectDesc& object : scene.objects) {
-    plan.meshes.push_back(plan_mesh(object));
-    plan.mesh_bytes += plan.meshes.back().bytes;
+  Planner planner(scene, plan);
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectDesc& object = scene.objects[i];
+    const std::string where = file + ": /objects/" + std::to_string(i);
+    MeshPlan mesh = plan_mesh(object, mesh_key(object));
+    if (!object.material.empty()) {
+      // An explicit material overrides the MTL: every triangle of the object uses it.
+      mesh.material = planner.material(object.material, where + "/material", false);
+      plan.materials[mesh.material].objects.push_back(i);
+      if (object.obj_mesh) mesh.mtl_materials.assign(object.obj_mesh->materials.size(), mesh.material);
+    } else {
+      for (const std::string& name : object.mtl_materials) {
+        mesh.mtl_materials.push_back(planner.material(name, object.mesh.file.string() + " (" + where + "/mesh/file)", true));
+        plan.materials[mesh.mtl_materials.back()].objects.push_back(i);
+      }
+      if (mesh.mtl_materials.empty()) throw Error(where + "/material", "required (the mesh has no MTL materials)");
+    }
+    plan.meshes.push_back(std::move(mesh));
   }
-  for (const MaterialDesc& material : scene.materials) {
-    const bool used = std::any_of(scene.objects.begin(), scene.objects.end(),
-                                  [&](const ObjectDesc& o) { return o.material == material.name; });
-    if (!used) continue;  // unused materials cost nothing
-    plan.materials.push_back(plan_material(material, file + ": /materials/" + material.name, plan.textures));
+  // Per-vertex blend weights live in the meshes: part of their content.
+  for (std::size_t m = 0; m < plan.materials.size(); ++m) {
+    const MaterialPlan& material = plan.materials[m];
+    if (!material.blend || material.weight_mode != WeightMode::Vertex) continue;
+    for (std::size_t o : material.objects) {
+      MeshPlan& mesh = plan.meshes[o];
+      mesh.vertex_weights = int(m);
+      mesh.key += "|vertex_weights:" + weights_key(material.desc.blend.weights, int(material.layers.size()));
+      mesh.bytes += mesh.vertices * 4 * sizeof(float);
+    }
   }
+  for (std::size_t m = 0; m < plan.materials.size(); ++m) planner.derived(std::uint32_t(m));
+
+  for (const MeshPlan& m : plan.meshes) plan.mesh_bytes += m.bytes;
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
-  for (const MaterialPlan& m : plan.materials) {
-    plan.cone_map_bytes += m.cone_bytes;
-    plan.derived_bytes += m.weight_bytes + m.combined_bytes + m.ao_bytes;
-  }
+  for (const DerivedPlan& d : plan.derived) plan.derived_bytes += d.bytes;
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
   return plan;
+}
+
+std::vector<std::string> FramePlan::items() const {
+  std::vector<std::string> items;
+  for (const MeshPlan& m : meshes) items.push_back("mesh " + m.key);
+  for (const TextureRequest& t : textures) items.push_back("texture " + t.key);
+  for (const DerivedPlan& d : derived) items.push_back(d.key);
+  return items;
 }
 
 std::string FramePlan::describe() const {
@@ -394,44 +539,63 @@ std::string FramePlan::describe() const {
   s << "output: " << width << "x" << height << "\n";
   s << "materials (" << materials.size() << "):\n";
   for (const MaterialPlan& m : materials) {
-    s << "  " << m.name << ": " << m.program << "\n";
+    s << "  " << m.name << ": " << m.variant << "\n";
     for (std::size_t i = 0; i < m.layers.size(); ++i) {
       const LayerPlan& l = m.layers[i];
       s << "    layer " << i << ": albedo: texture " << l.albedo << ", normal: texture " << l.normal;
       if (l.height >= 0) s << ", height: texture " << l.height;
       if (l.height_max >= 0) s << ", max-quadtree: texture " << l.height_max;
+      if (l.ao >= 0) s << ", ao: derived " << l.ao;
       s << "\n";
     }
     if (m.blend)
-      s << "    blend weights: " << (m.weight_mode == WeightMode::Vertex ? "per vertex (interpolated)"
-                                                                         : "per pixel, weight texture " + mib(m.weight_bytes))
-        << (m.combined_quadtree ? ", combined quadtree " + mib(m.combined_bytes) : std::string())
-        << "\n";
-    if (m.ao_map)
-      s << "    ao: baked map " << (m.blend_ao ? "of the blended surface" : "per layer") << ", " << mib(m.ao_bytes)
-        << ", baked or from cache\n";
-    if (m.cone_map)
-      s << "    cone map (" << cone_kind_name(m.cone_kind) << "), baked or from cache, " << mib(m.cone_bytes) << "\n";
+      s << "    blend weights: " << (m.weight_mode == WeightMode::Vertex ? "per vertex (in the meshes)" : "per pixel") << "\n";
+    std::ostringstream uses;
+    for (int d : {m.weights, m.combined_surface, m.combined_quadtree, m.blend_ao, m.cones, m.bilinear_bound})
+      if (d >= 0) uses << " [" << d << "]";
+    if (!m.layers.empty() && m.layers[0].field >= 0) uses << " [" << m.layers[0].field << "]";
+    if (!uses.str().empty()) s << "    derived:" << uses.str() << "\n";
+    if (m.reference) s << "    traces the exact reference (error AOVs)\n";
   }
   s << "textures to build (" << textures.size() << "):\n";
   for (std::size_t i = 0; i < textures.size(); ++i) {
     const TextureRequest& t = textures[i];
     s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << " "
       << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
-      << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where << "\n";
+      << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where;
+    if (t.desc.source == TextureSource::File) s << " (" << t.desc.file.filename().string() << ")";
+    s << "\n";
   }
-  s << "derived data: cone maps " << mib(cone_map_bytes) << ", blend weight and AO maps " << mib(derived_bytes) << "\n";
+  s << "derived data to build (" << derived.size() << "):\n";
+  for (std::size_t i = 0; i < derived.size(); ++i) {
+    const DerivedPlan& d = derived[i];
+    s << "  [" << i << "] " << derived_kind_name(d.kind);
+    if (d.kind == DerivedKind::ConeMap || d.kind == DerivedKind::BlendAoMap || d.kind == DerivedKind::LayerAoMap)
+      s << " (baked or from the cache)";
+    if (!d.inputs.empty()) {
+      s << " from";
+      for (int in : d.inputs) s << " [" << in << "]";
+    }
+    if (d.texture >= 0) s << " from texture " << d.texture;
+    s << ", " << mib(d.bytes) << "  <- " << d.where << "\n";
+  }
   s << "meshes (" << meshes.size() << "):\n";
-  for (const MeshPlan& m : meshes)
-    s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles"
-      << (m.estimated ? " (counted from the file)" : "") << ", " << mib(m.bytes) << "\n";
+  for (const MeshPlan& m : meshes) {
+    s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles, "
+      << mib(m.bytes);
+    if (m.vertex_weights >= 0) s << ", per-vertex weights of " << materials[std::size_t(m.vertex_weights)].name;
+    if (!m.mtl_materials.empty() && (m.mtl_materials.size() > 1 || m.mtl_materials[0] != m.material)) {
+      s << ", MTL materials:";
+      for (std::uint32_t mat : m.mtl_materials) s << " " << materials[mat].name;
+    }
+    s << "\n";
+  }
   s << "aovs:";
   if (aovs.empty()) s << " none";
   for (Aov a : aovs) s << " " << aov_name(a);
   s << "\n";
   s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
-    << (cone_map_bytes > 0 ? ", cone maps " + mib(cone_map_bytes) : std::string())
-    << (derived_bytes > 0 ? ", weight/AO maps " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
+    << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
     << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
@@ -440,26 +604,43 @@ nlohmann::json FramePlan::to_json() const {
   nlohmann::json j;
   j["width"] = width;
   j["height"] = height;
+  j["materials"] = nlohmann::json::array();
   for (const MaterialPlan& m : materials) {
     nlohmann::json layers = nlohmann::json::array();
     for (const LayerPlan& l : m.layers)
-      layers.push_back({{"albedo", l.albedo}, {"normal", l.normal}, {"height", l.height}, {"height_max", l.height_max}});
-    j["materials"].push_back({{"name", m.name}, {"program", m.program}, {"layers", layers},
-                              {"cone_map", m.cone_map ? nlohmann::json(cone_kind_name(m.cone_kind)) : nlohmann::json()},
-                              {"cone_bytes", m.cone_bytes}, {"weight_bytes", m.weight_bytes},
-                              {"combined_quadtree_bytes", m.combined_bytes}, {"ao_bytes", m.ao_bytes}});
+      layers.push_back({{"albedo", l.albedo}, {"normal", l.normal}, {"height", l.height}, {"height_max", l.height_max},
+                        {"field", l.field}, {"ao", l.ao}});
+    j["materials"].push_back({{"name", m.name}, {"variant", m.variant}, {"technique", technique_name(m.technique)},
+                              {"layers", layers}, {"reference", m.reference},
+                              {"derived", {{"weights", m.weights}, {"combined_surface", m.combined_surface},
+                                           {"combined_quadtree", m.combined_quadtree}, {"blend_ao", m.blend_ao},
+                                           {"cones", m.cones}, {"bilinear_bound", m.bilinear_bound}}}});
   }
-  for (const TextureRequest& t : textures)
-    j["textures"].push_back({{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
-                             {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
-                             {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where}, {"users", t.users}});
-  for (const MeshPlan& m : meshes)
+  j["textures"] = nlohmann::json::array();
+  for (const TextureRequest& t : textures) {
+    nlohmann::json entry = {{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
+                            {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
+                            {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where}, {"users", t.users}};
+    if (t.desc.source == TextureSource::File) entry["file"] = t.desc.file.string();
+    j["textures"].push_back(entry);
+  }
+  j["derived"] = nlohmann::json::array();
+  for (const DerivedPlan& d : derived)
+    j["derived"].push_back({{"kind", derived_kind_name(d.kind)}, {"inputs", d.inputs}, {"texture", d.texture},
+                            {"bytes", d.bytes}, {"where", d.where}});
+  j["meshes"] = nlohmann::json::array();
+  for (const MeshPlan& m : meshes) {
+    nlohmann::json mtl = nlohmann::json::array();
+    for (std::uint32_t mat : m.mtl_materials) mtl.push_back(materials[mat].name);
     j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
-                           {"bytes", m.bytes}, {"estimated", m.estimated}});
+                           {"bytes", m.bytes}, {"material", materials.empty() ? "" : materials[m.material].name},
+                           {"mtl_materials", mtl}});
+  }
+  j["items"] = items();
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
-                 {"cone_map_bytes", cone_map_bytes}, {"derived_bytes", derived_bytes}, {"total_bytes", total_bytes()}};
+                 {"derived_bytes", derived_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

@@ -9,15 +9,10 @@
 #include <glm/vec4.hpp>
 
 #include "qdmr/mesh/mesh.hpp"
-#include "qdmr/render/pixel_buffer.hpp"
+#include "program/varyings.hpp"
+#include "qdmr/core/pixel_buffer.hpp"
 
 namespace qdmr {
-
-// Per-vertex values interpolated across triangles, in this order. Programs say how many they read: the
-// blend weights are interpolated only for programs that blend layers per vertex.
-enum Varying : int { kWorldX, kWorldY, kWorldZ, kNormalX, kNormalY, kNormalZ, kTangentX, kTangentY, kTangentZ, kTangentW, kU, kV,
-                     kWeight0, kWeight1, kWeight2, kWeight3, kVaryingCount };
-inline constexpr int kBaseVaryingCount = kWeight0;  // everything but the blend weights
 
 struct ClipVertex {
   glm::vec4 clip;  // homogeneous clip-space position (GL convention: -w <= z <= w)

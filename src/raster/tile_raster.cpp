@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <bit>
 
+#include "program/batch.hpp"
 #include "qdmr/core/limits.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
 
 using simd::Float;
@@ -65,7 +66,7 @@ public:
     if (r.empty()) return;
     setup_ = &s;
     steps_ = edge_steps(s);
-    program_ = ctx_.programs[s.material];
+    program_ = static_cast<const ShadingProgram*>(ctx_.programs[s.material]);
     for (int v = 0; v < 3; ++v) vertex_[v] = &ctx_.geometry->vertices[s.vertex[v]];
 
     for (int by = r.y0 - r.y0 % kBlock; by <= r.y1; by += kBlock) {
@@ -207,20 +208,6 @@ private:
 
 }  // namespace
 
-TileCounters& TileCounters::operator+=(const TileCounters& o) {
-  bin_entries += o.bin_entries;
-  blocks_rejected += o.blocks_rejected;
-  blocks_full += o.blocks_full;
-  blocks_partial += o.blocks_partial;
-  batches_shaded += o.batches_shaded;
-  quads_shaded += o.quads_shaded;
-  pixels_shaded += o.pixels_shaded;
-  pixels_depth_failed += o.pixels_depth_failed;
-  for (std::size_t i = 0; i < iteration_histogram.size(); ++i) iteration_histogram[i] += o.iteration_histogram[i];
-  iterations_useful += o.iterations_useful;
-  iterations_executed += o.iterations_executed;
-  return *this;
-}
 
 void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters) {
@@ -229,4 +216,4 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

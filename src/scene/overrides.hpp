@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "qdmr/scene/load.hpp"
+#include "qdmr/scene/overrides.hpp"
 
 namespace qdmr::scene_detail {
 

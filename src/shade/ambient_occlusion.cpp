@@ -1,11 +1,11 @@
 #include "shade/ambient_occlusion.hpp"
 
 #include "core/gather.hpp"
-#include "shade/ao_pattern.hpp"
+#include "bake/ao_pattern.hpp"
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 template <class Surface>
 simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const simd::Float& u, const simd::Float& v,
@@ -21,7 +21,7 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
   const Float s0 = xsimd::select(active, s, zero), ds0 = xsimd::select(active, ds, zero);
   const Float width(float(surface.width())), height(float(surface.height()));
   const int top = surface.has_hierarchy() ? surface.top_level() : 0;
-  const Int rotation = desc.jitter ? ao::rotation(pixel_x, pixel_y, desc.seed) : Int(0);
+  const Int rotation = desc.jitter ? ao_rotation(pixel_x, pixel_y, desc.seed) : Int(0);
   const simd::FetchPath fetch = surface.sampler().fetch;
 
   Float visible = zero;
@@ -57,4 +57,4 @@ template simd::Float ambient_occlusion<BlendedSurface>(const BlendedSurface&, co
                                                        const simd::Float&, const simd::Float&, const simd::Float&,
                                                        const simd::Float&, const simd::Float&, simd::Mask);
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -13,10 +13,25 @@
 //   fine:   every tap reads the filtered surface height(u, v, lod 0), as the material's technique fetches it.
 // Cell addressing wraps (the max-quadtree's rule); the filtered surface uses the material's address mode.
 // A flat surface (h(tap) equal to the point's height, s = ds * (1 - h)) gives exactly 1.
+#include "bake/ao_pattern.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
+
+// ao::rotation per lane, from pixel centres (x + 0.5, y + 0.5).
+inline simd::Int ao_rotation(const simd::Float& pixel_x, const simd::Float& pixel_y, std::uint32_t seed) {
+  using simd::UInt;
+  const UInt x = xsimd::bitwise_cast<UInt>(xsimd::to_int(xsimd::floor(pixel_x)));
+  const UInt y = xsimd::bitwise_cast<UInt>(xsimd::to_int(xsimd::floor(pixel_y)));
+  UInt h = (x * UInt(0x8da6b343u)) ^ (y * UInt(0xd8163841u)) ^ UInt(seed * 0xcb1ab31fu);
+  h ^= h >> 16;
+  h *= UInt(0x85ebca6bu);
+  h ^= h >> 13;
+  h *= UInt(0xc2b2ae35u);
+  h ^= h >> 16;
+  return xsimd::bitwise_cast<simd::Int>(h >> 28);
+}
 
 // ao' = 1 - strength * (1 - ao): strength 0 disables the darkening, 1 keeps it (for baked maps too).
 inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
@@ -34,4 +49,4 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
                               const simd::Float& s, const simd::Float& ds, const simd::Float& pixel_x,
                               const simd::Float& pixel_y, simd::Mask active);
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

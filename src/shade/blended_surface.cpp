@@ -2,7 +2,7 @@
 
 #include "shade/traversal.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
 
 using simd::Float;
@@ -192,4 +192,4 @@ Float BlendedSurface::cell_max_filtered(const Float& u, const Float& v, const Fl
   return bound(hmax, weights_);
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -10,7 +10,7 @@
 // queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
 #include "shade/height_surface.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 struct WeightTexture {
   const TextureView* view = nullptr;  // RGBA8 linear, power-of-two, max chain; level 0 sampled bilinearly (wrap)
@@ -76,4 +76,4 @@ private:
   unsigned present_ = 0;             // bit i: layer i has weight in some lane
 };
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

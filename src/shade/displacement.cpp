@@ -4,6 +4,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/study/reference.hpp"
 #include "qdmr/core/limits.hpp"
@@ -12,7 +13,7 @@
 #include "shade/shading_math.hpp"
 #include "shade/traversal.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
 
 using namespace shading;
@@ -57,7 +58,7 @@ Int address_texel(const Int& i, int n, AddressMode mode) {
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : ShadingProgram(inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
+    : ShadingProgram(program_variant(material), inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
       cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
@@ -722,4 +723,4 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   shade_surface(in, setup, surface, out);
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

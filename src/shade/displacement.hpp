@@ -7,39 +7,17 @@
 #include <vector>
 
 #include "qdmr/bake/cone_map.hpp"
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
-#include "shade/lighting.hpp"
+#include "program/light_rig.hpp"
 #include "shade/lighting_models.hpp"
-#include "shade/program.hpp"
+#include "program/batch.hpp"
+#include "program/inputs.hpp"
 #include "shade/shading_math.hpp"
 #include "texture/sampler.hpp"
 
-namespace qdmr {
-
-struct LayerInputs {
-  const Texture* albedo = nullptr;      // RGBA8 sRGB
-  const Texture* normal = nullptr;      // RGBA8, 0.5 + 0.5 n
-  const Texture* height = nullptr;      // box-filtered heights (techniques, height blending)
-  const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
-  const Texture* ao = nullptr;          // baked AO of this layer's heights (R16), when the material bakes AO
-};
-
-struct DisplacementInputs {
-  std::vector<LayerInputs> layers;        // 1 .. 4
-  const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
-  const Texture* combined = nullptr;      // blending per pixel: the precomputed combined quadtree (optional)
-  int combined_period = 0;                // its period in level-0 texels (layers' size x repeats of the weights)
-  const Texture* blend_ao = nullptr;      // baked AO of a blend's combined surface over the weights span (R16)
-  int blend_ao_scale = 1;                 // ... sampled at UV / this (the whole number of repeats it spans)
-  const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
-  const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
-  int reference_scale = 1;                // texture repeats the reference spans (a blend's combined surface)
-  // qdm with bilinear-patch refinement: the fp64 heights solved exactly, and height_max built from
-  // bilinear_upper_bound() of them (conservative for the bilinear surface).
-  const HeightField* surface = nullptr;
-};
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 class DisplacementProgram final : public ShadingProgram {
 public:
@@ -116,4 +94,4 @@ private:
   LightRig lights_;
 };
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

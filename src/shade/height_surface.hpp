@@ -13,7 +13,7 @@
 #include "qdmr/scene/scene.hpp"
 #include "texture/sampler.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 class SingleLayerSurface {
 public:
@@ -78,4 +78,4 @@ private:
   HeightFetch fetch_;
 };
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,6 +1,6 @@
 #include "shade/lighting_models.hpp"
 
-namespace qdmr::shading {
+namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 namespace {
 
 // pi * D * Vis * F * n.l of the header, for one light.
@@ -65,4 +65,4 @@ Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs
   return Float(coeffs.scale) * detmath::pow(x, Float(coeffs.power));
 }
 
-}  // namespace qdmr::shading
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::shading

@@ -13,10 +13,10 @@
 // Lane-wise IEEE only; pow through detmath.
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "shade/lighting.hpp"
+#include "program/light_rig.hpp"
 #include "shade/shading_math.hpp"
 
-namespace qdmr::shading {
+namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 
 struct SurfaceSample {
   const Float* albedo;      // 3 channels, linear RGB
@@ -34,4 +34,4 @@ void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, cons
 // `fallback` (the material's lighting.specular) when coeffs.enabled is false.
 Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs, float fallback);
 
-}  // namespace qdmr::shading
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::shading

@@ -3,7 +3,7 @@
 #include "shade/lighting_models.hpp"
 #include "shade/shading_math.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 using namespace shading;
 
@@ -31,4 +31,4 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   out.hit_v = v;
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

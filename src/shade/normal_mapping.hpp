@@ -1,18 +1,18 @@
 #pragma once
 // The first shading program: albedo with tangent-space normal mapping, lit by the material's lighting model
 // (lighting_models.hpp) from directional lights plus ambient.
-#include "shade/lighting.hpp"
-#include "shade/program.hpp"
+#include "program/light_rig.hpp"
+#include "program/batch.hpp"
 #include "texture/sampler.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
-  NormalMappingProgram(const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
+  NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
                        const LightingDesc& lighting, const SpecularFromAlbedo& specular, const LightRig& lights)
-      : albedo_(albedo), normal_(normal), sampler_(SamplerState::from(sampling)), lod_mode_(sampling.lod),
+      : ShadingProgram(variant, kBaseVaryingCount), albedo_(albedo), normal_(normal), sampler_(SamplerState::from(sampling)), lod_mode_(sampling.lod),
         lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
 
@@ -25,4 +25,4 @@ private:
   LightRig lights_;
 };
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

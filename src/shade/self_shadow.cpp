@@ -8,7 +8,7 @@
 #include "shade/height_surface.hpp"
 #include "shade/traversal.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
 
 using simd::Float;
@@ -254,4 +254,4 @@ template ShadowResult self_shadow<SingleLayerSurface>(const SingleLayerSurface&,
 template ShadowResult self_shadow<BlendedSurface>(const BlendedSurface&, const ShadowDesc&, const ShadowRay&,
                                                  const simd::Float&, simd::Mask);
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

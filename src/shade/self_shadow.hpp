@@ -45,7 +45,7 @@
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // A ray from the displaced point towards one directional light, in UV/depth space.
 struct ShadowRay {
@@ -67,4 +67,4 @@ template <class Surface>
 ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const ShadowRay& ray, const simd::Float& lod,
                          simd::Mask active);
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -4,10 +4,10 @@
 #include "core/det_math.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "shade/lighting.hpp"
-#include "shade/program.hpp"
+#include "program/light_rig.hpp"
+#include "program/batch.hpp"
 
-namespace qdmr::shading {
+namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 
 using simd::Float;
 
@@ -59,4 +59,4 @@ inline Vec3 view_vector(const Fragments& in, const LightRig& lights) {
                     Float(lights.camera_position.z) - in.varyings[kWorldZ]});
 }
 
-}  // namespace qdmr::shading
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::shading

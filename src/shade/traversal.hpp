@@ -3,7 +3,7 @@
 // texel coordinates are clamped to before they become indices.
 #include "core/simd.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // Texel coordinates are clamped to +-2^22 before they become indices: beyond that fp32 positions are
 // meaningless anyway, and indices (plus at most 2^20 capped steps) stay exact in fp32.
@@ -48,4 +48,4 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
   level = xsimd::select(descend, child_level, level);
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

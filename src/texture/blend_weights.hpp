@@ -9,7 +9,7 @@
 
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/image.hpp"
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {

@@ -9,7 +9,7 @@
 #include "qdmr/core/error.hpp"
 #include "texture/internal.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
 
 using simd::FetchPath;
@@ -212,4 +212,4 @@ void load(const TextureView& view, const Int& level, const Int& x, const Int& y,
   fetch(view, info, cx, cy, path, out);
 }
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

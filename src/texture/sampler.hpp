@@ -11,7 +11,7 @@
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // A Texture with the per-level tables the sampler looks up per lane.
 class TextureView {
@@ -69,4 +69,4 @@ void sample(const TextureView& texture, const SamplerState& state, const simd::F
 void load(const TextureView& texture, const simd::Int& level, const simd::Int& x, const simd::Int& y,
           simd::FetchPath fetch, simd::Float* out);
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,17 +1,18 @@
-// Same scene, same bits: through the qdmr command, the SSE4.2 twin (qdmr-sse) renders every scene to the
-// same float pixels as the AVX2 build, and neither the thread count nor the tile size changes a bit. The
-// colour image and the depth, normal and uv AOVs are all compared exactly (no tolerance: determinism is
-// the contract).
+// Same scene, same bits: through the qdmr command, every draw kernel this machine can run (--isa sse4.2, avx2,
+// ...) renders every scene to the same float pixels, and neither the thread count nor the tile size changes a
+// bit. The colour image and the depth, normal, uv and iterations AOVs are all compared exactly (no tolerance:
+// determinism is the contract).
 #include <gtest/gtest.h>
 
 #include "cli/cli_test_util.hpp"
+#include "qdmr/core/isa.hpp"
 
 namespace qdmr::test {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kImages{"color", "depth", "normal", "uv"};
+const std::vector<std::string> kImages{"color", "depth", "normal", "uv", "iterations"};
 
 // Renders `scene` with every AOV through `binary` into `dir`; returns the file of each image in kImages.
 std::vector<fs::path> render_all(const fs::path& binary, const ShippedScene& scene, const fs::path& dir,
@@ -30,22 +31,25 @@ void expect_identical(const std::vector<fs::path>& a, const std::vector<fs::path
   }
 }
 
-class CliSimd : public testing::TestWithParam<ShippedScene> {};
+class CliIsa : public testing::TestWithParam<ShippedScene> {};
 
-TEST_P(CliSimd, SseTwinRendersTheSameBits) {
+TEST_P(CliIsa, EveryKernelRendersTheSameBits) {
   const ShippedScene& scene = GetParam();
-  if (cli_sse().empty())
-    GTEST_SKIP() << "qdmr-sse is not built (QDMR_BUILD_SSE_TWIN=OFF, or this build is itself SSE4.2)";
+  const std::vector<Isa> isas = usable_isas();
+  if (isas.size() < 2) GTEST_SKIP() << "this CPU runs only one of the binary's kernels: nothing to compare";
   if (scene.needs_data && !have_data())
     GTEST_SKIP() << scene.name << ".json needs the real CC0 maps, not found in QDMR_DATA_DIR=" << data_dir();
-  TempDir avx2_dir, sse_dir;
-  const auto avx2 = render_all(cli(), scene, avx2_dir.path());
-  const auto sse = render_all(cli_sse(), scene, sse_dir.path());
-  if (HasFatalFailure()) return;
-  expect_identical(avx2, sse, scene.name + ": " + cli().filename().string() + " vs " + cli_sse().filename().string());
+  TempDir first_dir;
+  const auto first = render_all(cli(), scene, first_dir.path(), {"--isa", isa_name(isas[0])});
+  for (std::size_t k = 1; k < isas.size(); ++k) {
+    TempDir dir;
+    const auto other = render_all(cli(), scene, dir.path(), {"--isa", isa_name(isas[k])});
+    if (HasFatalFailure()) return;
+    expect_identical(first, other, scene.name + ": --isa " + isa_name(isas[0]) + " vs " + isa_name(isas[k]));
+  }
 }
 
-INSTANTIATE_TEST_SUITE_P(, CliSimd, testing::ValuesIn(shipped_scenes()), scene_name);
+INSTANTIATE_TEST_SUITE_P(, CliIsa, testing::ValuesIn(shipped_scenes()), scene_name);
 
 // terrain (58k small triangles, many per tile) and objects (overlapping meshes, depth test across tiles)
 // are the scenes where scheduling could leak into pixels; plane adds nothing.

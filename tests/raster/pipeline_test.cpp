@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/render/render.hpp"
-#include "qdmr/scene/load.hpp"
+#include "qdmr/load/load.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {

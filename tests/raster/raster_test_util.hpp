@@ -7,6 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "program/batch.hpp"
 #include "raster/binner.hpp"
 #include "raster/tile_raster.hpp"
 
@@ -15,7 +16,8 @@ namespace qdmr::test {
 // Records every shaded pixel (tests run the tiles on one thread, so no synchronisation is needed).
 class CountingProgram final : public ShadingProgram {
 public:
-  explicit CountingProgram(int width, int height) : width_(width), counts(std::size_t(width) * height, 0) {}
+  explicit CountingProgram(int width, int height)
+      : ShadingProgram("counting", kBaseVaryingCount), width_(width), counts(std::size_t(width) * height, 0) {}
   void shade(const Fragments& in, ShadeOutput& out) const override {
     alignas(64) float x[simd::kLanes], y[simd::kLanes];
     in.pixel_x.store_aligned(x);
@@ -82,7 +84,7 @@ struct ScreenScene {
     context.geometry = &geometry;
     context.setups = &setups;
     context.framebuffer = &fb;
-    context.programs = {&program};
+    context.programs = {static_cast<const Program*>(&program)};
     for (int tile = 0; tile < grid.count(); ++tile) {
       TileCounters counters;
       raster_tile(context, tile, grid.rect(tile), bins, counters);

@@ -1,6 +1,7 @@
 // Reading scene files and resolving the paths they name.
 #include <gtest/gtest.h>
 
+#include "qdmr/mesh/mesh.hpp"
 #include "scene/scene_test_util.hpp"
 #include "support/test_support.hpp"
 
@@ -56,7 +57,8 @@ TEST(SceneFiles, PathsResolveAgainstTheSceneDirectory) {
   fs::create_directories(dir / "scenes" / "textures");
   test::write_file(dir / "scenes" / "textures" / "rock_h.png", "not really a png");
   test::write_file(dir / "scenes" / "textures" / "rock_a.png", "");
-  test::write_file(dir / "model.obj", "");
+  // Loading reads the OBJ: one triangle without a material (it gets the OBJ's "default" material).
+  test::write_file(dir / "model.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   json document = test::minimal_scene();
   document["materials"]["rock"]["layers"][0] = {
       {"albedo", {{"file", "textures/rock_a.png"}, {"srgb", false}}},
@@ -75,6 +77,11 @@ TEST(SceneFiles, PathsResolveAgainstTheSceneDirectory) {
   EXPECT_EQ(layer.normal.source, TextureSource::FromHeight);
   EXPECT_EQ(scene.objects.at(1).mesh.file, root / "model.obj");
   EXPECT_TRUE(scene.objects.at(1).material.empty());
+  // The OBJ is read when the scene is loaded, and its materials join the scene's, after them.
+  ASSERT_TRUE(scene.objects.at(1).obj_mesh);
+  EXPECT_EQ(scene.objects.at(1).obj_mesh->triangle_count(), 1u);
+  EXPECT_EQ(scene.objects.at(1).mtl_materials, std::vector<std::string>{"object 1/default"});
+  EXPECT_EQ(scene.materials.back().name, "object 1/default");
 
   // The same document in memory, resolved against an explicit base directory; absolute paths stay as they are.
   document["materials"]["rock"]["layers"][0]["albedo"] = (root / "scenes" / "textures" / "rock_a.png").string();

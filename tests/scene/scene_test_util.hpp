@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "qdmr/core/error.hpp"
-#include "qdmr/scene/load.hpp"
+#include "qdmr/load/load.hpp"
 
 namespace qdmr::test {
 

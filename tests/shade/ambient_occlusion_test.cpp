@@ -14,7 +14,7 @@
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/ambient_occlusion.hpp"
-#include "shade/ao_pattern.hpp"
+#include "bake/ao_pattern.hpp"
 #include "shade/height_surface.hpp"
 
 namespace qdmr {
@@ -238,7 +238,7 @@ TEST(AmbientOcclusion, JitterRotationIsAHashOfPixelAndSeed) {
       alignas(64) float px[simd::kLanes];
       alignas(64) std::int32_t r[simd::kLanes];
       for (int l = 0; l < simd::kLanes; ++l) px[l] = float(x + l) + 0.5f;
-      ao::rotation(Float::load_aligned(px), Float(float(y) + 0.5f), 9u).store_aligned(r);
+      ao_rotation(Float::load_aligned(px), Float(float(y) + 0.5f), 9u).store_aligned(r);
       for (int l = 0; l < simd::kLanes; ++l) {
         EXPECT_EQ(r[l], ao::rotation(std::uint32_t(x + l), std::uint32_t(y), 9u));
         seen.insert(r[l]);

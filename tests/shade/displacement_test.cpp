@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/render/render.hpp"
-#include "qdmr/scene/load.hpp"
+#include "qdmr/load/load.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/displacement_test_util.hpp"
 #include "support/test_support.hpp"

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 
 namespace qdmr::test {
 

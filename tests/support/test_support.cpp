@@ -16,7 +16,6 @@ std::filesystem::path source_dir() { return QDMR_SOURCE_DIR; }
 std::filesystem::path data_dir() { return QDMR_DATA_DIR; }
 bool have_data() { return std::filesystem::is_directory(data_dir() / "materials"); }
 std::filesystem::path cli() { return QDMR_CLI; }
-std::filesystem::path cli_sse() { return QDMR_CLI_SSE; }
 
 TempDir::TempDir() {
   static std::atomic<int> counter{0};

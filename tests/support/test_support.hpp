@@ -10,7 +10,6 @@ std::filesystem::path source_dir();
 std::filesystem::path data_dir();  // QDMR_DATA_DIR; may not exist
 bool have_data();
 std::filesystem::path cli();       // the qdmr command of this build
-std::filesystem::path cli_sse();   // the SSE twin, empty when not built
 
 // A fresh empty directory under the system temp folder, removed by the destructor.
 class TempDir {

@@ -18,7 +18,7 @@
 #include <filesystem>
 
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 #include "qdmr/texture/image.hpp"
 
 namespace qdmr {

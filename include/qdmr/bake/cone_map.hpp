@@ -42,7 +42,7 @@
 #include <string>
 #include <vector>
 
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 
 namespace qdmr {
 

@@ -1,6 +1,8 @@
 #pragma once
-// FramePlan: what a scene requires before anything is built — the program variant of each material,
-// the textures and derived data to make, the AOVs, and the memory all of it will take.
+// The plan stage: FramePlan = what a loaded scene requires before anything is built — the program variant of
+// each material, the meshes, textures and derived data to make (each with a content key), the AOVs, and the
+// memory all of it will take. prepare() builds exactly what the plan lists and nothing else; `qdmr plan`
+// prints it.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -8,7 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "qdmr/bake/cone_map.hpp"
-#include "qdmr/render/render.hpp"
+#include "qdmr/core/aov.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/format.hpp"
 #include "qdmr/texture/mip_texture.hpp"
@@ -16,8 +18,12 @@
 
 namespace qdmr {
 
+struct PlanOptions {
+  std::vector<Aov> aovs;  // error_texels and missed make displacement programs trace the exact reference
+};
+
 struct TextureRequest {
-  std::string key;           // identical requests share one texture
+  std::string key;           // content key: identical requests share one texture (and survive re-planning)
   TexturePurpose purpose;
   TextureDesc desc;
   LayerDesc layer;           // the layer it belongs to (height for from_height normals, scale/offset)
@@ -30,61 +36,88 @@ struct TextureRequest {
   std::vector<std::string> users;  // material names
 };
 
-// Indices into FramePlan::textures of one layer's textures (-1: not needed).
+// Data derived from textures, meshes and material settings, built after them.
+enum class DerivedKind {
+  WeightTexture,     // blends per pixel: RGBA8 weight texture with a max chain (from the weight map or the vertices)
+  CombinedSurface,   // blends: fp64 blended box surface over the weights span (reference, combined tree, AO)
+  CombinedQuadtree,  // qdm over a per-pixel blend: the max-quadtree of the combined surface
+  BlendAoMap,        // baked AO of a blend's combined surface
+  HeightField,       // fp64 level 0 of a stored height map (exact reference, cone bake, bilinear patches, layer AO)
+  LayerAoMap,        // baked AO of one layer's heights
+  ConeMap,           // csm, rcsm
+  BilinearBound,     // qdm with bilinear-patch refinement: max-quadtree of the 3x3 maxima
+};
+const char* derived_kind_name(DerivedKind kind);
+
+struct DerivedPlan {
+  DerivedKind kind;
+  std::string key;      // content key: equal keys build equal data
+  std::string where;    // scene field, for messages
+  std::vector<int> inputs;  // derived items it is made from (built before it)
+  int texture = -1;     // the height texture it is made from (HeightField), else -1
+  int material = -1;    // the first material that asked for it
+  int side = 0;         // ao maps: the map's width
+  std::uint64_t bytes = 0;
+};
+
+// Indices into FramePlan::textures and FramePlan::derived of one layer (-1: not needed).
 struct LayerPlan {
   int albedo = -1, normal = -1;
   int height = -1;           // box-filtered heights (displacement techniques, height blending)
   int height_max = -1;       // max-quadtree (qdm, hard or qdm_soft shadows, coarse AO)
+  int field = -1;            // derived HeightField of the height (layer 0: reference, cones; any: baked AO)
+  int ao = -1;               // derived LayerAoMap
 };
 
 struct MaterialPlan {
   std::string name;
-  std::string program;       // the shading program variant
+  std::string where;         // the scene field it comes from (an OBJ's MTL material: the object's mesh file)
+  MaterialDesc desc;         // what the scene says; the program reads its knobs
+  std::string variant;       // the shading program variant (the instantiated program type's name)
   TechniqueKind technique = TechniqueKind::Normal;
   std::vector<LayerPlan> layers;  // one per material layer
-  // Blending (more than one layer): the weights come per vertex or from a weight texture built from the map.
-  bool blend = false;
+  bool blend = false;        // more than one layer
   WeightMode weight_mode = WeightMode::Pixel;
-  std::uint64_t weight_bytes = 0;  // pixel mode: RGBA8 weight texture with its max chain
-  bool combined_quadtree = false;  // pixel mode, qdm: the precomputed max-quadtree of the blended surface
-  std::uint64_t combined_bytes = 0;
-  bool ao_map = false;       // baked AO: one map per layer, or one of the blended surface (blend_ao)
-  bool blend_ao = false;     // baked AO of a blend: of the combined surface over the weights span
-  int ao_resolution = 0;     // blend_ao: the map's side
-  std::uint64_t ao_bytes = 0;
-  bool cone_map = false;     // csm, rcsm: a cone map of the height's level 0, baked or from the cache
+  bool reference = false;    // error AOVs: trace the exact reference (layer 0's field, or the combined surface)
+  bool cone_map = false;
   ConeKind cone_kind = ConeKind::Conservative;
-  std::uint64_t cone_bytes = 0;  // one float per level-0 texel
-  SamplingDesc sampling;
-  LightingDesc lighting;
+  // Indices into FramePlan::derived, -1 when not needed.
+  int weights = -1, combined_surface = -1, combined_quadtree = -1, blend_ao = -1, cones = -1, bilinear_bound = -1;
+  int weights_scale = 1;     // whole repeats the combined surface spans
+  std::vector<std::size_t> objects;  // objects drawn with it
 };
 
 struct MeshPlan {
   std::string object;
   std::string kind;
+  std::string key;           // content key (with the vertex weights it carries)
   std::uint64_t vertices = 0, triangles = 0, bytes = 0;
-  bool estimated = false;    // obj: counted from the file, MTL materials resolved when prepared
+  std::uint32_t material = 0;                // frame material of its triangles (no MTL materials)
+  std::vector<std::uint32_t> mtl_materials;  // obj with MTL materials: frame material per mesh-local material
+  int vertex_weights = -1;   // per-vertex blend weights of this frame material are stored in the mesh, else -1
 };
 
 struct FramePlan {
+  SceneDesc scene;           // the loaded scene: camera, lights and transforms for draw
+  PlanOptions options;
   int width = 0, height = 0;
-  std::vector<MaterialPlan> materials;
+  std::vector<MaterialPlan> materials;   // the materials objects use, in first-use order
   std::vector<TextureRequest> textures;
-  std::vector<MeshPlan> meshes;
+  std::vector<DerivedPlan> derived;      // in build order (inputs first)
+  std::vector<MeshPlan> meshes;          // one per scene object
   std::vector<Aov> aovs;
-  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, cone_map_bytes = 0, derived_bytes = 0;
-  std::uint64_t total_bytes() const {
-    return framebuffer_bytes + texture_bytes + mesh_bytes + cone_map_bytes + derived_bytes;
-  }
+  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, derived_bytes = 0;
+  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes + derived_bytes; }
 
+  // Everything prepare() builds, one line per item ("texture <key>", "mesh <key>", "<derived kind> <key>"),
+  // in build order; Assets::built lists the same lines as they are made.
+  std::vector<std::string> items() const;
   std::string describe() const;  // human-readable, for `qdmr plan`
   nlohmann::json to_json() const;
 };
 
-// Throws qdmr::Error for unreadable texture files (their headers are read to size them).
-FramePlan plan_frame(const SceneDesc& scene, const RenderOptions& options);
+// Throws qdmr::Error for settings that cannot be built (texture headers are read to size them).
+FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options = {});
 
-// Adds the texture requests of one material (shared by planning and preparing) and returns its plan.
-MaterialPlan plan_material(const MaterialDesc& material, const std::string& where, std::vector<TextureRequest>& textures);
 
 }  // namespace qdmr

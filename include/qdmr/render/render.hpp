@@ -1,78 +1,39 @@
 #pragma once
-// Rendering a scene: the library's front door. The qdmr command is a thin layer over these calls.
+// Rendering a scene: the library's front door. A Renderer prepares a scene once and draws it many times;
+// render_frame() is the one-shot form. The qdmr command is a thin layer over these calls.
 //
 //   qdmr::SceneDesc scene = qdmr::load_scene("scenes/plane.json");
-//   qdmr::Frame frame = qdmr::render_frame(scene, {});
+//   qdmr::Renderer renderer;
+//   renderer.set_scene(scene);
+//   const qdmr::Frame& frame = renderer.draw();
 //   qdmr::write_frame(frame, "plane.png");
-#include <cstdint>
-#include <filesystem>
 #include <functional>
-#include <optional>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json_fwd.hpp>
-
-#include "qdmr/render/pixel_buffer.hpp"
+#include "qdmr/core/aov.hpp"
+#include "qdmr/core/isa.hpp"
+#include "qdmr/core/pixel_buffer.hpp"
+#include "qdmr/core/stats.hpp"
 #include "qdmr/scene/scene.hpp"
 
 namespace qdmr {
 
-// Per-pixel outputs besides colour. Displacement AOVs: `iterations` of the intersection loop, `hit_uv` and
-// `hit_depth` (UV units) of the hit; against the exact reference: `error_texels` (distance from the reference
-// hit, in level-0 texels) and `missed` (1 where the technique hit more than a texel away from the reference,
-// i.e. another feature or layer). Normal mapping reports 0 iterations and the hit at the polygon.
-enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed };
-inline constexpr int kAovCount = 8;
-std::optional<Aov> parse_aov(const std::string& name);
-std::string aov_name(Aov aov);
-int aov_channels(Aov aov);
-std::vector<std::string> aov_names();
+struct FramePlan;
 
 struct RenderOptions {
-  int threads = 0;     // 0 = every core
-  int tile_size = 64;  // pixels, a multiple of 8 in [8, 1024]
+  int threads = 0;       // 0 = every core
+  int tile_size = 64;    // pixels, a multiple of 8 in [8, 1024]
+  Isa isa = Isa::Auto;   // draw kernel; Auto: $QDMR_ISA, else the best this CPU supports
   std::vector<Aov> aovs;
   // Called with a stage name ("prepare", "raster") and the fraction done, from any worker thread,
   // never concurrently with itself. Optional.
   std::function<void(const char* stage, double fraction)> progress;
 };
 
-// Throws qdmr::Error("option", ...) when options are out of range.
+// Throws qdmr::Error("--threads" / "--tile" / "--isa", ...) when options are out of range or the ISA is unusable.
 void validate_options(const RenderOptions& options);
-
-// What was built for one texture of the frame.
-struct TextureStat {
-  std::string where;    // the scene field it came from
-  std::string purpose;  // albedo, normal, height
-  std::string format;   // storage format of the chain, e.g. "rgba8 srgb"
-  int width = 0, height = 0, levels = 0;
-  std::uint64_t bytes = 0;
-  std::string height_format;  // heights behind it (from_height normals, heights): storage format, else empty
-  bool bc3 = false;           // the height was BC3-compressed; errors in 8-bit steps
-  double bc3_max_error = 0, bc3_rms_error = 0;
-};
-
-struct RenderStats {
-  // Milliseconds per stage; load and write are filled in by whoever loads and writes.
-  double load_ms = 0, prepare_ms = 0, geometry_ms = 0, binning_ms = 0, raster_shade_ms = 0, write_ms = 0;
-  std::uint64_t triangles_in = 0, triangles_culled = 0, triangles_clipped = 0, triangles_rasterized = 0;
-  std::uint64_t tiles = 0, tile_bin_entries = 0, blocks_rejected = 0, blocks_full = 0, blocks_partial = 0;
-  std::uint64_t batches = 0, quads = 0, pixels_shaded = 0, pixels_depth_failed = 0;
-  // Intersection iterations per written pixel (0 for normal mapping); p99 and max from a histogram capped at
-  // 1024 (a max of 1024 means "1024 or more"). Lane utilisation: useful lane-iterations / executed ones.
-  double iterations_mean = 0, iterations_p99 = 0, iterations_max = 0, lane_utilisation = 1;
-  // Against the exact reference, over the covered pixels, when the error_texels or missed AOV is rendered.
-  bool reference = false;
-  std::uint64_t reference_pixels = 0;
-  double error_texels_mean = 0, error_texels_max = 0, missed_fraction = 0;
-  int threads = 0, tile_size = 0, simd_lanes = 0;
-  std::string simd_arch;
-  std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
-  std::vector<TextureStat> textures;
-
-  nlohmann::json to_json() const;
-};
 
 struct AovImage {
   Aov aov;
@@ -87,15 +48,38 @@ struct Frame {
   RenderStats stats;
 };
 
-Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
+// Prepares scenes and draws frames, keeping what it built: the assets of the last scene (a new scene re-uses
+// every item whose content key is unchanged, so a new camera, output size or lighting re-prepares nothing),
+// the programs, the framebuffer and the AOV planes (no per-frame allocation once sizes settle), a task arena
+// of `threads` workers and the draw kernel of the chosen ISA. Not thread-safe: one frame at a time.
+class Renderer {
+public:
+  explicit Renderer(const RenderOptions& options = {});  // throws qdmr::Error on invalid options
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
 
-// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear) through a temporary
-// file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
-void write_frame(const Frame& frame, const std::filesystem::path& file);
-// Writes the stats as JSON, atomically like the images.
-void write_stats(const RenderStats& stats, const std::filesystem::path& file);
-// Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
-// fractional part, depth, iterations, hit depth and errors divided by their maximum).
-void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
+  // Plans the scene with these AOVs and prepares what the previous scene did not already have.
+  void set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs);
+  void set_scene(const SceneDesc& scene) { set_scene(scene, options_aovs()); }
+  const FramePlan& plan() const;  // of the current scene (throws if none)
+
+  // Draws one frame of the current scene. The frame's buffers belong to the renderer and are overwritten by the
+  // next draw; its stats carry plan_ms and prepare_ms of the set_scene() before the first draw of a scene only.
+  const Frame& draw();
+  const Frame& frame() const;
+  Frame take_frame();  // moves the last frame out (the next draw allocates again)
+
+  Isa isa() const;
+  int threads() const;
+
+private:
+  std::vector<Aov> options_aovs() const;
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// One frame, one shot: a Renderer for one draw.
+Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
 
 }  // namespace qdmr

@@ -3,6 +3,7 @@
 // Units: lengths in scene units, angles in degrees, colours linear RGB.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include <glm/vec4.hpp>
 
 namespace qdmr {
+
+struct MeshData;  // qdmr/mesh/mesh.hpp: an OBJ mesh, read when the scene is loaded
 
 struct OutputDesc {
   int width = 1920;
@@ -287,6 +290,10 @@ struct ObjectDesc {
   MeshDesc mesh;
   std::string material;  // a key of SceneDesc::materials; may be empty for obj meshes (their MTL materials are used)
   TransformDesc transform;
+  // obj, filled by load_scene: the mesh as read, and for an object without `material`, the scene material of each
+  // of the mesh's MTL materials (MeshData::triangle_materials indexes this list).
+  std::shared_ptr<const MeshData> obj_mesh;
+  std::vector<std::string> mtl_materials;
 };
 
 struct SceneDesc {
@@ -294,7 +301,7 @@ struct SceneDesc {
   OutputDesc output;
   CameraDesc camera;
   LightsDesc lights;
-  std::vector<MaterialDesc> materials;  // sorted by name (JSON objects are unordered)
+  std::vector<MaterialDesc> materials;  // sorted by name (JSON objects are unordered), then those of MTL files
   std::vector<ObjectDesc> objects;      // submission order
 
   const MaterialDesc* find_material(const std::string& name) const {

@@ -1,7 +1,7 @@
 #pragma once
 // The exact reference: the first intersection of a ray with a heightfield surface, in fp64, by grid
 // traversal with an analytic solve per cell. It is the ground truth every technique is measured against.
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 
 namespace qdmr {
 

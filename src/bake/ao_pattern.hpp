@@ -1,6 +1,7 @@
 #pragma once
 // Where horizon-based ambient occlusion looks: the same pattern for the per-frame AO (SIMD, float) and the
-// baked AO map (scalar, double), so both see the same directions and tap distances.
+// baked AO map (scalar, double), so both see the same directions and tap distances. The per-lane jitter
+// rotation is in shade/ambient_occlusion.hpp.
 //
 // Directions: n = clamp(directions, 4, 16) equally spaced directions in the UV plane, direction i at
 //   angle 2 pi (i + r / kRotations) / n,
@@ -18,7 +19,6 @@
 #include <array>
 #include <cstdint>
 
-#include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 
 namespace qdmr::ao {
@@ -95,20 +95,6 @@ inline std::uint32_t mix_hash(std::uint32_t x, std::uint32_t y, std::uint32_t se
   return h;
 }
 inline int rotation(std::uint32_t x, std::uint32_t y, std::uint32_t seed) { return int(mix_hash(x, y, seed) >> 28); }
-
-// The same per lane, from pixel centres (x + 0.5, y + 0.5).
-inline simd::Int rotation(const simd::Float& pixel_x, const simd::Float& pixel_y, std::uint32_t seed) {
-  using simd::UInt;
-  const UInt x = xsimd::bitwise_cast<UInt>(xsimd::to_int(xsimd::floor(pixel_x)));
-  const UInt y = xsimd::bitwise_cast<UInt>(xsimd::to_int(xsimd::floor(pixel_y)));
-  UInt h = (x * UInt(0x8da6b343u)) ^ (y * UInt(0xd8163841u)) ^ UInt(seed * 0xcb1ab31fu);
-  h ^= h >> 16;
-  h *= UInt(0x85ebca6bu);
-  h ^= h >> 13;
-  h *= UInt(0xc2b2ae35u);
-  h ^= h >> 16;
-  return xsimd::bitwise_cast<simd::Int>(h >> 28);
-}
 
 struct Tap {
   float distance;      // UV units

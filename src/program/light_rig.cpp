@@ -1,4 +1,4 @@
-#include "shade/lighting.hpp"
+#include "program/light_rig.hpp"
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>

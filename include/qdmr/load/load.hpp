@@ -1,26 +1,19 @@
 #pragma once
-// Loading a scene file: JSON in, validated SceneDesc out, with --set overrides applied first.
+// The load stage: a scene file in, a validated SceneDesc out, with --set overrides applied first. Everything the
+// scene refers to is resolved here: paths made absolute, and OBJ meshes read with their MTL materials, which
+// join the scene's materials (named "<object>/<mtl material>"), so the plan sees every material of the frame.
 #include <filesystem>
-#include <string>
-#include <string_view>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "qdmr/scene/overrides.hpp"
 #include "qdmr/scene/scene.hpp"
 
 namespace qdmr {
 
-// One --set /json/pointer=value override; value is JSON (a bare word that is not JSON is taken as a string).
-struct SceneOverride {
-  std::string pointer;
-  std::string value;
-};
-
-// Parses "POINTER=VALUE"; throws qdmr::Error naming the option on malformed text.
-SceneOverride parse_override(std::string_view text);
-
-// Reads, overrides, validates. Throws qdmr::Error("FILE: /pointer", "what is wrong [; did you mean 'x'?]").
+// Reads, overrides, validates, resolves OBJ meshes. Throws qdmr::Error("FILE: /pointer", "what is wrong [; did
+// you mean 'x'?]").
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides = {});
 
 // The same from an in-memory document; relative paths resolve against base_dir, messages name `name`.

@@ -1,9 +1,10 @@
 #pragma once
-// The shading program interface: one batch of lanes (whole 2x2 quads) in, colour and AOVs out.
+// The shading program interface inside a draw kernel: one batch of lanes (whole 2x2 quads) in, colour and
+// AOVs out. Compiled once per ISA (simd::Float is the kernel's batch type).
 #include "core/simd.hpp"
-#include "raster/geometry.hpp"
+#include "program/program.hpp"
 
-namespace qdmr {
+namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // Interpolated inputs of one batch. Every lane carries values, including helper lanes outside the triangle
 // (extrapolated, as on a GPU), so quad derivatives are defined; only `covered` lanes are written.
@@ -17,7 +18,7 @@ struct Fragments {
 struct ShadeOutput {
   simd::Float color[3];   // linear RGB
   simd::Float normal[3];  // world-space shading normal (for the "normal" AOV)
-  // Displacement AOVs (see Aov in qdmr/render/render.hpp); every program sets them.
+  // Displacement AOVs (see Aov in qdmr/core/aov.hpp); every program sets them.
   simd::Float iterations, hit_u, hit_v, hit_depth, error_texels, missed;
   // Programs that displace the surface may replace the polygon's depth (window depth, and distance along the
   // view axis for the depth AOV); the rasterizer then tests it again before writing (a late depth test).
@@ -25,16 +26,10 @@ struct ShadeOutput {
   simd::Float depth, view_depth;
 };
 
-class ShadingProgram {
+class ShadingProgram : public Program {
 public:
-  explicit ShadingProgram(int varying_count = kBaseVaryingCount) : varying_count_(varying_count) {}
-  virtual ~ShadingProgram() = default;
+  using Program::Program;
   virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
-  // The rasterizer interpolates varyings [0, varying_count()) only; the others are left unset.
-  int varying_count() const { return varying_count_; }
-
-private:
-  int varying_count_;
 };
 
-}  // namespace qdmr
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -12,7 +12,7 @@
 #include "core/det_math.hpp"
 #include "io/atomic_file.hpp"
 #include "qdmr/core/error.hpp"
-#include "qdmr/render/render.hpp"
+#include "qdmr/write/write.hpp"
 
 namespace qdmr {
 namespace {
@@ -80,8 +80,10 @@ void write_frame(const Frame& frame, const std::filesystem::path& file) {
   write_pixels(file, frame.width, frame.height, 3, frame.color, true);
 }
 
-void write_stats(const RenderStats& stats, const std::filesystem::path& file) {
-  write_text_file(file, stats.to_json().dump(2) + "\n");
+void write_stats(const RenderStats& stats, const std::filesystem::path& file) { write_json(stats.to_json(), file); }
+
+void write_json(const nlohmann::json& document, const std::filesystem::path& file) {
+  write_text_file(file, document.dump(2) + "\n");
 }
 
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {

@@ -1,4 +1,4 @@
-#include "qdmr/study/heightfield.hpp"
+#include "qdmr/texture/heightfield.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,24 @@
+#pragma once
+// The write stage: a frame's pixels, AOVs and statistics to files, each through a temporary file in the same
+// folder and a rename, so a failed or killed write leaves the previous file (or none), never a torn one.
+#include <filesystem>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "qdmr/core/aov.hpp"
+#include "qdmr/core/stats.hpp"
+#include "qdmr/render/render.hpp"
+
+namespace qdmr {
+
+// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear). Throws qdmr::Error.
+void write_frame(const Frame& frame, const std::filesystem::path& file);
+// Writes the stats as JSON.
+void write_stats(const RenderStats& stats, const std::filesystem::path& file);
+// Writes any JSON document (indented by 2), e.g. `qdmr bench --json`.
+void write_json(const nlohmann::json& document, const std::filesystem::path& file);
+// Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
+// fractional part, depth, iterations, hit depth and errors divided by their maximum).
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
+
+}  // namespace qdmr

@@ -1,0 +1,194 @@
+#include "draw/draw.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/trigonometric.hpp>
+#include <tbb/parallel_for.h>
+
+#include "raster/binner.hpp"
+#include "raster/geometry.hpp"
+
+namespace qdmr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+glm::mat4 model_matrix(const TransformDesc& t) {
+  glm::mat4 m = glm::translate(glm::mat4(1.0f), t.translate);
+  m = glm::rotate(m, glm::radians(t.rotate_deg.z), glm::vec3(0, 0, 1));
+  m = glm::rotate(m, glm::radians(t.rotate_deg.y), glm::vec3(0, 1, 0));
+  m = glm::rotate(m, glm::radians(t.rotate_deg.x), glm::vec3(1, 0, 0));
+  return glm::scale(m, t.scale);
+}
+
+// The error AOVs summarised over the pixels some triangle covers (depth below the clear value), in pixel order.
+void summarise_reference(const Framebuffer& fb, RenderStats& stats) {
+  const PixelBuffer& error = fb.aov[std::size_t(Aov::ErrorTexels)];
+  const PixelBuffer& missed = fb.aov[std::size_t(Aov::Missed)];
+  if (error.empty() && missed.empty()) return;
+  stats.reference = true;
+  double error_sum = 0.0, missed_sum = 0.0;
+  for (std::size_t i = 0; i < fb.depth.size(); ++i) {
+    if (!(fb.depth[i] < 1.0f)) continue;
+    ++stats.reference_pixels;
+    if (!error.empty()) {
+      error_sum += error[i];
+      stats.error_texels_max = std::max(stats.error_texels_max, double(error[i]));
+    }
+    if (!missed.empty()) missed_sum += missed[i];
+  }
+  if (stats.reference_pixels == 0) return;
+  stats.error_texels_mean = error_sum / double(stats.reference_pixels);
+  stats.missed_fraction = missed_sum / double(stats.reference_pixels);
+}
+
+void summarise_counters(const TileCounters& total, RenderStats& stats) {
+  stats.tile_bin_entries = total.bin_entries;
+  stats.blocks_rejected = total.blocks_rejected;
+  stats.blocks_full = total.blocks_full;
+  stats.blocks_partial = total.blocks_partial;
+  stats.batches = total.batches_shaded;
+  stats.quads = total.quads_shaded;
+  stats.pixels_shaded = total.pixels_shaded;
+  stats.pixels_depth_failed = total.pixels_depth_failed;
+  stats.iterations_mean = stats.iterations_p99 = stats.iterations_max = 0;
+  if (total.pixels_shaded > 0) {
+    stats.iterations_mean = double(total.iterations_useful) / double(total.pixels_shaded);
+    std::uint64_t seen = 0;
+    const std::uint64_t p99_rank = (total.pixels_shaded * 99 + 99) / 100;  // ceil(0.99 n)
+    bool p99_found = false;
+    for (std::size_t i = 0; i < total.iteration_histogram.size(); ++i) {
+      if (total.iteration_histogram[i] == 0) continue;
+      seen += total.iteration_histogram[i];
+      if (!p99_found && seen >= p99_rank) {
+        stats.iterations_p99 = double(i);
+        p99_found = true;
+      }
+      stats.iterations_max = double(i);
+    }
+  }
+  stats.lane_utilisation =
+      total.iterations_executed > 0 ? double(total.iterations_useful) / double(total.iterations_executed) : 1.0;
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel) {
+  const LightRig lights = LightRig::from_scene(plan.scene);
+  std::vector<std::unique_ptr<Program>> programs;
+  for (const MaterialPlan& m : plan.materials) {
+    const auto texture = [&](int i) { return i >= 0 ? assets.textures[std::size_t(i)].get() : nullptr; };
+    const auto derived = [&](int i) -> const DerivedAsset* { return i >= 0 ? &assets.derived[std::size_t(i)] : nullptr; };
+    DisplacementInputs inputs;
+    for (const LayerPlan& l : m.layers) {
+      const DerivedAsset* ao = derived(l.ao);
+      inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max),
+                               ao ? ao->texture.get() : nullptr});
+    }
+    if (const DerivedAsset* w = derived(m.weights); w && m.weight_mode == WeightMode::Pixel) inputs.weights = w->texture.get();
+    if (const DerivedAsset* c = derived(m.combined_quadtree)) {
+      inputs.combined = c->texture.get();
+      inputs.combined_period = assets.derived[std::size_t(m.combined_surface)].field->width;
+    }
+    if (const DerivedAsset* a = derived(m.blend_ao)) {
+      inputs.blend_ao = a->texture.get();
+      inputs.blend_ao_scale = m.weights_scale;
+    }
+    if (const DerivedAsset* c = derived(m.cones)) inputs.cones = c->cones.get();
+    if (const DerivedAsset* b = derived(m.bilinear_bound)) {
+      // QDM then walks the bound's quadtree and solves the fp64 bilinear patches exactly.
+      inputs.layers[0].height_max = b->texture.get();
+      inputs.surface = assets.derived[std::size_t(m.layers[0].field)].field.get();
+    }
+    if (m.reference) {
+      if (m.blend) {
+        inputs.reference = assets.derived[std::size_t(m.combined_surface)].field.get();
+        inputs.reference_scale = m.weights_scale;
+      } else {
+        inputs.reference = assets.derived[std::size_t(m.layers[0].field)].field.get();
+      }
+    }
+    programs.push_back(kernel.make_program(m.desc, inputs, lights));
+  }
+  return programs;
+}
+
+void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
+          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, const DrawOptions& options,
+          RenderStats& stats) {
+  const SceneDesc& scene = plan.scene;
+  auto start = Clock::now();
+  const Viewport viewport{plan.width, plan.height};
+  std::vector<DrawItem> items(plan.meshes.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    items[i].mesh = assets.meshes[i].get();
+    items[i].material = plan.meshes[i].material;
+    items[i].mesh_materials = plan.meshes[i].mtl_materials;
+    items[i].model = model_matrix(scene.objects[i].transform);
+  }
+  const glm::mat4 view = LightRig::view_matrix(scene.camera);
+  const glm::mat4 projection = LightRig::projection_matrix(scene.camera, scene.output);
+  const GeometryResult geometry = run_geometry(items, view, projection, viewport);
+  stats.geometry_ms = ms_since(start);
+  stats.triangles_in = geometry.counters.triangles_in;
+  stats.triangles_culled = geometry.counters.culled_backface + geometry.counters.culled_outside;
+  stats.triangles_clipped = geometry.counters.clipped;
+  stats.triangles_rasterized = geometry.counters.triangles_out;
+
+  start = Clock::now();
+  TriangleSetups setups(geometry.triangles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
+  });
+  const TileGrid grid(viewport.width, viewport.height, options.tile_size);
+  const TileBins bins = bin_triangles(setups, grid);
+  stats.binning_ms = ms_since(start);
+  stats.tiles = std::uint64_t(grid.count());
+  stats.tile_size = options.tile_size;
+
+  start = Clock::now();
+  fb.resize(plan.width, plan.height, plan.aovs);
+  fb.background = scene.output.background;
+  stats.framebuffer_bytes = fb.bytes();
+  RasterContext context;
+  context.geometry = &geometry;
+  context.setups = &setups;
+  context.framebuffer = &fb;
+  for (const auto& program : programs) context.programs.push_back(program.get());
+  std::vector<TileCounters> tile_counters(std::size_t(grid.count()));
+  std::atomic<int> tiles_done{0};
+  std::mutex progress_mutex;
+  const int report_every = std::max(1, grid.count() / 100);
+  tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
+    for (int tile = range.begin(); tile != range.end(); ++tile) {
+      kernel.raster_tile(context, tile, grid.rect(tile), bins, tile_counters[std::size_t(tile)]);
+      const int done = ++tiles_done;
+      if (options.progress && done % report_every == 0) {
+        std::lock_guard lock(progress_mutex);
+        options.progress(double(done) / grid.count());
+      }
+    }
+  });
+  TileCounters total;
+  for (const TileCounters& c : tile_counters) total += c;  // in tile order
+  stats.raster_shade_ms = ms_since(start);
+  summarise_counters(total, stats);
+  stats.reference = false;
+  stats.reference_pixels = 0;
+  stats.error_texels_mean = stats.error_texels_max = stats.missed_fraction = 0;
+  summarise_reference(fb, stats);
+  stats.simd_lanes = kernel.lanes();
+  stats.simd_arch = isa_name(kernel.isa());
+  stats.materials.clear();
+  for (std::size_t i = 0; i < programs.size(); ++i) stats.materials.push_back({plan.materials[i].name, programs[i]->variant()});
+}
+
+}  // namespace qdmr

@@ -1,0 +1,31 @@
+#pragma once
+// The draw stage: a prepared frame into a framebuffer — geometry, triangle setup, binning, then the tiles in
+// parallel through the chosen kernel's rasterizer and programs. Reads the plan and the assets, writes only the
+// framebuffer and the stats.
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "draw/kernel.hpp"
+#include "prepare/assets.hpp"
+#include "qdmr/core/stats.hpp"
+#include "raster/framebuffer.hpp"
+
+namespace qdmr {
+
+struct DrawOptions {
+  int tile_size = 64;  // pixels, a multiple of 8
+  // Called with the fraction of tiles done, from any worker thread, never concurrently with itself. Optional.
+  std::function<void(double fraction)> progress;
+};
+
+// One program per plan material, made by `kernel` from the prepared assets.
+std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel);
+
+// Draws into `fb` (sized and its background set here; its memory is kept when large enough) and fills the draw
+// part of `stats` (timings, counters, the reference summary). Runs in the caller's task arena.
+void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
+          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, const DrawOptions& options,
+          RenderStats& stats);
+
+}  // namespace qdmr

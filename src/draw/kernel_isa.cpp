@@ -1,0 +1,40 @@
+// The draw kernel of one ISA. This file (with raster/tile_raster.cpp, shade/ and texture/sampler.cpp) is compiled
+// once per ISA with that ISA's flags; QDMR_ISA names its namespace and QDMR_ISA_ENUM its Isa value.
+#include "draw/kernel.hpp"
+#include "program/variant.hpp"
+#include "raster/tile_raster.hpp"
+#include "shade/displacement.hpp"
+#include "shade/normal_mapping.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+namespace {
+
+class IsaKernel final : public Kernel {
+public:
+  Isa isa() const override { return Isa::QDMR_ISA_ENUM; }
+  int lanes() const override { return simd::kLanes; }
+
+  std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
+                                        const LightRig& lights) const override {
+    if (material.technique.kind == TechniqueKind::Normal && inputs.layers.size() == 1) {
+      const LayerInputs& l = inputs.layers[0];
+      return std::make_unique<NormalMappingProgram>(program_variant(material), *l.albedo, *l.normal, material.sampling, material.lighting,
+                                                    material.layers[0].specular, lights);
+    }
+    return std::make_unique<DisplacementProgram>(inputs, material, lights);
+  }
+
+  void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
+                   TileCounters& counters) const override {
+    qdmr::QDMR_ISA::raster_tile(context, tile_index, tile, bins, counters);
+  }
+};
+
+}  // namespace
+
+const Kernel& kernel() {
+  static const IsaKernel instance;
+  return instance;
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,0 +1,262 @@
+#include "prepare/assets.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <map>
+#include <mutex>
+
+#include "qdmr/bake/ao_map.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/texture/height_texture.hpp"
+#include "texture/blend_weights.hpp"
+
+namespace qdmr {
+namespace {
+
+// Builds one requested texture. Heights (and the heights behind from_height normals) go through the storage
+// the scene asks for — quantisation, BC3 — so what is rendered is what a GPU would sample.
+Texture build_texture(const TextureRequest& request, TextureStat& stat) {
+  const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight;
+  Texture texture;
+  Image height;
+  if (needs_height) {
+    // Behind a from_height normal map only level 0 is used: any reduction will do.
+    const MipReduce reduce = request.purpose == TexturePurpose::Height ? request.reduce : MipReduce::Box;
+    HeightTexture stored = make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce);
+    stat.height_format = format_name(stored.texture.format);
+    if (stored.bc3) {
+      stat.bc3 = true;
+      stat.bc3_max_error = stored.bc3->max_error;
+      stat.bc3_rms_error = stored.bc3->rms_error;
+    }
+    if (request.purpose == TexturePurpose::Height)
+      texture = std::move(stored.texture);
+    else
+      height = stored.texture.level_image(0);
+  }
+  if (request.purpose != TexturePurpose::Height) {
+    Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
+    if (request.purpose == TexturePurpose::Normal)
+      for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
+    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+  }
+  stat.where = request.where;
+  stat.purpose = purpose_name(request.purpose);
+  stat.format = format_name(texture.format) + (texture.srgb ? " srgb" : "");
+  stat.width = texture.width();
+  stat.height = texture.height();
+  stat.levels = texture.level_count();
+  stat.bytes = texture.bytes();
+  return texture;
+}
+
+// Level 0 of a stored height texture in fp64, for the exact reference and the bakes.
+HeightField height_field(const Texture& h, AddressMode address) {
+  HeightField field;
+  field.width = h.width();
+  field.height = h.height();
+  field.address = address;
+  field.h.resize(std::size_t(h.width()) * std::size_t(h.height()));
+  for (int y = 0; y < h.height(); ++y)
+    for (int x = 0; x < h.width(); ++x) field.h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
+  return field;
+}
+
+// Items of the previous assets by key, to share instead of rebuild.
+struct Previous {
+  std::map<std::string, std::shared_ptr<const MeshData>> meshes;
+  std::map<std::string, std::pair<std::shared_ptr<const Texture>, TextureStat>> textures;
+  std::map<std::string, DerivedAsset> derived;
+
+  Previous(const Assets* assets, const FramePlan* plan) {
+    if (!assets || !plan) return;
+    for (std::size_t i = 0; i < plan->meshes.size() && i < assets->meshes.size(); ++i)
+      meshes.emplace(plan->meshes[i].key, assets->meshes[i]);
+    for (std::size_t i = 0; i < plan->textures.size() && i < assets->textures.size(); ++i)
+      textures.emplace(plan->textures[i].key, std::make_pair(assets->textures[i], assets->texture_stats[i]));
+    for (std::size_t i = 0; i < plan->derived.size() && i < assets->derived.size(); ++i)
+      derived.emplace(plan->derived[i].key, assets->derived[i]);
+  }
+};
+
+class Preparer {
+public:
+  Preparer(const FramePlan& plan, const Previous& previous, Assets& assets)
+      : plan_(plan), previous_(previous), assets_(assets), file_(plan.scene.file.string()) {}
+
+  void run() {
+    const std::vector<std::string> items = plan_.items();
+    weight_maps();
+    meshes();
+    textures();
+    assets_.derived.resize(plan_.derived.size());
+    for (std::size_t i = 0; i < plan_.derived.size(); ++i) derived(i);
+    // Built and reused lines in plan order, whatever order the parallel builds finished in.
+    for (const std::string& item : items)
+      (std::find(built_.begin(), built_.end(), item) != built_.end() ? assets_.built : assets_.reused).push_back(item);
+    if (assets_.built.size() != built_.size()) throw Error("prepare", "built an item the plan does not list");
+  }
+
+private:
+  void record(const std::string& item) {
+    std::lock_guard lock(mutex_);
+    built_.push_back(item);
+  }
+
+  // The weight maps of blended materials whose meshes or weight textures are built (not reused), made once.
+  void weight_maps() {
+    std::vector<bool> needed(plan_.materials.size(), false);
+    for (const MeshPlan& mp : plan_.meshes)
+      if (mp.vertex_weights >= 0 && !previous_.meshes.count(mp.key)) needed[std::size_t(mp.vertex_weights)] = true;
+    for (const DerivedPlan& d : plan_.derived)
+      if (d.kind == DerivedKind::WeightTexture && !previous_.derived.count(d.key)) needed[std::size_t(d.material)] = true;
+    for (std::size_t i = 0; i < needed.size(); ++i) {
+      if (!needed[i]) continue;
+      const MaterialPlan& m = plan_.materials[i];
+      weight_maps_.emplace(i, make_weight_map(m.desc.blend.weights, int(m.layers.size()),
+                                              file_ + ": /materials/" + m.name + "/blend/weights"));
+    }
+  }
+  const Image& weight_map(std::size_t material) const { return weight_maps_.at(material); }
+
+  void meshes() {
+    const std::size_t n = plan_.meshes.size();
+    assets_.meshes.resize(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+      const MeshPlan& mp = plan_.meshes[i];
+      if (auto it = previous_.meshes.find(mp.key); it != previous_.meshes.end()) {
+        assets_.meshes[i] = it->second;
+        return;
+      }
+      const ObjectDesc& object = plan_.scene.objects[i];
+      std::shared_ptr<const MeshData> mesh =
+          object.obj_mesh ? object.obj_mesh
+                          : std::make_shared<const MeshData>(
+                                build_mesh(object.mesh, file_ + ": /objects/" + std::to_string(i) + "/mesh"));
+      if (mp.vertex_weights >= 0) {
+        const MaterialPlan& m = plan_.materials[std::size_t(mp.vertex_weights)];
+        auto weighted = std::make_shared<MeshData>(*mesh);
+        weighted->blend_weights = vertex_weights(weight_map(std::size_t(mp.vertex_weights)), weighted->uvs,
+                                                 m.desc.blend.weights.scale);
+        mesh = std::move(weighted);
+      }
+      assets_.meshes[i] = std::move(mesh);
+      record("mesh " + mp.key);
+    });
+  }
+
+  void textures() {
+    const std::size_t n = plan_.textures.size();
+    assets_.textures.resize(n);
+    assets_.texture_stats.resize(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+      const TextureRequest& request = plan_.textures[i];
+      if (auto it = previous_.textures.find(request.key); it != previous_.textures.end()) {
+        assets_.textures[i] = it->second.first;
+        assets_.texture_stats[i] = it->second.second;
+        return;
+      }
+      assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
+      record("texture " + request.key);
+    });
+  }
+
+  void derived(std::size_t index) {
+    const DerivedPlan& d = plan_.derived[index];
+    DerivedAsset& out = assets_.derived[index];
+    if (auto it = previous_.derived.find(d.key); it != previous_.derived.end()) {
+      out = it->second;
+      return;
+    }
+    const MaterialPlan& m = plan_.materials[std::size_t(d.material)];
+    const MaterialDesc& desc = m.desc;
+    const auto input = [&](std::size_t k) -> const DerivedAsset& { return assets_.derived[std::size_t(d.inputs.at(k))]; };
+    const auto mip = [](Image image, TexelFormat format, MipReduce reduce) {
+      return std::make_shared<const Texture>(make_mip_texture(image, format, false, reduce));
+    };
+    switch (d.kind) {
+      case DerivedKind::WeightTexture: {
+        const WeightsDesc& w = desc.blend.weights;
+        const Image& map = weight_map(std::size_t(d.material));
+        Image level0 = resample_weight_map(map, w.resolution);
+        if (w.from_vertices)
+          for (std::size_t o : m.objects) {
+            const MeshData& mesh = *assets_.meshes[o];
+            rasterize_vertex_weights(mesh.uvs, mesh.indices, vertex_weights(map, mesh.uvs, w.scale), w.scale, level0);
+          }
+        out.texture = std::make_shared<const Texture>(make_weight_texture(level0));
+        break;
+      }
+      case DerivedKind::CombinedSurface: {
+        // The blended box surface with per-pixel weights over the repeats the weights span, made once for the
+        // combined quadtree, the exact reference (per-vertex errors then show the floating) and the baked AO.
+        std::vector<const Texture*> heights;
+        for (const LayerPlan& l : m.layers) heights.push_back(assets_.textures[std::size_t(l.height)].get());
+        out.field = std::make_shared<const HeightField>(
+            combined_surface(heights, *input(0).texture, m.weights_scale, desc.blend.op));
+        break;
+      }
+      case DerivedKind::CombinedQuadtree:
+        out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field));
+        break;
+      case DerivedKind::BlendAoMap: {
+        AoDesc ao = desc.ao;
+        ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats
+        ao.resolution = d.side;
+        out.texture = mip(load_or_bake_ao_map(*input(0).field, desc.technique.depth_scale, ao, default_cache_dir()),
+                          TexelFormat::R16, MipReduce::Box);
+        break;
+      }
+      case DerivedKind::HeightField:
+        out.field = std::make_shared<const HeightField>(
+            height_field(*assets_.textures[std::size_t(d.texture)], desc.sampling.address));
+        break;
+      case DerivedKind::LayerAoMap:
+        // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
+        out.texture = mip(load_or_bake_ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, default_cache_dir()),
+                          TexelFormat::R16, MipReduce::Box);
+        break;
+      case DerivedKind::ConeMap:
+        out.cones = std::make_shared<const ConeMap>(load_or_bake_cone_map(*input(0).field, m.cone_kind, default_cache_dir()));
+        break;
+      case DerivedKind::BilinearBound:
+        // QDM walks a quadtree of the 3x3 maxima, conservative for the bilinear surface it then solves exactly.
+        out.texture = mip(bilinear_upper_bound(*input(0).field), TexelFormat::R32F, MipReduce::Max);
+        break;
+    }
+    record(d.key);
+  }
+
+  const FramePlan& plan_;
+  const Previous& previous_;
+  Assets& assets_;
+  std::string file_;
+  std::mutex mutex_;
+  std::map<std::size_t, Image> weight_maps_;
+  std::vector<std::string> built_;
+};
+
+}  // namespace
+
+std::uint64_t Assets::texture_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const auto& t : textures) bytes += t->bytes();
+  return bytes;
+}
+
+std::uint64_t Assets::mesh_bytes() const {
+  std::uint64_t bytes = 0;
+  for (const auto& m : meshes)
+    bytes += m->vertex_count() * (sizeof(glm::vec3) * 2 + sizeof(glm::vec4) + sizeof(glm::vec2)) +
+             (m->indices.size() + m->triangle_materials.size()) * sizeof(std::uint32_t);
+  return bytes;
+}
+
+Assets prepare(const FramePlan& plan, const Assets* previous, const FramePlan* previous_plan) {
+  Assets assets;
+  const Previous reuse(previous, previous_plan);
+  Preparer(plan, reuse, assets).run();
+  return assets;
+}
+
+}  // namespace qdmr

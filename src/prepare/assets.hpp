@@ -1,0 +1,44 @@
+#pragma once
+// The prepare stage: Assets = everything a FramePlan lists, built — meshes, textures with their mip chains and
+// the derived data (weight textures, combined surfaces and quadtrees, fp64 height fields, AO and cone maps).
+// Read-only while drawing; shared (by content key) with the assets of the next plan, so a re-plan that keeps
+// an item's key keeps the item.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qdmr/bake/cone_map.hpp"
+#include "qdmr/mesh/mesh.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "qdmr/core/stats.hpp"
+#include "qdmr/texture/heightfield.hpp"
+#include "qdmr/texture/mip_texture.hpp"
+
+namespace qdmr {
+
+// One derived item: the member its kind makes (weight textures, quadtrees, AO maps and bilinear bounds are
+// textures; combined surfaces and height fields are fields; cone maps are cones).
+struct DerivedAsset {
+  std::shared_ptr<const Texture> texture;
+  std::shared_ptr<const HeightField> field;
+  std::shared_ptr<const ConeMap> cones;
+};
+
+struct Assets {
+  std::vector<std::shared_ptr<const MeshData>> meshes;  // parallel to FramePlan::meshes
+  std::vector<std::shared_ptr<const Texture>> textures; // parallel to FramePlan::textures
+  std::vector<TextureStat> texture_stats;               // parallel to FramePlan::textures
+  std::vector<DerivedAsset> derived;                    // parallel to FramePlan::derived
+  // FramePlan::items() lines: what this prepare built, and what it took from the previous assets.
+  std::vector<std::string> built, reused;
+
+  std::uint64_t texture_bytes() const;
+  std::uint64_t mesh_bytes() const;
+};
+
+// Builds what the plan lists, in parallel (in the caller's task arena); items whose key is in `previous` are
+// shared instead of rebuilt. Cone and AO maps go through the bake cache in default_cache_dir(). Throws
+// qdmr::Error on bad input.
+Assets prepare(const FramePlan& plan, const Assets* previous = nullptr, const FramePlan* previous_plan = nullptr);
+
+}  // namespace qdmr

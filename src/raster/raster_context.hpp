@@ -1,0 +1,40 @@
+#pragma once
+// What a draw kernel's tile rasterizer reads and writes, and the counters it keeps per tile. ISA-independent:
+// the draw stage fills it, any kernel consumes it.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "program/program.hpp"
+#include "raster/binner.hpp"
+#include "raster/framebuffer.hpp"
+#include "raster/geometry.hpp"
+
+namespace qdmr {
+
+struct TileCounters {
+  std::uint64_t bin_entries = 0;       // triangles visited by this tile
+  std::uint64_t blocks_rejected = 0;   // 8x8 blocks skipped by the coarse test
+  std::uint64_t blocks_full = 0;       // 8x8 blocks entirely inside a triangle (no per-pixel edge test)
+  std::uint64_t blocks_partial = 0;
+  std::uint64_t batches_shaded = 0;    // program invocations
+  std::uint64_t quads_shaded = 0;      // 2x2 quads with at least one written pixel
+  std::uint64_t pixels_shaded = 0;     // lanes written (covered and passed the depth test)
+  std::uint64_t pixels_depth_failed = 0;
+  // Intersection loop iterations of the written pixels: histogram (last bin: that many or more), and lane
+  // use: useful = sum of the lanes' own iterations, executed = the batch's longest lane times the lane count.
+  static constexpr int kIterationBins = 1024;
+  std::array<std::uint64_t, kIterationBins + 1> iteration_histogram{};
+  std::uint64_t iterations_useful = 0, iterations_executed = 0;
+
+  TileCounters& operator+=(const TileCounters& o);
+};
+
+struct RasterContext {
+  const GeometryResult* geometry = nullptr;
+  const TriangleSetups* setups = nullptr;
+  std::vector<const Program*> programs;  // indexed by TriangleSetup::material; made by the kernel that rasterizes
+  Framebuffer* framebuffer = nullptr;
+};
+
+}  // namespace qdmr

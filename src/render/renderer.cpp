@@ -1,0 +1,158 @@
+#include <sys/resource.h>
+
+#include <chrono>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
+#include "draw/draw.hpp"
+#include "prepare/assets.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "qdmr/render/render.hpp"
+#include "raster/framebuffer.hpp"
+
+namespace qdmr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::uint64_t peak_rss_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux reports KiB
+}
+
+int thread_count(const RenderOptions& options) {
+  return options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+}  // namespace
+
+void validate_options(const RenderOptions& options) {
+  if (options.threads < 0 || options.threads > limits::kMaxThreads)
+    throw Error("--threads", "must be between 1 and " + std::to_string(limits::kMaxThreads) + " (or 0 for every core), got " +
+                                 std::to_string(options.threads));
+  if (options.tile_size < limits::kMinTileSize || options.tile_size > limits::kMaxTileSize ||
+      options.tile_size % limits::kCoarseBlockSize != 0)
+    throw Error("--tile", "must be a multiple of 8 between " + std::to_string(limits::kMinTileSize) + " and " +
+                              std::to_string(limits::kMaxTileSize) + ", got " + std::to_string(options.tile_size));
+  resolve_isa(options.isa);
+}
+
+struct Renderer::State {
+  RenderOptions options;
+  int threads;
+  const Kernel* kernel;
+  // Lets an arena larger than the core count run without oneTBB's warning.
+  tbb::global_control parallelism;
+  tbb::task_arena arena;
+  std::optional<FramePlan> plan;
+  Assets assets;
+  std::vector<std::unique_ptr<Program>> programs;
+  Framebuffer fb;
+  Frame frame;
+  double pending_plan_ms = 0, pending_prepare_ms = 0;
+  std::uint64_t pending_built = 0, pending_reused = 0;
+
+  explicit State(const RenderOptions& o)
+      : options(o), threads(thread_count(o)), kernel(&kernel_for(resolve_isa(o.isa))),
+        parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads)), arena(threads) {}
+};
+
+Renderer::Renderer(const RenderOptions& options) {
+  validate_options(options);
+  state_ = std::make_unique<State>(options);
+}
+
+Renderer::~Renderer() = default;
+
+std::vector<Aov> Renderer::options_aovs() const { return state_->options.aovs; }
+Isa Renderer::isa() const { return state_->kernel->isa(); }
+int Renderer::threads() const { return state_->threads; }
+
+const FramePlan& Renderer::plan() const {
+  if (!state_->plan) throw Error("renderer", "no scene set");
+  return *state_->plan;
+}
+
+void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
+  State& s = *state_;
+  auto start = Clock::now();
+  FramePlan plan = plan_frame(scene, PlanOptions{aovs});
+  s.pending_plan_ms = ms_since(start);
+  start = Clock::now();
+  if (s.options.progress) s.options.progress("prepare", 0.0);
+  s.arena.execute([&] {
+    Assets assets = prepare(plan, &s.assets, s.plan ? &*s.plan : nullptr);
+    // Programs point into the new assets: make them before the old assets go.
+    std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel);
+    s.programs = std::move(programs);
+    s.assets = std::move(assets);
+  });
+  s.plan = std::move(plan);
+  if (s.options.progress) s.options.progress("prepare", 1.0);
+  s.pending_prepare_ms = ms_since(start);
+  s.pending_built = s.assets.built.size();
+  s.pending_reused = s.assets.reused.size();
+}
+
+const Frame& Renderer::draw() {
+  State& s = *state_;
+  const FramePlan& plan = this->plan();
+  Frame& frame = s.frame;
+  // The frame's buffers are the framebuffer's planes, lent to it between draws (no copy, no new pages).
+  s.fb.color.swap(frame.color);
+  for (AovImage& a : frame.aovs) s.fb.aov[std::size_t(a.aov)].swap(a.pixels);
+  frame.aovs.clear();
+
+  RenderStats& stats = frame.stats;
+  stats = RenderStats{};
+  stats.plan_ms = std::exchange(s.pending_plan_ms, 0.0);
+  stats.prepare_ms = std::exchange(s.pending_prepare_ms, 0.0);
+  stats.items_built = std::exchange(s.pending_built, 0);
+  stats.items_reused = std::exchange(s.pending_reused, 0);
+  stats.threads = s.threads;
+  stats.texture_bytes = s.assets.texture_bytes();
+  stats.textures = s.assets.texture_stats;
+  stats.mesh_bytes = s.assets.mesh_bytes();
+  DrawOptions options;
+  options.tile_size = s.options.tile_size;
+  if (s.options.progress) {
+    const auto& report = s.options.progress;
+    options.progress = [&report](double fraction) { report("raster", fraction); };
+  }
+  s.arena.execute([&] { qdmr::draw(plan, s.assets, *s.kernel, s.programs, s.fb, options, stats); });
+  if (s.options.progress) s.options.progress("raster", 1.0);
+
+  frame.width = s.fb.width;
+  frame.height = s.fb.height;
+  s.fb.color.swap(frame.color);
+  for (Aov aov : plan.aovs) {
+    frame.aovs.push_back({aov, aov_channels(aov), {}});
+    frame.aovs.back().pixels.swap(s.fb.aov[std::size_t(aov)]);
+  }
+  stats.peak_rss_bytes = peak_rss_bytes();
+  return frame;
+}
+
+const Frame& Renderer::frame() const { return state_->frame; }
+
+Frame Renderer::take_frame() { return std::move(state_->frame); }
+
+Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
+  Renderer renderer(options);
+  renderer.set_scene(scene, options.aovs);
+  renderer.draw();
+  return renderer.take_frame();
+}
+
+}  // namespace qdmr

@@ -1,0 +1,101 @@
+// The plan drives the frame: for every shipped scene, prepare() builds exactly the items the plan lists (and
+// `qdmr plan` prints), in the plan's order; a second prepare with the first as `previous` builds nothing; a change
+// that touches no asset (the camera) re-uses everything and one that does rebuilds only what depends on it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "cli/cli_test_util.hpp"
+#include "prepare/assets.hpp"
+#include "qdmr/load/load.hpp"
+#include "qdmr/plan/plan.hpp"
+
+namespace qdmr::test {
+namespace {
+
+// The scene as the shipped file says, data paths relocated like the CLI tests do.
+SceneDesc load_shipped(const ShippedScene& scene, std::vector<SceneOverride> overrides = {}) {
+  const std::vector<std::string> args = scene_args(scene);
+  for (std::size_t i = 1; i + 1 < args.size(); i += 2) overrides.push_back(parse_override(args[i + 1]));
+  overrides.push_back({"/output/width", "64"});
+  overrides.push_back({"/output/height", "36"});
+  return load_scene(args[0], overrides);
+}
+
+class PreparePlan : public testing::TestWithParam<ShippedScene> {};
+
+TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
+  const ShippedScene& shipped = GetParam();
+  if (shipped.needs_data && !have_data()) GTEST_SKIP() << shipped.name << " needs QDMR_DATA_DIR=" << data_dir();
+  const SceneDesc scene = load_shipped(shipped);
+  // With the error AOVs the displacement materials also need their exact references (height fields, combined
+  // surfaces): both plans must hold.
+  for (const std::vector<Aov>& aovs : {std::vector<Aov>{}, std::vector<Aov>{Aov::ErrorTexels}}) {
+    const FramePlan plan = plan_frame(scene, PlanOptions{aovs});
+    const std::vector<std::string> items = plan.items();
+    EXPECT_EQ(std::set<std::string>(items.begin(), items.end()).size(), items.size()) << "an item is listed twice";
+    const Assets assets = prepare(plan);
+    EXPECT_EQ(assets.built, items) << shipped.name;
+    EXPECT_TRUE(assets.reused.empty());
+    ASSERT_EQ(assets.meshes.size(), plan.meshes.size());
+    ASSERT_EQ(assets.textures.size(), plan.textures.size());
+    ASSERT_EQ(assets.derived.size(), plan.derived.size());
+    for (std::size_t i = 0; i < plan.derived.size(); ++i) {
+      const DerivedAsset& d = assets.derived[i];
+      EXPECT_TRUE(d.texture || d.field || d.cones) << plan.derived[i].key << " was not built";
+    }
+    // Prepared again with the first assets as the previous ones: nothing is built, everything shared.
+    const Assets again = prepare(plan, &assets, &plan);
+    EXPECT_TRUE(again.built.empty());
+    EXPECT_EQ(again.reused, items);
+    for (std::size_t i = 0; i < assets.textures.size(); ++i) EXPECT_EQ(again.textures[i], assets.textures[i]);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(, PreparePlan, testing::ValuesIn(shipped_scenes()), scene_name);
+
+TEST(PrepareReuse, ObjMaterialsAreKnownAfterLoad) {
+  const SceneDesc scene = load_shipped({"objects", false});
+  const FramePlan plan = plan_frame(scene);
+  // The torus knot has no material of its own: its MTL material joins the plan, named after the object.
+  const auto knot = std::find_if(plan.materials.begin(), plan.materials.end(),
+                                 [](const MaterialPlan& m) { return m.name == "knot/knot"; });
+  ASSERT_NE(knot, plan.materials.end()) << plan.describe();
+  EXPECT_NE(knot->where.find("torus_knot.obj"), std::string::npos) << knot->where;
+  EXPECT_GE(knot->layers.at(0).albedo, 0);
+  const MeshPlan& mesh = plan.meshes.at(3);
+  EXPECT_EQ(mesh.object, "knot");
+  EXPECT_GT(mesh.triangles, 0u);  // counted from the mesh read at load, not estimated
+  EXPECT_EQ(plan.materials.at(mesh.mtl_materials.at(0)).name, "knot/knot");
+}
+
+TEST(PrepareReuse, ACameraChangeRebuildsNothingADepthScaleChangeOnlyItsDerivedData) {
+  const ShippedScene csm{"pom_vs_qdm_depth_1.0", false};
+  const SceneDesc base = load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}});
+  const FramePlan plan = plan_frame(base);
+  const Assets assets = prepare(plan);
+
+  const SceneDesc moved = load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/camera/fov_deg", "20"}});
+  const FramePlan moved_plan = plan_frame(moved);
+  EXPECT_EQ(moved_plan.items(), plan.items());
+  EXPECT_TRUE(prepare(moved_plan, &assets, &plan).built.empty());
+
+  // The cone map is baked from the heights alone: a new depth scale keeps it; new heights rebuild it.
+  const SceneDesc deeper =
+      load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/materials/surface/technique/depth_scale", "0.2"}});
+  const FramePlan deeper_plan = plan_frame(deeper);
+  EXPECT_TRUE(prepare(deeper_plan, &assets, &plan).built.empty());
+  const SceneDesc other = load_shipped(
+      csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/materials/surface/layers/0/height/seed", "77"}});
+  const FramePlan other_plan = plan_frame(other);
+  const Assets rebuilt = prepare(other_plan, &assets, &plan);
+  ASSERT_FALSE(rebuilt.built.empty());
+  for (const std::string& item : rebuilt.built)
+    EXPECT_TRUE(item.find("texture height") == 0 || item.find("texture normal") == 0 || item.find("texture albedo") == 0 ||
+                item.find("height_field") == 0 || item.find("cone_map") == 0)
+        << item;
+}
+
+}  // namespace
+}  // namespace qdmr::test
