@@ -7,7 +7,7 @@
 #
 # CASE: plane terrain objects real_rocks grid1m (default: all; real_rocks only when ../shared/data exists).
 # grid1m is scenes/plane.json with its plane replaced by a 710x710 grid: 1,008,200 small triangles.
-# --sse also runs BUILD_DIR/qdmr-sse; --llvmpipe also runs BUILD_DIR/bench/llvmpipe/llvmpipe_bench on
+# --sse also runs the SSE4.2 kernel of the same binary (qdmr --isa sse4.2, labelled qdmr-sse); --llvmpipe also runs BUILD_DIR/bench/llvmpipe/llvmpipe_bench on
 # plane and grid1m with LP_NUM_THREADS set to each thread count. For clean timings run it on an otherwise
 # idle machine (nothing compiling).
 set -eu
@@ -35,7 +35,7 @@ if [ $# -eq 0 ] && [ ! -d "$root/../shared/data" ]; then cases="plane terrain ob
 
 binaries="qdmr"
 if [ $sse -eq 1 ]; then binaries="qdmr qdmr-sse"; fi
-for b in $binaries; do [ -x "$build/$b" ] || { echo "run_scenes.sh: $build/$b is not built" >&2; exit 1; }; done
+[ -x "$build/qdmr" ] || { echo "run_scenes.sh: $build/qdmr is not built" >&2; exit 1; }
 lp="$build/bench/llvmpipe/llvmpipe_bench"
 if [ $llvmpipe -eq 1 ] && [ ! -x "$lp" ]; then echo "run_scenes.sh: $lp is not built" >&2; exit 1; fi
 
@@ -43,14 +43,16 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 grid='/objects/0/mesh={"type":"grid","size":[4,4],"resolution":710,"uv_scale":[2,2]}'
 
-render() {  # render CASE BINARY THREADS ROUND
+render() {  # render CASE BUILD THREADS ROUND (BUILD: qdmr = the best kernel, qdmr-sse = --isa sse4.2)
+  isa=auto
+  if [ "$2" = qdmr-sse ]; then isa=sse4.2; fi
   scene="$root/scenes/$1.json"
   if [ "$1" = grid1m ]; then scene="$root/scenes/plane.json"; fi
   set -- "$1" "$2" "$3" "$4" "$scene"
   if [ "$1" = grid1m ]; then
-    "$build/$2" render "$5" --set "$grid" -o "$out/image.png" --threads "$3" --stats "$out/$1__$2__t$3__r$4.json" >/dev/null
+    "$build/qdmr" render "$5" --set "$grid" -o "$out/image.png" --threads "$3" --isa "$isa" --stats "$out/$1__$2__t$3__r$4.json" >/dev/null
   else
-    "$build/$2" render "$5" -o "$out/image.png" --threads "$3" --stats "$out/$1__$2__t$3__r$4.json" >/dev/null
+    "$build/qdmr" render "$5" -o "$out/image.png" --threads "$3" --isa "$isa" --stats "$out/$1__$2__t$3__r$4.json" >/dev/null
   fi
 }
 
