@@ -49,14 +49,42 @@ const char* blend_name(BlendOperator op) {
   return "?";
 }
 
+const char* level_up_name(QdmLevelUp l) {
+  switch (l) {
+    case QdmLevelUp::Stay: return "stay";
+    case QdmLevelUp::One: return "one";
+    case QdmLevelUp::Aligned: return "aligned";
+  }
+  return "?";
+}
+
 }  // namespace
 
-std::string program_variant(const MaterialDesc& material) {
-  const TechniqueKind kind = material.technique.kind;
+TraceOptions trace_options(const MaterialDesc& material) {
+  TraceOptions o;
+  o.technique = material.technique.kind;
+  if (o.technique == TechniqueKind::Qdm) {
+    o.sm3_cells = material.sampling.math == MathMode::Sm3;
+    o.filtered_max = material.technique.height_fetch == HeightFetch::Trilinear;
+    o.level_up = material.technique.level_up;
+  }
+  return o;
+}
+
+std::string trace_variant_name(const TraceOptions& o) {
+  std::string name = technique_name(o.technique);
+  if (o.technique == TechniqueKind::Qdm)
+    name += std::string("<") + (o.sm3_cells ? "sm3_cells" : "int_cells") + "," +
+            (o.filtered_max ? "filtered_max" : "max_fetch") + ",level_up_" + level_up_name(o.level_up) + ">";
+  return name;
+}
+
+std::string program_variant(const MaterialDesc& material, const TraceOptions& trace) {
   const std::size_t layer_count = material.layers.size();
   const bool blend = layer_count > 1;
-  std::string variant = kind == TechniqueKind::Normal && !blend ? std::string("normal_mapping")
-                                                                : std::string("displacement:") + technique_name(kind);
+  std::string variant = trace.technique == TechniqueKind::Normal && !blend
+                            ? std::string("normal_mapping")
+                            : std::string("displacement:") + trace_variant_name(trace);
   if (blend)
     variant += std::string(" | blend ") + blend_name(material.blend.op) + " x" + std::to_string(layer_count) +
                (material.blend.weights.mode == WeightMode::Vertex ? " per vertex" : " per pixel");

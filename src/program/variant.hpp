@@ -1,13 +1,32 @@
 #pragma once
-// The name of a material's shading program variant: what `qdmr plan` lists and what the program made for the
-// material reports (RenderStats::materials) — one function, so the two cannot drift apart.
+// Program variants: the options a material fixes that a displacement program's inner loops would otherwise test
+// per iteration are template arguments of the program's trace (shade/displacement.cpp instantiates every
+// combination below, 17 per ISA). The plan derives the options from the material (trace_options) and names the
+// variant; the program reports the name of the instantiation it runs, from its template arguments. A test checks
+// that the two agree.
 #include <string>
 
 #include "qdmr/scene/scene.hpp"
 
 namespace qdmr {
 
-std::string program_variant(const MaterialDesc& material);
+struct TraceOptions {
+  TechniqueKind technique = TechniqueKind::Normal;
+  bool sm3_cells = false;     // qdm: cells found again from the fp32 position after a crossing (SM3 emulation)
+  bool filtered_max = false;  // qdm: LinearMipMapLinear over the max chain (height_fetch trilinear)
+  QdmLevelUp level_up = QdmLevelUp::One;  // qdm
+  bool operator==(const TraceOptions&) const = default;
+};
+
+// The options of a material, canonical: those its technique ignores are left at their defaults.
+TraceOptions trace_options(const MaterialDesc& material);
+// "relief", "pom", "csm", "rcsm", "normal", "qdm<int_cells,max_fetch,level_up_one>".
+std::string trace_variant_name(const TraceOptions& options);
+
+// The whole variant as `qdmr plan` and the stats name it: the trace variant and the options the program reads
+// per batch (blend, shadow, AO, lighting model, texture filter).
+std::string program_variant(const MaterialDesc& material, const TraceOptions& trace);
+inline std::string program_variant(const MaterialDesc& material) { return program_variant(material, trace_options(material)); }
 
 const char* technique_name(TechniqueKind kind);  // "normal", "relief", "pom", "csm", "rcsm", "qdm"
 const char* filter_name(Filter filter);          // "point", "bilinear", "trilinear", ...

@@ -58,11 +58,11 @@ Int address_texel(const Int& i, int n, AddressMode mode) {
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : ShadingProgram(program_variant(material), inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
+    : ShadingProgram(program_variant(material, select(trace_options(material)).options), inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
-      sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod), math_(material.sampling.math),
+      shade_(select(trace_options(material)).shade), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
+      sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
@@ -169,12 +169,11 @@ DisplacementProgram::Hit DisplacementProgram::pom(const Surface& surface, const 
 // the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
 // level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped
 // exactly across walls, or recomputed from the fp32 position (SM3 emulation).
-template <class Surface>
+template <class V, class Surface>
 DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const Ray& ray, const Float& ds,
                                                  const Float& stop_level, const Int& cap, Mask active) const {
   const int top = surface.top_level();
   const float width = float(surface.width()), height = float(surface.height());
-  const bool sm3 = math_ == MathMode::Sm3;
   const IntMask none = Int(0) != Int(0);
   const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
   const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
@@ -190,9 +189,11 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const 
 
     // The cell's highest point (wrap addressing: power-of-two level sizes), or LinearMipMapLinear at the ray's
     // position on this level, which smooths the maxima and so can miss features.
-    const Float hmax = technique_.height_fetch != HeightFetch::Trilinear
-                           ? surface.cell_max(level, cx, cy)
-                           : surface.cell_max_filtered(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level));
+    Float hmax;
+    if constexpr (V::filtered_max)
+      hmax = surface.cell_max_filtered(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level));
+    else
+      hmax = surface.cell_max(level, cx, cy);
     const Float top_depth = ds * (Float(1.0f) - hmax);
     const Mask below = active & (s >= top_depth);
     const IntMask at_stop = level <= stop;
@@ -217,7 +218,7 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const 
     const IntMask cross_i = int_mask(cross);
     const IntMask cross_x = cross_i & int_mask(tx <= ty);
     const IntMask cross_y = cross_i & int_mask(ty <= tx);
-    if (sm3) {
+    if constexpr (V::sm3_cells) {
       // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
       const Float nudge = Float(1.0f / 64.0f);
       const Float px = x0 + dx * s + xsimd::select(dx > Float(0.0f), nudge, Float(0.0f) - nudge);
@@ -231,25 +232,22 @@ DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const 
     // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
     // while the wall just crossed is also a wall of the parent.
     IntMask up = cross_i & (level < Int(top));
-    switch (technique_.level_up) {
-      case QdmLevelUp::Stay: up = none; break;
-      case QdmLevelUp::One: break;
-      case QdmLevelUp::Aligned: {
-        // Entering a cell through its low wall (+ direction) that wall is the parent's iff the index is even;
-        // through its high wall (- direction) iff the index is odd.
-        IntMask climbing = up;
-        for (int k = 0; k < top && xsimd::any(climbing); ++k) {
-          const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
-          const IntMask aligned_x = step_x_pos ^ odd_x, aligned_y = step_y_pos ^ odd_y;
-          const IntMask ok = climbing & ((!cross_x) | aligned_x) & ((!cross_y) | aligned_y);
-          level = xsimd::select(ok, level + Int(1), level);
-          cx = xsimd::select(ok, cx >> 1, cx);
-          cy = xsimd::select(ok, cy >> 1, cy);
-          climbing = ok & (level < Int(top));
-        }
-        up = none;
-        break;
+    if constexpr (V::level_up == QdmLevelUp::Stay) {
+      up = none;
+    } else if constexpr (V::level_up == QdmLevelUp::Aligned) {
+      // Entering a cell through its low wall (+ direction) that wall is the parent's iff the index is even;
+      // through its high wall (- direction) iff the index is odd.
+      IntMask climbing = up;
+      for (int k = 0; k < top && xsimd::any(climbing); ++k) {
+        const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
+        const IntMask aligned_x = step_x_pos ^ odd_x, aligned_y = step_y_pos ^ odd_y;
+        const IntMask ok = climbing & ((!cross_x) | aligned_x) & ((!cross_y) | aligned_y);
+        level = xsimd::select(ok, level + Int(1), level);
+        cx = xsimd::select(ok, cx >> 1, cx);
+        cy = xsimd::select(ok, cy >> 1, cy);
+        climbing = ok & (level < Int(top));
       }
+      up = none;
     }
     level = xsimd::select(up, level + Int(1), level);
     cx = xsimd::select(up, cx >> 1, cx);
@@ -276,8 +274,9 @@ void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, 
 // Conservative cones never let a step pass through the surface: the first texel top the ray is at or below is
 // the hit. Relaxed cones let a step enter the surface at most once and not leave it before the step's end: a
 // step that ends below the surface brackets the first hit, found by binary search on the box surface.
+template <class V>
 DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Float& ds, Mask active) const {
-  const bool relaxed = technique_.kind == TechniqueKind::Rcsm;
+  constexpr bool relaxed = V::technique == TechniqueKind::Rcsm;
   const float width = float(cones_->width), height = float(cones_->height);
   const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
   const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
@@ -298,7 +297,7 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
     // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
     // the surface), or a relaxed step that went in.
     const Mask below = active & (s >= top);
-    if (relaxed) search = search | (below & (s_prev < s));
+    if constexpr (relaxed) search = search | (below & (s_prev < s));
     active = active & !below;
 
     // The walls of p ahead, each crossing computed from the integer wall as in QDM.
@@ -337,7 +336,7 @@ DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Fl
     s = xsimd::select(stepping | to_top, next, s);
   }
   Float iterations = loop.iterations();
-  if (relaxed) {
+  if constexpr (relaxed) {
     // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
     Float lo = s_prev, hi = s;
     for (int i = 0; i < technique_.binary_steps && xsimd::any(search); ++i) {
@@ -480,51 +479,42 @@ struct DisplacementProgram::Setup {
   Float height_lod = Float(0.0f);  // mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows
 };
 
-template <class Surface>
+template <class V, class Surface>
 DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup, Float& ds) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
-  switch (technique_.kind) {
-    case TechniqueKind::Normal: break;
-    case TechniqueKind::Relief:
-      hit = relief(surface, ray, ds, setup.height_lod, active);
-      hit.box_s = hit.s;
-      break;
-    case TechniqueKind::Pom: {
-      const Float& lod = setup.height_lod;
-      // Far away (high LOD) POM fades to normal mapping.
-      const Float fade = xsimd::min(
-          xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
-          Float(1.0f));
-      ds = ds * (Float(1.0f) - fade);
-      hit = pom(surface, ray, ds, lod, setup.view_tangent.z, active);
-      hit.box_s = hit.s;
-      break;
+  if constexpr (V::technique == TechniqueKind::Relief) {
+    hit = relief(surface, ray, ds, setup.height_lod, active);
+    hit.box_s = hit.s;
+  } else if constexpr (V::technique == TechniqueKind::Pom) {
+    const Float& lod = setup.height_lod;
+    // Far away (high LOD) POM fades to normal mapping.
+    const Float fade = xsimd::min(
+        xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
+        Float(1.0f));
+    ds = ds * (Float(1.0f) - fade);
+    hit = pom(surface, ray, ds, lod, setup.view_tangent.z, active);
+    hit.box_s = hit.s;
+  } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
+    hit = cone_step<V>(ray, ds, active);
+    hit.box_s = hit.s;
+    hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
+  } else if constexpr (V::technique == TechniqueKind::Qdm) {
+    Float stop(0.0f);
+    if (technique_.lod_stop)
+      stop = xsimd::max(xsimd::floor(lod_from_derivatives(*layers_[0].height_max, d.dudx, d.dvdx, d.dudy, d.dvdy)),
+                        Float(0.0f));
+    Int cap(technique_.max_iterations);
+    if (technique_.min_iterations > 0) {
+      const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
+      cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
+                          Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
     }
-    case TechniqueKind::Csm:
-    case TechniqueKind::Rcsm:
-      hit = cone_step(ray, ds, active);
-      hit.box_s = hit.s;
-      hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
-      break;
-    case TechniqueKind::Qdm: {
-      Float stop(0.0f);
-      if (technique_.lod_stop)
-        stop = xsimd::max(xsimd::floor(lod_from_derivatives(*layers_[0].height_max, d.dudx, d.dvdx, d.dudy, d.dvdy)),
-                          Float(0.0f));
-      Int cap(technique_.max_iterations);
-      if (technique_.min_iterations > 0) {
-        const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
-        cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
-                            Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
-      }
-      hit = qdm(surface, ray, ds, stop, cap, active);
-      hit.box_s = hit.s;
-      hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
-      break;
-    }
+    hit = qdm<V>(surface, ray, ds, stop, cap, active);
+    hit.box_s = hit.s;
+    hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
   }
   return hit;
 }
@@ -566,13 +556,13 @@ void blend_factors(BlendOperator op, float width, int count, const Float* h, con
 
 }  // namespace
 
-template <class Surface>
+template <class V, class Surface>
 void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup, const Surface& surface,
                                         ShadeOutput& out) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
   Float ds = setup.ds;
-  const Hit hit = trace(surface, setup, ds);
+  const Hit hit = trace<V>(surface, setup, ds);
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   // Baked AO is read per layer and blended like the colours.
@@ -629,7 +619,8 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
   out.hit_v = hv;
   out.hit_depth = hit.s;
   out.error_texels = out.missed = Float(0.0f);
-  if (reference_ && technique_.kind != TechniqueKind::Normal) reference_errors(ray, ds, hit, in.covered, out);
+  if constexpr (V::technique != TechniqueKind::Normal)
+    if (reference_) reference_errors(ray, ds, hit, in.covered, out);
   if (technique_.write_depth) displaced_depth(in, d, frame, ray, hit.s, out);
 }
 
@@ -676,8 +667,10 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
                shadows ? visibility : nullptr, lighting_, lights_, out.color);
 }
 
-void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
+void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const { (this->*shade_)(in, out); }
 
+template <class V>
+void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) const {
   const Float& u = in.varyings[kU];
   const Float& v = in.varyings[kV];
   Setup setup;
@@ -701,7 +694,7 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
 
   const int count = int(layers_.size());
   if (count == 1) {
-    shade_surface(in, setup, layer_surface(0), out);
+    shade_surface<V>(in, setup, layer_surface(0), out);
     return;
   }
   const SingleLayerSurface surfaces[BlendedSurface::kMaxLayers] = {
@@ -710,7 +703,7 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
     const Float w[BlendedSurface::kMaxLayers] = {in.varyings[kWeight0], in.varyings[kWeight1],
                                                  count > 2 ? in.varyings[kWeight2] : Float(0.0f),
                                                  count > 3 ? in.varyings[kWeight3] : Float(0.0f)};
-    shade_surface(in, setup, BlendedSurface(surfaces, count, blend_.op, w), out);
+    shade_surface<V>(in, setup, BlendedSurface(surfaces, count, blend_.op, w), out);
     return;
   }
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
@@ -720,7 +713,36 @@ void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const BlendedSurface surface(surfaces, count, blend_.op, weights,
                                xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
                                xsimd::max(ray.v0, v1));
-  shade_surface(in, setup, surface, out);
+  shade_surface<V>(in, setup, surface, out);
+}
+
+template <class V>
+DisplacementProgram::Variant DisplacementProgram::variant() {
+  return {&DisplacementProgram::shade_variant<V>, V::options()};
+}
+
+// Every combination of the trace options is instantiated (program/variant.hpp): 5 techniques, and for qdm
+// 2 cell modes x 2 max fetches x 3 level-up rules.
+DisplacementProgram::Variant DisplacementProgram::select(const TraceOptions& o) {
+  using K = TechniqueKind;
+  switch (o.technique) {
+    case K::Normal: return variant<Trace<K::Normal>>();
+    case K::Relief: return variant<Trace<K::Relief>>();
+    case K::Pom: return variant<Trace<K::Pom>>();
+    case K::Csm: return variant<Trace<K::Csm>>();
+    case K::Rcsm: return variant<Trace<K::Rcsm>>();
+    case K::Qdm: break;
+  }
+  const auto qdm = [&]<bool Sm3, bool Filtered>() -> Variant {
+    switch (o.level_up) {
+      case QdmLevelUp::Stay: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::Stay>>();
+      case QdmLevelUp::One: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::One>>();
+      case QdmLevelUp::Aligned: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::Aligned>>();
+    }
+    throw Error("displacement program", "unknown level_up");
+  };
+  if (o.sm3_cells) return o.filtered_max ? qdm.operator()<true, true>() : qdm.operator()<true, false>();
+  return o.filtered_max ? qdm.operator()<false, true>() : qdm.operator()<false, false>();
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

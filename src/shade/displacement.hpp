@@ -14,10 +14,21 @@
 #include "shade/lighting_models.hpp"
 #include "program/batch.hpp"
 #include "program/inputs.hpp"
+#include "program/variant.hpp"
 #include "shade/shading_math.hpp"
 #include "texture/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
+
+// A trace variant: the options of program/variant.hpp as compile-time constants of the inner loops.
+template <TechniqueKind T, bool Sm3Cells = false, bool FilteredMax = false, QdmLevelUp LevelUp = QdmLevelUp::One>
+struct Trace {
+  static constexpr TechniqueKind technique = T;
+  static constexpr bool sm3_cells = Sm3Cells;
+  static constexpr bool filtered_max = FilteredMax;
+  static constexpr QdmLevelUp level_up = LevelUp;
+  static TraceOptions options() { return {T, Sm3Cells, FilteredMax, LevelUp}; }
+};
 
 class DisplacementProgram final : public ShadingProgram {
 public:
@@ -42,11 +53,22 @@ private:
   };
   // What shade() computes before the surface is known: the frame, the ray and the depth scale.
   struct Setup;
+  // The instantiation of shade_variant for a material's trace options, and the options of the type it runs.
+  using ShadeFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&) const;
+  struct Variant {
+    ShadeFn shade;
+    TraceOptions options;
+  };
+  static Variant select(const TraceOptions& options);
+  template <class V>
+  static Variant variant();
 
   SingleLayerSurface layer_surface(int i) const;
-  template <class Surface>
+  template <class V>
+  void shade_variant(const Fragments& in, ShadeOutput& out) const;
+  template <class V, class Surface>
   void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
-  template <class Surface>
+  template <class V, class Surface>
   Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
   template <class Surface>
   Hit relief(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
@@ -54,12 +76,13 @@ private:
   template <class Surface>
   Hit pom(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
           const simd::Float& cos_view, simd::Mask active) const;
-  template <class Surface>
+  template <class V, class Surface>
   Hit qdm(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& stop_level,
           const simd::Int& cap, simd::Mask active) const;
   template <class Surface>
   simd::Float refine(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit,
                      simd::Float& iterations, simd::Mask active) const;
+  template <class V>
   Hit cone_step(const Ray& ray, const simd::Float& depth_scale, simd::Mask active) const;
   void cone_texel(const simd::Int& x, const simd::Int& y, simd::Float& height, simd::Float& ratio) const;
   simd::Float bilinear_patch(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_start,
@@ -73,6 +96,7 @@ private:
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
 
+  ShadeFn shade_;
   std::vector<Layer> layers_;
   std::optional<TextureView> weights_;
   std::optional<TextureView> combined_;
@@ -85,7 +109,6 @@ private:
   const HeightField* surface_;
   SamplerState sampler_;
   LodMode lod_mode_;
-  MathMode math_;
   TechniqueDesc technique_;
   LightingDesc lighting_;
   BlendDesc blend_;

@@ -92,6 +92,41 @@ TEST(Renderer, StatsNameTheVariantThePlanPicked) {
   }
 }
 
+// Every trace variant (program/variant.hpp): the instantiation the program runs, named from its template
+// arguments, is the one the plan picked from the material.
+TEST(Renderer, EveryTraceVariantRunsTheInstantiationThePlanNames) {
+  int checked = 0;
+  Renderer renderer;  // one renderer: the textures are prepared once and shared by every combination
+  for (const std::string technique : {"normal", "relief", "pom", "csm", "rcsm", "qdm"})
+    for (const std::string math : {"sm4", "sm3", "exact"})
+      for (const std::string fetch : {"point", "trilinear"})
+        for (const std::string level_up : {"stay", "one", "aligned"}) {
+          if (technique != "qdm" && (math != "sm4" || fetch != "point" || level_up != "one")) continue;
+          const SceneDesc scene = small_scene(
+              "pom_vs_qdm_depth_5.0", {{"/materials/surface/technique/name", technique},
+                                       {"/materials/surface/sampling/math", math},
+                                       {"/materials/surface/technique/height_fetch", fetch},
+                                       {"/materials/surface/technique/level_up", level_up}});
+          renderer.set_scene(scene);
+          const Frame& frame = renderer.draw();
+          const FramePlan& plan = renderer.plan();
+          for (std::size_t i = 0; i < plan.materials.size(); ++i) {
+            if (plan.materials[i].name != "surface") continue;
+            const std::string& ran = frame.stats.materials.at(i).variant;
+            EXPECT_EQ(ran, plan.materials[i].variant);
+            const std::string expected =
+                technique == "normal" ? "normal_mapping"
+                : technique != "qdm"  ? "displacement:" + technique + " "
+                                      : "displacement:qdm<" + std::string(math == "sm3" ? "sm3_cells" : "int_cells") + "," +
+                                           (fetch == "trilinear" ? "filtered_max" : "max_fetch") + ",level_up_" +
+                                           level_up + ">";
+            EXPECT_EQ(ran.rfind(expected, 0), 0u) << ran << " does not start with " << expected;
+            ++checked;
+          }
+        }
+  EXPECT_EQ(checked, 5 + 3 * 2 * 3);
+}
+
 TEST(Renderer, MemoryDoesNotGrowOverAThousandFrames) {
   Renderer renderer;
   renderer.set_scene(small_scene("plane"), {Aov::Depth, Aov::Normal});
