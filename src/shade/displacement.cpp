@@ -11,6 +11,11 @@
 #include "shade/ambient_occlusion.hpp"
 #include "shade/self_shadow.hpp"
 #include "shade/shading_math.hpp"
+#include "shade/cone_step.hpp"
+#include "shade/pom.hpp"
+#include "shade/qdm.hpp"
+#include "shade/refine.hpp"
+#include "shade/relief.hpp"
 #include "shade/traversal.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -25,34 +30,6 @@ using simd::Mask;
 using simd::count;
 using simd::float_mask;
 using simd::int_mask;
-
-
-// Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
-Float texel_step(const DisplacementProgram::Ray& ray, float width, float height) {
-  const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));
-  return Float(1.0f) / xsimd::max(reach, Float(1e-6f));
-}
-
-// The texel a ray at texel coordinate p is over: the one ahead along the ray (direction dir) when p lies on a
-// texel boundary, so a step that ends on a wall moves on. Finite for any p (a NaN clamps to the bound).
-Int texel_ahead(const Float& p, const Float& dir) {
-  const Float c = xsimd::max(xsimd::min(p, Float(kMaxTexelCoordinate)), Float(-kMaxTexelCoordinate));
-  return xsimd::to_int(xsimd::select(dir < Float(0.0f), Float(-1.0f) - xsimd::floor(Float(0.0f) - c), xsimd::floor(c)));
-}
-
-// Texel index i (|i| < 2^24) to [0, n) by the address mode, as HeightField::at: wrap, clamp, mirror (period 2n).
-Int address_texel(const Int& i, int n, AddressMode mode) {
-  const Int last(n - 1);
-  if (mode == AddressMode::Clamp) return xsimd::min(xsimd::max(i, Int(0)), last);
-  const int period = mode == AddressMode::Mirror ? 2 * n : n;
-  // i and period are exact floats and the quotient is rounded to nearest, so its floor is floor(i / period) or
-  // one more: r lands in [-period, period) and one correction puts it in [0, period).
-  const Int q = xsimd::to_int(xsimd::floor(xsimd::to_float(i) / Float(float(period))));
-  Int r = i - q * Int(period);
-  r = xsimd::select(r < Int(0), r + Int(period), r);
-  if (mode == AddressMode::Mirror) r = xsimd::select(r >= Int(n), Int(period - 1) - r, r);
-  return xsimd::min(xsimd::max(r, Int(0)), last);
-}
 
 }  // namespace
 
@@ -98,317 +75,6 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
 SingleLayerSurface DisplacementProgram::layer_surface(int i) const {
   const Layer& l = layers_[std::size_t(i)];
   return SingleLayerSurface(*l.height, l.height_max ? &*l.height_max : nullptr, sampler_, technique_.height_fetch);
-}
-
-// Relief mapping (Policarpo 2005): fixed linear steps from the top, then a binary search in the last step.
-template <class Surface>
-DisplacementProgram::Hit DisplacementProgram::relief(const Surface& surface, const Ray& ray, const Float& ds,
-                                                    const Float& lod, Mask active) const {
-  const int steps = technique_.linear_steps;
-  const Float step = ds / Float(float(steps));
-  Float lo(0.0f), hi = ds, iterations(0.0f);
-  for (int i = 0; i <= steps && xsimd::any(active); ++i) {
-    const Float s = step * Float(float(i));
-    const Float h = surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
-    const Mask found = active & (s >= ds * (Float(1.0f) - h));
-    iterations += count(active);
-    hi = xsimd::select(found, s, hi);
-    lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
-    active = active & !found;
-  }
-  lo = xsimd::select(active, ds - step, lo);  // never below: the bottom (h >= 0 everywhere) is the hit
-  Mask searching = lo < hi;
-  for (int i = 0; i < technique_.binary_steps && xsimd::any(searching); ++i) {
-    const Float mid = (lo + hi) * Float(0.5f);
-    const Float h = surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
-    const Mask below = mid >= ds * (Float(1.0f) - h);
-    iterations += count(searching);
-    hi = xsimd::select(searching & below, mid, hi);
-    lo = xsimd::select(searching & !below, mid, lo);
-  }
-  return {hi, iterations, Float(0.0f)};
-}
-
-// Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
-// the ray with the line through the last two height samples.
-template <class Surface>
-DisplacementProgram::Hit DisplacementProgram::pom(const Surface& surface, const Ray& ray, const Float& ds,
-                                                 const Float& lod, const Float& cos_view, Mask active) const {
-  const Float lerp = xsimd::min(xsimd::max(cos_view, Float(0.0f)), Float(1.0f));
-  const Float n = xsimd::floor(Float(float(technique_.max_steps)) +
-                               (Float(float(technique_.min_steps)) - Float(float(technique_.max_steps))) * lerp +
-                               Float(0.5f));
-  const Float step = ds / n;
-  Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
-  // gap = surface depth - ray depth: > 0 while the ray is above the surface.
-  {
-    const Float gap0 = ds * (Float(1.0f) - surface.height(ray.u0, ray.v0, lod));
-    iterations += count(active);
-    const Mask at_top = active & (gap0 <= Float(0.0f));
-    s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
-    active = active & !at_top;
-    prev_gap = gap0;
-  }
-  for (int i = 1; i <= technique_.max_steps && xsimd::any(active); ++i) {
-    const Float fi = Float(static_cast<float>(i));
-    const Mask in_range = active & (fi <= n);
-    const Float s = step * fi;
-    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
-    iterations += count(in_range);
-    const Mask found = in_range & (gap <= Float(0.0f));
-    const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
-    s_hit = xsimd::select(found, prev_s + (s - prev_s) * t, s_hit);
-    active = in_range & !found;
-    prev_s = s;
-    prev_gap = gap;
-  }
-  return {s_hit, iterations, Float(0.0f)};
-}
-
-// Quadtree displacement mapping (Drobot 2009) over the max-quadtree: from the root, advance to the nearer of
-// the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
-// level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped
-// exactly across walls, or recomputed from the fp32 position (SM3 emulation).
-template <class V, class Surface>
-DisplacementProgram::Hit DisplacementProgram::qdm(const Surface& surface, const Ray& ray, const Float& ds,
-                                                 const Float& stop_level, const Int& cap, Mask active) const {
-  const int top = surface.top_level();
-  const float width = float(surface.width()), height = float(surface.height());
-  const IntMask none = Int(0) != Int(0);
-  const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
-  const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
-  const IntMask step_x_pos = int_mask(dx > Float(0.0f)), step_y_pos = int_mask(dy > Float(0.0f));
-  const Float inf(std::numeric_limits<float>::infinity());
-
-  Int level(top);
-  Int cx = xsimd::to_int(xsimd::floor(x0)) >> top, cy = xsimd::to_int(xsimd::floor(y0)) >> top;
-  Float s(0.0f);
-  const Int stop = xsimd::to_int(stop_level);
-  CappedLoop loop{cap};
-  while (loop.next(active)) {
-
-    // The cell's highest point (wrap addressing: power-of-two level sizes), or LinearMipMapLinear at the ray's
-    // position on this level, which smooths the maxima and so can miss features.
-    Float hmax;
-    if constexpr (V::filtered_max)
-      hmax = surface.cell_max_filtered(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level));
-    else
-      hmax = surface.cell_max(level, cx, cy);
-    const Float top_depth = ds * (Float(1.0f) - hmax);
-    const Mask below = active & (s >= top_depth);
-    const IntMask at_stop = level <= stop;
-    const Mask hit = below & float_mask(at_stop);
-    active = active & !hit;
-    // Below the cell's top but not at the last level: descend into the child that holds the ray.
-    const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) descend_to_child(descend, s, x0, y0, dx, dy, level, cx, cy);
-    // Above the cell's top: advance to its top plane or its wall, whichever comes first.
-    const Mask above = active & !below;
-    if (!xsimd::any(above)) continue;
-    const Float cell = xsimd::to_float(Int(1) << level);
-    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
-    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
-    const Float tx = xsimd::select(dx != Float(0.0f), (wall_x - x0) / dx, inf);
-    const Float ty = xsimd::select(dy != Float(0.0f), (wall_y - y0) / dy, inf);
-    const Float t_wall = xsimd::max(xsimd::min(tx, ty), s);
-    const Mask to_plane = above & (top_depth <= t_wall);
-    s = xsimd::select(to_plane, top_depth, s);
-    const Mask cross = above & !to_plane;
-    s = xsimd::select(cross, t_wall, s);
-    const IntMask cross_i = int_mask(cross);
-    const IntMask cross_x = cross_i & int_mask(tx <= ty);
-    const IntMask cross_y = cross_i & int_mask(ty <= tx);
-    if constexpr (V::sm3_cells) {
-      // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
-      const Float nudge = Float(1.0f / 64.0f);
-      const Float px = x0 + dx * s + xsimd::select(dx > Float(0.0f), nudge, Float(0.0f) - nudge);
-      const Float py = y0 + dy * s + xsimd::select(dy > Float(0.0f), nudge, Float(0.0f) - nudge);
-      cx = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx);
-      cy = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy);
-    } else {
-      cx = xsimd::select(cross_x, xsimd::select(step_x_pos, cx + Int(1), cx - Int(1)), cx);
-      cy = xsimd::select(cross_y, xsimd::select(step_y_pos, cy + Int(1), cy - Int(1)), cy);
-    }
-    // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
-    // while the wall just crossed is also a wall of the parent.
-    IntMask up = cross_i & (level < Int(top));
-    if constexpr (V::level_up == QdmLevelUp::Stay) {
-      up = none;
-    } else if constexpr (V::level_up == QdmLevelUp::Aligned) {
-      // Entering a cell through its low wall (+ direction) that wall is the parent's iff the index is even;
-      // through its high wall (- direction) iff the index is odd.
-      IntMask climbing = up;
-      for (int k = 0; k < top && xsimd::any(climbing); ++k) {
-        const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
-        const IntMask aligned_x = step_x_pos ^ odd_x, aligned_y = step_y_pos ^ odd_y;
-        const IntMask ok = climbing & ((!cross_x) | aligned_x) & ((!cross_y) | aligned_y);
-        level = xsimd::select(ok, level + Int(1), level);
-        cx = xsimd::select(ok, cx >> 1, cx);
-        cy = xsimd::select(ok, cy >> 1, cy);
-        climbing = ok & (level < Int(top));
-      }
-      up = none;
-    }
-    level = xsimd::select(up, level + Int(1), level);
-    cx = xsimd::select(up, cx >> 1, cx);
-    cy = xsimd::select(up, cy >> 1, cy);
-  }
-  return {xsimd::min(s, ds), loop.iterations(), Float(0.0f)};
-}
-
-void DisplacementProgram::cone_texel(const Int& x, const Int& y, Float& height, Float& ratio) const {
-  const Int ax = address_texel(x, cones_->width, sampler_.address);
-  const Int ay = address_texel(y, cones_->height, sampler_.address);
-  Float texel[4];
-  load(*layers_[0].height, Int(0), ax, ay, sampler_.fetch, texel);
-  height = texel[0];
-  ratio = simd::load_f32(cones_->ratio.data(), ay * Int(cones_->width) + ax, sampler_.fetch);
-}
-
-// Cone step mapping over the box surface (Dummer 2006; relaxed cones: Policarpo & Oliveira 2007). The ray reads
-// the cone of the level-0 texel p it is over; the cone stands for S_p, the union of cones with apex anywhere on
-// p's top face (cone_map.hpp), and the ray steps to where it leaves S_p. Along the ray S_p is: p's air column
-// up to the first wall, then, outside one wall, distance (alpha (s - sa)) <= r (top - s) / depth_scale, then,
-// outside both, the Euclidean distance to p's square; so the exit is p's top (a hit), a linear solve or a
-// quadratic. With r = 0 the step still reaches p's wall (or top): the march never stalls on rough maps.
-// Conservative cones never let a step pass through the surface: the first texel top the ray is at or below is
-// the hit. Relaxed cones let a step enter the surface at most once and not leave it before the step's end: a
-// step that ends below the surface brackets the first hit, found by binary search on the box surface.
-template <class V>
-DisplacementProgram::Hit DisplacementProgram::cone_step(const Ray& ray, const Float& ds, Mask active) const {
-  constexpr bool relaxed = V::technique == TechniqueKind::Rcsm;
-  const float width = float(cones_->width), height = float(cones_->height);
-  const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
-  const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
-  const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
-  const Float ax = xsimd::abs(ray.du) * ds, ay = xsimd::abs(ray.dv) * ds;  // UV per unit of height, as the ratios
-  const IntMask step_x_pos = int_mask(dx > zero), step_y_pos = int_mask(dy > zero);
-  const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
-
-  Int cx = texel_ahead(x0, dx), cy = texel_ahead(y0, dy);
-  Float s(0.0f), s_prev(0.0f);
-  Mask search = zero != zero;  // rcsm: the last step entered the surface
-  CappedLoop loop{Int(technique_.max_iterations)};
-  while (loop.next(active)) {
-
-    Float hp, r;
-    cone_texel(cx, cy, hp, r);
-    const Float top = ds * (Float(1.0f) - hp);
-    // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
-    // the surface), or a relaxed step that went in.
-    const Mask below = active & (s >= top);
-    if constexpr (relaxed) search = search | (below & (s_prev < s));
-    active = active & !below;
-
-    // The walls of p ahead, each crossing computed from the integer wall as in QDM.
-    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx));
-    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy));
-    const Float sx = xsimd::select(dx != zero, xsimd::max((wall_x - x0) / dx, s), inf);
-    const Float sy = xsimd::select(dy != zero, xsimd::max((wall_y - y0) / dy, s), inf);
-    const Mask x_first = sx <= sy;
-    const Float alpha = xsimd::select(x_first, ax, ay), beta = xsimd::select(x_first, ay, ax);
-    const Mask to_top = active & (top <= xsimd::min(sx, sy));
-    // Finite stand-ins (a wall never crossed lies beyond the top): lanes going to the top ignore the rest.
-    const Float sa = xsimd::min(xsimd::min(sx, sy), top), sb = xsimd::min(xsimd::max(sx, sy), top);
-    // Outside the first wall only: alpha (s - sa) = r (top - s).
-    const Float exit1 =
-        xsimd::max((alpha * sa + r * top) / xsimd::max(alpha + r, Float(1e-30f)), sa);
-    // Outside both: with tau = s - sb, delta = sb - sa, T = top - sb,
-    //   alpha^2 (tau + delta)^2 + beta^2 tau^2 = r^2 (T - tau)^2,
-    // a2 tau^2 + 2 b1 tau + c0 = 0 with c0 <= 0 (the ray is in S_p at sb): the root in [0, T] in the stable form.
-    const Float delta = sb - sa, T = top - sb;
-    const Float a2 = alpha * alpha + beta * beta - r * r;
-    const Float b1 = alpha * alpha * delta + r * r * T;
-    const Float c0 = (alpha * delta - r * T) * (alpha * delta + r * T);
-    const Float disc = xsimd::max(b1 * b1 - a2 * c0, zero);
-    const Float tau = xsimd::min(xsimd::max((zero - c0) / xsimd::max(b1 + xsimd::sqrt(disc), Float(1e-30f)), zero), T);
-    const Float next = xsimd::select(to_top, top, xsimd::min(xsimd::select(exit1 <= sb, exit1, sb + tau), top));
-    active = active & !to_top;  // on p's top while over p: the hit
-
-    // The texel at the step's end: the one ahead of the position, at least one past each wall crossed.
-    const Mask stepping = active;
-    const Int ahead_x = texel_ahead(x0 + dx * next, dx), ahead_y = texel_ahead(y0 + dy * next, dy);
-    const Int moved_x = xsimd::select(step_x_pos, xsimd::max(ahead_x, cx + step_x), xsimd::min(ahead_x, cx + step_x));
-    const Int moved_y = xsimd::select(step_y_pos, xsimd::max(ahead_y, cy + step_y), xsimd::min(ahead_y, cy + step_y));
-    cx = xsimd::select(int_mask(stepping & (next >= sx)), moved_x, cx);
-    cy = xsimd::select(int_mask(stepping & (next >= sy)), moved_y, cy);
-    s_prev = xsimd::select(stepping, s, s_prev);
-    s = xsimd::select(stepping | to_top, next, s);
-  }
-  Float iterations = loop.iterations();
-  if constexpr (relaxed) {
-    // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
-    Float lo = s_prev, hi = s;
-    for (int i = 0; i < technique_.binary_steps && xsimd::any(search); ++i) {
-      const Float mid = (lo + hi) * Float(0.5f);
-      Float h, unused;
-      cone_texel(texel_ahead(x0 + dx * mid, zero), texel_ahead(y0 + dy * mid, zero), h, unused);
-      const Mask below = mid >= ds * (Float(1.0f) - h);
-      iterations += count(search);
-      hi = xsimd::select(search & below, mid, hi);
-      lo = xsimd::select(search & !below, mid, lo);
-    }
-    s = xsimd::select(search, hi, s);
-  }
-  return {xsimd::min(s, ds), iterations, Float(0.0f)};
-}
-
-// Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
-template <class Surface>
-Float DisplacementProgram::refine(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit,
-                                  Float& iterations, Mask active) const {
-  if (technique_.refinement == QdmRefinement::None) return s_hit;
-  const Float lod0(0.0f);
-  const Float step = texel_step(ray, float(surface.width()), float(surface.height()));
-  Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
-  const Float gap_lo = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * lo, ray.v0 + ray.dv * lo, lod0)) - lo;
-  const Float gap_hi = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * hi, ray.v0 + ray.dv * hi, lod0)) - hi;
-  iterations += count(active) * Float(2.0f);
-  if (technique_.refinement == QdmRefinement::Linear) {
-    const Mask bracket = active & (gap_lo > Float(0.0f)) & (gap_hi <= Float(0.0f));
-    const Float t = gap_lo / (gap_lo - gap_hi);
-    return xsimd::select(bracket, lo + (hi - lo) * t, xsimd::select(gap_lo <= Float(0.0f), lo, hi));
-  }
-  if (technique_.refinement == QdmRefinement::BilinearPatch && surface_) return bilinear_patch(ray, ds, s_hit, iterations, active);
-  // Binary (and the bilinear patch without its fp64 surface): bisection on the filtered surface.
-  const int steps = technique_.refinement == QdmRefinement::Binary ? 8 : 24;
-  Mask searching = active & (gap_lo > Float(0.0f));
-  hi = xsimd::select(gap_lo > Float(0.0f), hi, lo);
-  for (int i = 0; i < steps && xsimd::any(searching); ++i) {
-    const Float mid = (lo + hi) * Float(0.5f);
-    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
-    iterations += count(searching);
-    const Mask below = gap <= Float(0.0f);
-    hi = xsimd::select(searching & below, mid, hi);
-    lo = xsimd::select(searching & !below, mid, lo);
-  }
-  return hi;
-}
-
-// The exact bilinear-patch hit: from the point where the ray reached the conservative bound, the patches are
-// walked cell by cell and solved analytically in fp64 (the reference's traversal), per lane.
-Float DisplacementProgram::bilinear_patch(const Ray& ray, const Float& ds, const Float& s_start, Float& iterations,
-                                          Mask active) const {
-  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes], s[kLanes], cells[kLanes];
-  ray.u0.store_aligned(u0);
-  ray.v0.store_aligned(v0);
-  ray.du.store_aligned(du);
-  ray.dv.store_aligned(dv);
-  ds.store_aligned(depth);
-  s_start.store_aligned(s);
-  const std::uint32_t lanes = simd::to_bits(active);
-  for (int l = 0; l < kLanes; ++l) {
-    cells[l] = 0.0f;
-    if (!((lanes >> l) & 1u)) continue;
-    const double start = s[l];
-    const SurfaceRay r{{u0[l] + double(du[l]) * start, v0[l] + double(dv[l]) * start, start}, {du[l], dv[l], 1.0}};
-    const ReferenceHit hit = intersect_reference(*surface_, depth[l], r, ReferenceSurface::Bilinear,
-                                                 std::max(1, technique_.max_iterations));
-    cells[l] = float(hit.cells_visited);
-    if (hit.hit) s[l] = float(hit.point.z);
-  }
-  iterations += Float::load_aligned(cells);
-  return Float::load_aligned(s);
 }
 
 // The hit in world space: the UV offset through dP/du and dP/dv (from the quad derivatives of the world
@@ -486,7 +152,7 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
   if constexpr (V::technique == TechniqueKind::Relief) {
-    hit = relief(surface, ray, ds, setup.height_lod, active);
+    hit = trace::relief(surface, ray, ds, setup.height_lod, active, technique_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Pom) {
     const Float& lod = setup.height_lod;
@@ -495,12 +161,13 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
         xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
         Float(1.0f));
     ds = ds * (Float(1.0f) - fade);
-    hit = pom(surface, ray, ds, lod, setup.view_tangent.z, active);
+    hit = trace::pom(surface, ray, ds, lod, setup.view_tangent.z, active, technique_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
-    hit = cone_step<V>(ray, ds, active);
+    const trace::ConeTexels texels{cones_, &*layers_[0].height, sampler_.address, sampler_.fetch};
+    hit = trace::cone_step<V::technique == TechniqueKind::Rcsm>(texels, ray, ds, active, technique_);
     hit.box_s = hit.s;
-    hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
+    hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {
     Float stop(0.0f);
     if (technique_.lod_stop)
@@ -512,9 +179,9 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
       cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
                           Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
     }
-    hit = qdm<V>(surface, ray, ds, stop, cap, active);
+    hit = trace::qdm<V>(surface, ray, ds, stop, cap, active);
     hit.box_s = hit.s;
-    hit.s = refine(surface, ray, ds, hit.s, hit.iterations, active);
+    hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   }
   return hit;
 }

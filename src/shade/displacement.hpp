@@ -1,8 +1,8 @@
 #pragma once
 // Per-pixel displacement: a view ray in tangent space traced through the height field by one of the talk's
-// techniques (relief, POM, QDM; CSM/RCSM with a cone map), then the surface shaded at the hit as in normal
-// mapping. Up to four layers are blended into one surface (blended_surface.hpp) and their colours by the
-// material's blend operator. Optionally the exact fp64 reference is traced too, for the error AOVs.
+// techniques (one file each: relief.hpp, pom.hpp, qdm.hpp, cone_step.hpp, then refine.hpp), then the surface
+// shaded at the hit as in normal mapping. Up to four layers are blended into one surface (blended_surface.hpp)
+// and their colours by the material's blend operator. Optionally the exact fp64 reference is traced too, for the error AOVs.
 #include <optional>
 #include <vector>
 
@@ -16,6 +16,7 @@
 #include "program/inputs.hpp"
 #include "program/variant.hpp"
 #include "shade/shading_math.hpp"
+#include "shade/trace_ray.hpp"
 #include "texture/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -35,15 +36,8 @@ public:
   DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material, const LightRig& lights);
   void shade(const Fragments& in, ShadeOutput& out) const override;
 
-  // The view ray in UV/depth space: uv(s) = uv0 + duv * s for depth s in [0, depth_scale].
-  struct Ray {
-    simd::Float u0, v0, du, dv;
-  };
-  struct Hit {
-    simd::Float s;           // depth of the hit
-    simd::Float iterations;  // loop iterations per lane
-    simd::Float box_s;       // qdm, csm, rcsm: the hit on the level-0 box surface, before refinement; else s
-  };
+  using Ray = trace::Ray;
+  using Hit = trace::Hit;
 
 private:
   struct Layer {
@@ -70,23 +64,6 @@ private:
   void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
   template <class V, class Surface>
   Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
-  template <class Surface>
-  Hit relief(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
-             simd::Mask active) const;
-  template <class Surface>
-  Hit pom(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& lod,
-          const simd::Float& cos_view, simd::Mask active) const;
-  template <class V, class Surface>
-  Hit qdm(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& stop_level,
-          const simd::Int& cap, simd::Mask active) const;
-  template <class Surface>
-  simd::Float refine(const Surface& surface, const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_hit,
-                     simd::Float& iterations, simd::Mask active) const;
-  template <class V>
-  Hit cone_step(const Ray& ray, const simd::Float& depth_scale, simd::Mask active) const;
-  void cone_texel(const simd::Int& x, const simd::Int& y, simd::Float& height, simd::Float& ratio) const;
-  simd::Float bilinear_patch(const Ray& ray, const simd::Float& depth_scale, const simd::Float& s_start,
-                             simd::Float& iterations, simd::Mask active) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
                        const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
   template <class Surface>

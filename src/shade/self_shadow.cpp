@@ -52,22 +52,6 @@ Prepared prepare(const ShadowRay& ray, Mask active) {
   return p;
 }
 
-// After a crossing: up while the wall just crossed is also a wall of the parent, so the parent lies wholly
-// beyond it and the ray enters the parent where it stands. Entering through the low wall (+ direction) that
-// wall is the parent's iff the index is even; through the high wall (- direction) iff it is odd.
-void climb_aligned(Int& level, Int& cx, Int& cy, IntMask climbing, const IntMask& cross_x, const IntMask& cross_y,
-                   const IntMask& step_x_pos, const IntMask& step_y_pos, int top) {
-  climbing = climbing & (level < Int(top));
-  for (int k = 0; k < top && xsimd::any(climbing); ++k) {
-    const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
-    const IntMask ok = climbing & ((!cross_x) | (step_x_pos ^ odd_x)) & ((!cross_y) | (step_y_pos ^ odd_y));
-    level = xsimd::select(ok, level + Int(1), level);
-    cx = xsimd::select(ok, cx >> 1, cx);
-    cy = xsimd::select(ok, cy >> 1, cy);
-    climbing = ok & (level < Int(top));
-  }
-}
-
 // Hard: the first texel after the start texel that the rising ray enters below its top (see the header).
 // The traversals work in the texel space of the repeat holding the start (exact and small numbers); cells are
 // addressed in absolute indices, since a blended surface's weights do not repeat with the layers' heights.
@@ -132,11 +116,8 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     // At or above the cell's maximum where it enters: above it all the way through; on to the next cell.
     const Mask advance = active & !below;
     if (!xsimd::any(advance)) continue;
-    const Float cell = xsimd::to_float(Int(1) << level);
-    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
-    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
-    const Float tx = xsimd::select(dx != zero, (wall_x - x0) / dx, inf);
-    const Float ty = xsimd::select(dy != zero, (wall_y - y0) / dy, inf);
+    Float tx, ty;
+    exit_walls(level, cx, cy, x0, y0, dx, dy, step_x_pos, step_y_pos, tx, ty);
     c = xsimd::select(advance, xsimd::max(xsimd::min(tx, ty), c), c);
     const IntMask moving = int_mask(advance);
     const IntMask cross_x = moving & int_mask(tx <= ty), cross_y = moving & int_mask(ty <= tx);

@@ -1,6 +1,9 @@
 #pragma once
-// What the SIMD traversals (view rays, light rays) share: the iteration budget of a capped loop and the range
-// texel coordinates are clamped to before they become indices.
+// What the SIMD traversals of the max-quadtree (QDM's view rays, hard shadows' light rays) share: the iteration
+// budget of a capped loop, the range texel coordinates are clamped to before they become indices, and the cell
+// stepping: descending into a child, the distance to a cell's exit walls, climbing after a crossing.
+#include <limits>
+
 #include "core/simd.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -46,6 +49,41 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
   cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
   cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
   level = xsimd::select(descend, child_level, level);
+}
+
+// Where the ray x(t) = x0 + dx t, y(t) = y0 + dy t (texel units) crosses the exit walls of cell (cx, cy) of `level`
+// (the walls ahead in each axis: step_*_pos says which), as t; infinity in an axis the ray is parallel to.
+inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const simd::Float& x0,
+                       const simd::Float& y0, const simd::Float& dx, const simd::Float& dy,
+                       const simd::IntMask& step_x_pos, const simd::IntMask& step_y_pos, simd::Float& tx,
+                       simd::Float& ty) {
+  using simd::Float;
+  using simd::Int;
+  const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
+  const Float cell = xsimd::to_float(Int(1) << level);
+  const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
+  const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
+  tx = xsimd::select(dx != zero, (wall_x - x0) / dx, inf);
+  ty = xsimd::select(dy != zero, (wall_y - y0) / dy, inf);
+}
+
+// After a wall crossing, the `climbing` lanes go up while the wall just crossed (cross_x / cross_y) is also a
+// wall of the parent: entering a cell through its low wall (+ direction) that wall is the parent's iff the index
+// is even; through its high wall (- direction) iff the index is odd. Never above `top`.
+inline void climb_aligned(simd::Int& level, simd::Int& cx, simd::Int& cy, simd::IntMask climbing,
+                          const simd::IntMask& cross_x, const simd::IntMask& cross_y, const simd::IntMask& step_x_pos,
+                          const simd::IntMask& step_y_pos, int top) {
+  using simd::Int;
+  using simd::IntMask;
+  climbing = climbing & (level < Int(top));
+  for (int k = 0; k < top && xsimd::any(climbing); ++k) {
+    const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
+    const IntMask ok = climbing & ((!cross_x) | (step_x_pos ^ odd_x)) & ((!cross_y) | (step_y_pos ^ odd_y));
+    level = xsimd::select(ok, level + Int(1), level);
+    cx = xsimd::select(ok, cx >> 1, cx);
+    cy = xsimd::select(ok, cy >> 1, cy);
+    climbing = ok & (level < Int(top));
+  }
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -12,6 +12,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "qdmr/core/sampling.hpp"
+
 namespace qdmr {
 
 struct MeshData;  // qdmr/mesh/mesh.hpp: an OBJ mesh, read when the scene is loaded
@@ -143,24 +145,6 @@ struct TechniqueDesc {
   float fade_start = 0.0f;        // > 0: depth scale fades linearly to 0 between these view distances
   float fade_end = 0.0f;
 };
-
-// Texture filters, named as in OpenGL/D3D: texel filter (point = nearest, linear = bilinear) and mip filter
-// (none = level 0 only, point = nearest level, linear = between the two nearest levels).
-enum class Filter {
-  Point,           // nearest texel of level 0 (GL_NEAREST)
-  Bilinear,        // bilinear on level 0 (GL_LINEAR)
-  Trilinear,       // bilinear on two levels, blended (GL_LINEAR_MIPMAP_LINEAR)
-  PointMipPoint,   // nearest texel of the nearest level (GL_NEAREST_MIPMAP_NEAREST; tex2Dlod with point sampling)
-  PointMipLinear,  // nearest texel on two levels, blended (GL_NEAREST_MIPMAP_LINEAR)
-  LinearMipPoint   // bilinear on the nearest level (GL_LINEAR_MIPMAP_NEAREST)
-};
-enum class AddressMode { Wrap, Clamp, Mirror };
-// Filter weights and LOD fraction: exact floats, or quantised to 8 (D3D11 class) or 6 (D3D10 class) bits.
-enum class SamplePrecision { Exact, Hw8, Hw6 };
-// LOD from the derivatives of the 2x2 quad (what hardware does) or of each pixel's own row/column.
-enum class LodMode { PerQuad, PerPixel };
-// Shader arithmetic for texel and cell addressing: 32-bit integers (SM4), fp32 emulation (SM3), fp64.
-enum class MathMode { Sm4, Sm3, Exact };
 
 struct SamplingDesc {
   Filter filter = Filter::Trilinear;

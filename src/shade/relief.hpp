@@ -1,0 +1,47 @@
+#pragma once
+// Relief mapping: linear search, then binary search.
+#include "qdmr/scene/scene.hpp"
+#include "shade/trace_ray.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE::trace {
+
+using simd::Float;
+using simd::Int;
+using simd::IntMask;
+using simd::kLanes;
+using simd::Mask;
+using simd::count;
+using simd::float_mask;
+using simd::int_mask;
+
+// Relief mapping (Policarpo 2005): fixed linear steps from the top, then a binary search in the last step.
+template <class Surface>
+Hit relief(const Surface& surface, const Ray& ray, const Float& ds,
+                                                    const Float& lod, Mask active,
+           const TechniqueDesc& technique) {
+  const int steps = technique.linear_steps;
+  const Float step = ds / Float(float(steps));
+  Float lo(0.0f), hi = ds, iterations(0.0f);
+  for (int i = 0; i <= steps && xsimd::any(active); ++i) {
+    const Float s = step * Float(float(i));
+    const Float h = surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
+    const Mask found = active & (s >= ds * (Float(1.0f) - h));
+    iterations += count(active);
+    hi = xsimd::select(found, s, hi);
+    lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
+    active = active & !found;
+  }
+  lo = xsimd::select(active, ds - step, lo);  // never below: the bottom (h >= 0 everywhere) is the hit
+  Mask searching = lo < hi;
+  for (int i = 0; i < technique.binary_steps && xsimd::any(searching); ++i) {
+    const Float mid = (lo + hi) * Float(0.5f);
+    const Float h = surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
+    const Mask below = mid >= ds * (Float(1.0f) - h);
+    iterations += count(searching);
+    hi = xsimd::select(searching & below, mid, hi);
+    lo = xsimd::select(searching & !below, mid, lo);
+  }
+  return {hi, iterations, Float(0.0f)};
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::trace

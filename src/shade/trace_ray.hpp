@@ -1,0 +1,57 @@
+#pragma once
+// What every technique shares: the view ray, the hit it reports, and texel arithmetic along the ray.
+#include "core/simd.hpp"
+#include "qdmr/core/sampling.hpp"
+#include "shade/traversal.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE::trace {
+
+using simd::Float;
+using simd::Int;
+using simd::IntMask;
+using simd::kLanes;
+using simd::Mask;
+using simd::count;
+using simd::float_mask;
+using simd::int_mask;
+
+// The view ray in UV/depth space: uv(s) = uv0 + duv * s for depth s in [0, depth_scale].
+struct Ray {
+  Float u0, v0, du, dv;
+};
+
+// What a technique found.
+struct Hit {
+  Float s;           // depth of the hit
+  Float iterations;  // loop iterations per lane
+  Float box_s;       // qdm, csm, rcsm: the hit on the level-0 box surface, before refinement; else s
+};
+
+// Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
+inline Float texel_step(const Ray& ray, float width, float height) {
+  const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));
+  return Float(1.0f) / xsimd::max(reach, Float(1e-6f));
+}
+
+// The texel a ray at texel coordinate p is over: the one ahead along the ray (direction dir) when p lies on a
+// texel boundary, so a step that ends on a wall moves on. Finite for any p (a NaN clamps to the bound).
+inline Int texel_ahead(const Float& p, const Float& dir) {
+  const Float c = xsimd::max(xsimd::min(p, Float(kMaxTexelCoordinate)), Float(-kMaxTexelCoordinate));
+  return xsimd::to_int(xsimd::select(dir < Float(0.0f), Float(-1.0f) - xsimd::floor(Float(0.0f) - c), xsimd::floor(c)));
+}
+
+// Texel index i (|i| < 2^24) to [0, n) by the address mode, as HeightField::at: wrap, clamp, mirror (period 2n).
+inline Int address_texel(const Int& i, int n, AddressMode mode) {
+  const Int last(n - 1);
+  if (mode == AddressMode::Clamp) return xsimd::min(xsimd::max(i, Int(0)), last);
+  const int period = mode == AddressMode::Mirror ? 2 * n : n;
+  // i and period are exact floats and the quotient is rounded to nearest, so its floor is floor(i / period) or
+  // one more: r lands in [-period, period) and one correction puts it in [0, period).
+  const Int q = xsimd::to_int(xsimd::floor(xsimd::to_float(i) / Float(float(period))));
+  Int r = i - q * Int(period);
+  r = xsimd::select(r < Int(0), r + Int(period), r);
+  if (mode == AddressMode::Mirror) r = xsimd::select(r >= Int(n), Int(period - 1) - r, r);
+  return xsimd::min(xsimd::max(r, Int(0)), last);
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::trace
