@@ -258,7 +258,7 @@ TEST(CliHelp, EveryOptionIsDocumented) {
   const CommandResult render = run(cli(), {"render", "--help"});
   EXPECT_EQ(render.exit_code, 0) << render.output;
   for (const char* option : {"scene", "-o,--output", "--width", "--height", "--threads", "--tile", "--set", "--aov",
-                             "depth, normal, uv", "--stats", "--help"})
+                             "depth, normal, uv", "shadow, ao", "--stats", "--timestamp", "--help"})
     EXPECT_NE(render.output.find(option), std::string::npos) << option << "\n" << render.output;
 
   const CommandResult plan = run(cli(), {"plan", "--help"});

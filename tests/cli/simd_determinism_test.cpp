@@ -1,6 +1,6 @@
 // Same scene, same bits: through the qdmr command, the SSE4.2 twin (qdmr-sse) renders every scene to the
 // same float pixels as the AVX2 build, and neither the thread count nor the tile size changes a bit. The
-// colour image and the depth, normal and uv AOVs are all compared exactly (no tolerance: determinism is
+// colour image and the depth, normal, uv, shadow and ao AOVs are all compared exactly (no tolerance: determinism is
 // the contract).
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kImages{"color", "depth", "normal", "uv"};
+const std::vector<std::string> kImages{"color", "depth", "normal", "uv", "shadow", "ao"};
 
 // Renders `scene` with every AOV through `binary` into `dir`; returns the file of each image in kImages.
 std::vector<fs::path> render_all(const fs::path& binary, const ShippedScene& scene, const fs::path& dir,

@@ -22,8 +22,13 @@ namespace qdmr {
 // `hit_depth` (UV units) of the hit; against the exact reference: `error_texels` (distance from the reference
 // hit, in level-0 texels) and `missed` (1 where the technique hit more than a texel away from the reference,
 // i.e. another feature or layer). Normal mapping reports 0 iterations and the hit at the polygon.
-enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed };
-inline constexpr int kAovCount = 8;
+// Lighting AOVs, both in [0, 1] and 1 from programs or materials without the feature: `shadow`, the
+// self-shadow visibility of the scene's first directional light (1 lit, 0 shadowed; 0 when that light is below
+// the polygon; 1 with shadow mode off or no directional light) and `ao`, the ambient occlusion term that
+// multiplies the ambient light (after ao.strength; 1 = open, also with ao mode off). Pixels nothing covers are
+// 0 in every AOV.
+enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed, Shadow, Ao };
+inline constexpr int kAovCount = 10;
 std::optional<Aov> parse_aov(const std::string& name);
 std::string aov_name(Aov aov);
 int aov_channels(Aov aov);
@@ -89,13 +94,20 @@ struct Frame {
 
 Frame render_frame(const SceneDesc& scene, const RenderOptions& options);
 
+// How images are written. By default a file holds no wall-clock time, so the same frame gives the same bytes
+// (OpenImageIO's DateTime is written empty in EXR and TIFF; PNG gets no tIME chunk).
+struct WriteOptions {
+  bool timestamp = false;  // true: DateTime = the current local time, "YYYY:MM:DD hh:mm:ss" (EXR capDate,
+                           // TIFF tag 306, PNG tIME chunk)
+};
+
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear) through a temporary
 // file in the same folder and a rename, so a failed write leaves nothing behind. Throws qdmr::Error.
-void write_frame(const Frame& frame, const std::filesystem::path& file);
+void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write = {});
 // Writes the stats as JSON, atomically like the images.
 void write_stats(const RenderStats& stats, const std::filesystem::path& file);
 // Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
 // fractional part, depth, iterations, hit depth and errors divided by their maximum).
-void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write = {});
 
 }  // namespace qdmr
