@@ -175,7 +175,8 @@ TEST_F(CliBadInput, Tile) {
 
 TEST_F(CliBadInput, UnknownAov) {
   expect_refused(render_args({"--aov", "albedo=" + (out_ / "albedo.exr").string()}),
-                 {"--aov: unknown AOV 'albedo' (valid: depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed)"});
+                 {"--aov: unknown AOV 'albedo' (valid: depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed, "
+                  "shadow, ao)"});
   expect_refused(render_args({"--aov", "depth"}), {"--aov depth: expected NAME=FILE"});
 }
 
