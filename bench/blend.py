@@ -13,7 +13,10 @@ doubling of its step knob (relief linear_steps, POM max_steps) that leaves fewer
 `missed` against the exact reference of its own blended surface (at 480x270), as the talk set its iteration counts
 "for non artifact rendering".
 
-    bench/blend.py [-n RUNS] [-B BUILD_DIR] [--width W --height H] [--tuned]
+--cpu times CPU time instead of wall time (for a shared machine): the process's CPU time (all threads) at full
+size minus the same at 64x36, on one thread, as bench/techniques.py --cpu.
+
+    bench/blend.py [-n RUNS] [-B BUILD_DIR] [--width W --height H] [--tuned] [--cpu]
 """
 import os
 import statistics
@@ -53,6 +56,7 @@ def tune(qdmr, sets, tmp):
 def main():
     parser = arguments(__doc__.splitlines()[0])
     parser.add_argument("--tuned", action="store_true", help="per-pixel weights, step counts tuned to 0.1 %% missed")
+    parser.add_argument("--cpu", action="store_true", help="CPU time (full size minus 64x36) instead of wall time")
     args = parser.parse_args()
     qdmr = os.path.join(args.B, "qdmr")
     times = {label: [] for label, _, _ in VARIANTS}
@@ -72,14 +76,21 @@ def main():
                 variants.append((label, sets, talk))
         for _ in range(args.n):
             for label, sets, _ in variants:
-                stats = render(qdmr, SCENE, sets, args.width, args.height, tmp)
-                times[label].append(stats["time_ms"]["raster_shade"])
+                # --cpu renders on one thread: idle oneTBB workers spin, which would count as CPU time
+                one = ["--threads", "1"] if args.cpu else []
+                stats = render(qdmr, SCENE, sets, args.width, args.height, tmp, extra=one)
+                if args.cpu:
+                    small = render(qdmr, SCENE, sets, 64, 36, tmp, extra=one)
+                    times[label].append(stats["cpu_ms"] - small["cpu_ms"])
+                else:
+                    times[label].append(stats["time_ms"]["raster_shade"])
                 iters[label] = stats["iterations"]
     med = {label: statistics.median(v) for label, v in times.items()}
     base = med["normal mapping"]
     relief = med["relief, alpha blend"] - base
     low = {label: min(v) for label, v in times.items()}  # fastest runs: less exposed to other processes' load
-    print(f"| variant | steps / missed | raster_shade ms (median of {args.n}) | min–max | ms over normal mapping "
+    what = "CPU ms, full size minus 64x36" if args.cpu else "raster_shade ms"
+    print(f"| variant | steps / missed | {what} (median of {args.n}) | min–max | ms over normal mapping "
           f"| ratio to relief | over normal, from minima | talk ms over normal | talk ratio to relief "
           f"| iterations mean / p99 | lane use |")
     print("|" + "---|" * 11)

@@ -18,6 +18,11 @@ normal mapping with the POM/QDM ratios of each pairing next to the talk's.
     bench/techniques.py [-n RUNS] [-B BUILD_DIR] [--width W --height H] [--variants pom,qdm_bp,...]
                         [--settings FILE] [SCENE ...]
 
+--cpu times CPU time instead of wall time, for a shared machine: each variant's process CPU time (all threads)
+at full size minus the same at 64x36 (prepare and start-up, which do not depend on the size), so the difference
+is the frame's geometry, raster+shade and image write, and "over normal" leaves raster+shade's difference. The
+renders run on one thread (--threads 1): idle oneTBB workers spin, and spinning would count as CPU time.
+
 --settings FILE keeps the tuned settings in a JSON file: the ones found there are reused (only the timing runs
 again), new ones are added to it.
 """
@@ -47,8 +52,10 @@ def materials(scene):
         return list(json.load(f)["materials"].keys())
 
 
-def render_scene(qdmr, scene, sets, width, height, tmp, aov=None):
+def render_scene(qdmr, scene, sets, width, height, tmp, aov=None, one_thread=False):
     extra = ["--aov", f"missed={os.path.join(tmp, 'missed.exr')}"] if aov else []
+    if one_thread:
+        extra += ["--threads", "1"]
     return render(qdmr, os.path.join(ROOT, "scenes", scene + ".json"), sets, width, height, tmp, extra=extra)
 
 
@@ -94,6 +101,7 @@ def main():
     parser.add_argument("--variants", default="pom,qdm_bp,qdm_lin,qdm_box",
                         help="comma-separated subset of " + ", ".join(VARIANTS))
     parser.add_argument("--settings", help="JSON file of tuned settings, read and updated")
+    parser.add_argument("--cpu", action="store_true", help="CPU time (full size minus 64x36) instead of wall time")
     parser.add_argument("scenes", nargs="*", default=SCENES)
     args = parser.parse_args()
     qdmr = os.path.join(args.B, "qdmr")
@@ -116,8 +124,13 @@ def main():
             for _ in range(args.n):
                 for v in times:
                     sets = variant_sets(scene, v, settings[v][0] if v in settings else None)
-                    stats = render_scene(qdmr, scene, sets, args.width, args.height, tmp)
-                    times[v].append(stats["time_ms"]["raster_shade"])
+                    # --cpu renders on one thread: idle oneTBB workers spin, which would count as CPU time
+                    stats = render_scene(qdmr, scene, sets, args.width, args.height, tmp, one_thread=args.cpu)
+                    if args.cpu:
+                        small = render_scene(qdmr, scene, sets, 64, 36, tmp, one_thread=True)
+                        times[v].append(stats["cpu_ms"] - small["cpu_ms"])
+                    else:
+                        times[v].append(stats["time_ms"]["raster_shade"])
                     iters[v] = dict(stats["iterations"], pixels=stats["shading"]["pixels_shaded"])
             rows.append((scene, settings, {v: statistics.median(t) for v, t in times.items()}, iters,
                          {v: min(t) for v, t in times.items()}))
@@ -136,7 +149,8 @@ def main():
             cells.append(f"{it['mean']:.1f} / {it['p99']:.0f} / {it['lane_utilisation']:.2f}")
         print(f"| {scene} | " + " | ".join(cells) + " |")
 
-    print("\nraster_shade ms over normal mapping (medians of %d) and POM / QDM ratios:\n" % args.n)
+    what = "CPU ms (all threads, full size minus 64x36)" if args.cpu else "raster_shade ms"
+    print("\n%s over normal mapping (medians of %d) and POM / QDM ratios:\n" % (what, args.n))
     qdms = [v for v in variants if v != "pom"]
     header = "| scene | normal ms | " + " | ".join(f"{v} ms over normal" for v in variants)
     if "pom" in variants:
@@ -154,7 +168,7 @@ def main():
         talk = TALK_MS[scene][0] / TALK_MS[scene][1] if scene in TALK_MS else float("nan")
         print(f"| {scene} | " + " | ".join(cells) + f" | {talk:.2f}x |")
 
-    print("\nCost per iteration: ns of raster_shade over normal mapping per pixel-iteration (2 threads' wall time):\n")
+    print("\nCost per iteration: ns of %s over normal mapping per pixel-iteration:\n" % what)
     print("| scene | pixels shaded | " + " | ".join(f"{v} ns / iteration" for v in variants) + " |")
     print("|" + "---|" * (2 + len(variants)))
     for scene, settings, med, iters, low in rows:
