@@ -39,6 +39,7 @@ struct RenderArgs {
   int tile = qdmr::RenderOptions{}.tile_size;
   std::string isa = "auto";
   std::string stats;
+  bool timestamp = false;  // write the current time into the images
 };
 
 std::vector<qdmr::SceneOverride> overrides(const SceneArgs& args, const RenderArgs* render) {
@@ -124,8 +125,9 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   frame.stats.load_ms = load_ms;
 
   start = Clock::now();
-  qdmr::write_frame(frame, render.output);
-  for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file);
+  const qdmr::WriteOptions write{.timestamp = render.timestamp};
+  qdmr::write_frame(frame, render.output, write);
+  for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file, write);
   frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (!render.stats.empty()) qdmr::write_stats(frame.stats, render.stats);
   const qdmr::RenderStats& s = frame.stats;
@@ -227,8 +229,13 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--set", render_scene.sets,
                          "Override a scene value before validation: /json/pointer=VALUE (VALUE is JSON; a bare word is a "
                          "string). Repeatable, e.g. --set /camera/fov_deg=30");
-  render_cmd->add_option("--aov", render_scene.aovs, "Also write an AOV: NAME=FILE with NAME one of depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed. Repeatable");
+  std::string aov_list;
+  for (const std::string& n : qdmr::aov_names()) aov_list += (aov_list.empty() ? "" : ", ") + n;
+  render_cmd->add_option("--aov", render_scene.aovs, "Also write an AOV: NAME=FILE with NAME one of " + aov_list + ". Repeatable");
   render_cmd->add_option("--stats", render.stats, "Write timings and counters as JSON to this file");
+  render_cmd->add_flag("--timestamp", render.timestamp,
+                       "Write the current local time into the images (EXR capDate, TIFF DateTime, PNG tIME). Off by "
+                       "default: the same scene gives byte-identical files");
 
   SceneArgs plan_scene;
   bool plan_json = false;

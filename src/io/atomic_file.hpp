@@ -14,6 +14,7 @@ namespace qdmr {
 void write_atomically(const std::filesystem::path& file, const std::string& what,
                       const std::function<std::string(const std::filesystem::path& temporary)>& write);
 
+// Writes no wall-clock time unless `spec` carries a DateTime attribute (see atomic_file.cpp).
 void write_image_file(const std::filesystem::path& file, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
                       const void* data, const std::string& what);
 

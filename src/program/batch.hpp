@@ -20,6 +20,9 @@ struct ShadeOutput {
   simd::Float normal[3];  // world-space shading normal (for the "normal" AOV)
   // Displacement AOVs (see Aov in qdmr/core/aov.hpp); every program sets them.
   simd::Float iterations, hit_u, hit_v, hit_depth, error_texels, missed;
+  // Lighting AOVs: self-shadow visibility of the first directional light and the AO term on the ambient light,
+  // both 1 when the program or material does not compute them. Every program sets them.
+  simd::Float shadow, ao;
   // Programs that displace the surface may replace the polygon's depth (window depth, and distance along the
   // view axis for the depth AOV); the rasterizer then tests it again before writing (a late depth test).
   bool writes_depth = false;

@@ -167,7 +167,9 @@ private:
         {&out.hit_u, &out.hit_v},
         {&out.hit_depth},
         {&out.error_texels},
-        {&out.missed}};
+        {&out.missed},
+        {&out.shadow},
+        {&out.ao}};
     for (int a = 0; a < kAovCount; ++a) {
       PixelBuffer& plane = fb_.aov[std::size_t(a)];
       if (plane.empty()) continue;

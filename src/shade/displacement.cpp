@@ -330,6 +330,9 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
                            in.pixel_x, in.pixel_y, setup.active);
   }
   if (ao_.mode != AoMode::Off) ao = apply_ao_strength(ao, ao_.strength);
+  // The lighting AOVs: what the lighting model multiplies by, for the first directional light.
+  out.shadow = shadows && !lights_.directional.empty() ? visibility[0] : Float(1.0f);
+  out.ao = ao;
   shade_lights(shading_normal, setup.frame.n, setup.view, SurfaceSample{albedo, specular, ao},
                shadows ? visibility : nullptr, lighting_, lights_, out.color);
 }

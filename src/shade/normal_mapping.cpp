@@ -27,6 +27,7 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
   out.iterations = out.hit_depth = out.error_texels = out.missed = Float(0.0f);
+  out.shadow = out.ao = Float(1.0f);  // no self-shadowing, no AO
   out.hit_u = u;
   out.hit_v = v;
 }

@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <cmath>
+#include <ctime>
+#include <string>
 #include <memory>
 #include <span>
 #include <vector>
@@ -49,9 +51,19 @@ std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb
   return out;
 }
 
+// The current local time as TIFF/EXIF write it ("YYYY:MM:DD hh:mm:ss"), for WriteOptions::timestamp.
+std::string local_time_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &local);
+  return text;
+}
+
 // Writes pixels (float, `channels` per pixel), atomically.
 void write_pixels(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
-                  bool srgb) {
+                  bool srgb, const WriteOptions& write) {
   const Container container = container_of(file);
   OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
   std::vector<std::uint8_t> bytes8;
@@ -71,13 +83,14 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
   if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
   // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
   if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
+  if (write.timestamp) spec.attribute("DateTime", local_time_now());
   write_image_file(file, spec, format, data, "image");
 }
 
 }  // namespace
 
-void write_frame(const Frame& frame, const std::filesystem::path& file) {
-  write_pixels(file, frame.width, frame.height, 3, frame.color, true);
+void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write) {
+  write_pixels(file, frame.width, frame.height, 3, frame.color, true, write);
 }
 
 void write_stats(const RenderStats& stats, const std::filesystem::path& file) { write_json(stats.to_json(), file); }
@@ -86,13 +99,13 @@ void write_json(const nlohmann::json& document, const std::filesystem::path& fil
   write_text_file(file, document.dump(2) + "\n");
 }
 
-void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write) {
   const AovImage* image = nullptr;
   for (const AovImage& a : frame.aovs)
     if (a.aov == aov) image = &a;
   if (!image) throw Error(file.string(), "AOV '" + aov_name(aov) + "' was not rendered");
   if (container_of(file) != Container::Png) {
-    write_pixels(file, frame.width, frame.height, image->channels, image->pixels, false);
+    write_pixels(file, frame.width, frame.height, image->channels, image->pixels, false, write);
     return;
   }
   // 8-bit PNG: map the values into [0, 1] so the picture is readable.
@@ -115,7 +128,7 @@ void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file) {
     }
     mapped = std::move(rgb);
   }
-  write_pixels(file, frame.width, frame.height, image->channels == 2 ? 3 : image->channels, mapped, false);
+  write_pixels(file, frame.width, frame.height, image->channels == 2 ? 3 : image->channels, mapped, false, write);
 }
 
 }  // namespace qdmr

@@ -175,7 +175,8 @@ TEST_F(CliBadInput, Tile) {
 
 TEST_F(CliBadInput, UnknownAov) {
   expect_refused(render_args({"--aov", "albedo=" + (out_ / "albedo.exr").string()}),
-                 {"--aov: unknown AOV 'albedo' (valid: depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed)"});
+                 {"--aov: unknown AOV 'albedo' (valid: depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed, "
+                  "shadow, ao)"});
   expect_refused(render_args({"--aov", "depth"}), {"--aov depth: expected NAME=FILE"});
 }
 
@@ -258,7 +259,7 @@ TEST(CliHelp, EveryOptionIsDocumented) {
   const CommandResult render = run(cli(), {"render", "--help"});
   EXPECT_EQ(render.exit_code, 0) << render.output;
   for (const char* option : {"scene", "-o,--output", "--width", "--height", "--threads", "--tile", "--set", "--aov",
-                             "depth, normal, uv", "--stats", "--help"})
+                             "depth, normal, uv", "shadow, ao", "--stats", "--timestamp", "--help"})
     EXPECT_NE(render.output.find(option), std::string::npos) << option << "\n" << render.output;
 
   const CommandResult plan = run(cli(), {"plan", "--help"});

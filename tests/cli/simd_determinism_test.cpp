@@ -1,6 +1,6 @@
 // Same scene, same bits: through the qdmr command, every draw kernel this machine can run (--isa sse4.2, avx2,
 // ...) renders every scene to the same float pixels, and neither the thread count nor the tile size changes a
-// bit. The colour image and the depth, normal, uv and iterations AOVs are all compared exactly (no tolerance:
+// bit. The colour image and the depth, normal, uv, iterations, shadow and ao AOVs are all compared exactly (no tolerance:
 // determinism is the contract).
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kImages{"color", "depth", "normal", "uv", "iterations"};
+const std::vector<std::string> kImages{"color", "depth", "normal", "uv", "iterations", "shadow", "ao"};
 
 // Renders `scene` with every AOV through `binary` into `dir`; returns the file of each image in kImages.
 std::vector<fs::path> render_all(const fs::path& binary, const ShippedScene& scene, const fs::path& dir,

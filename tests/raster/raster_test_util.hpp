@@ -28,6 +28,7 @@ public:
     for (auto& c : out.color) c = simd::Float(1.0f);
     for (auto& n : out.normal) n = simd::Float(0.0f);
     out.iterations = out.hit_u = out.hit_v = out.hit_depth = out.error_texels = out.missed = simd::Float(0.0f);
+    out.shadow = out.ao = simd::Float(1.0f);
   }
   int width_;
   mutable std::vector<int> counts;

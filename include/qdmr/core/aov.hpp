@@ -10,8 +10,13 @@ namespace qdmr {
 // against the exact reference: `error_texels` (distance from the reference hit, in level-0 texels) and `missed`
 // (1 where the technique hit more than a texel away from the reference, i.e. another feature or layer). Normal
 // mapping reports 0 iterations and the hit at the polygon.
-enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed };
-inline constexpr int kAovCount = 8;
+// Lighting AOVs, both in [0, 1] and 1 from programs or materials without the feature: `shadow`, the
+// self-shadow visibility of the scene's first directional light (1 lit, 0 shadowed; 0 when that light is below
+// the polygon; 1 with shadow mode off or no directional light) and `ao`, the ambient occlusion term that
+// multiplies the ambient light (after ao.strength; 1 = open, also with ao mode off). Pixels nothing covers are
+// 0 in every AOV.
+enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed, Shadow, Ao };
+inline constexpr int kAovCount = 10;
 
 std::optional<Aov> parse_aov(const std::string& name);
 std::string aov_name(Aov aov);

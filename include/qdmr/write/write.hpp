@@ -11,14 +11,21 @@
 
 namespace qdmr {
 
+// How images are written. By default a file holds no wall-clock time, so the same frame gives the same bytes
+// (OpenImageIO's DateTime is written empty in EXR and TIFF; PNG gets no tIME chunk).
+struct WriteOptions {
+  bool timestamp = false;  // true: DateTime = the current local time, "YYYY:MM:DD hh:mm:ss" (EXR capDate,
+                           // TIFF tag 306, PNG tIME chunk)
+};
+
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear). Throws qdmr::Error.
-void write_frame(const Frame& frame, const std::filesystem::path& file);
+void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write = {});
 // Writes the stats as JSON.
 void write_stats(const RenderStats& stats, const std::filesystem::path& file);
 // Writes any JSON document (indented by 2), e.g. `qdmr bench --json`.
 void write_json(const nlohmann::json& document, const std::filesystem::path& file);
 // Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
 // fractional part, depth, iterations, hit depth and errors divided by their maximum).
-void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file);
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write = {});
 
 }  // namespace qdmr
