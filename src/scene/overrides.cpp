@@ -5,11 +5,12 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/core/error.hpp"
+#include "scene/reader.hpp"
 
 namespace qdmr {
 
 SceneOverride parse_override(std::string_view text) {
-  const std::string where = "--set '" + std::string(text) + "'";
+  const std::string where = "--set '" + scene_detail::shorten(text) + "'";
   const auto equals = text.find('=');
   if (equals == std::string_view::npos) throw Error(where, "expected POINTER=VALUE, e.g. /camera/fov_deg=30");
   SceneOverride result{std::string(text.substr(0, equals)), std::string(text.substr(equals + 1))};
@@ -27,9 +28,15 @@ namespace scene_detail {
 
 namespace {
 
-nlohmann::json parse_value(const std::string& text) {
-  nlohmann::json value = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  return value.is_discarded() ? nlohmann::json(text) : value;
+// JSON if it parses, else the text as a string; nesting deeper than the limit is an error.
+nlohmann::json parse_value(const std::string& text, const std::string& where) {
+  try {
+    return parse_json_bounded(text);
+  } catch (const Error& e) {
+    throw Error(where, e.what());
+  } catch (const nlohmann::json::exception&) {
+    return nlohmann::json(text);
+  }
 }
 
 void apply_override(nlohmann::json& document, const SceneOverride& override_, const std::string& file) {
@@ -61,7 +68,7 @@ void apply_override(nlohmann::json& document, const SceneOverride& override_, co
   }
   nlohmann::json& parent = document[parent_pointer];
   const std::string& key = pointer.back();
-  nlohmann::json value = parse_value(override_.value);
+  nlohmann::json value = parse_value(override_.value, file + ": " + override_.pointer);
 
   if (parent.is_object()) {
     parent[key] = std::move(value);
