@@ -90,7 +90,18 @@ void apply_override(nlohmann::json& document, const SceneOverride& override_, co
 }  // namespace
 
 void apply_overrides(nlohmann::json& document, const std::vector<SceneOverride>& overrides, const std::string& file) {
-  for (const auto& override_ : overrides) apply_override(document, override_, file);
+  for (const auto& override_ : overrides) {
+    // A pointer nlohmann::json cannot resolve in some way apply_override does not foresee (found by fuzz_set:
+    // "/objects/=1", an empty token on an array) is an input error like the others, not an internal one.
+    try {
+      apply_override(document, override_, file);
+    } catch (const nlohmann::json::exception& e) {
+      const std::string what = e.what();
+      const auto bracket = what.find("] ");
+      throw Error(file + ": " + override_.pointer,
+                  "cannot apply --set: " + (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+    }
+  }
 }
 
 }  // namespace scene_detail

@@ -304,6 +304,7 @@ args = [
     ("set_through_number", render("--set", "/output/width/x=1"), "cannot apply --set"),
     ("set_array_index_out_of_range", render("--set", "/objects/7=1"), "no element '7' in /objects"),
     ("set_array_bad_index", render("--set", "/objects/01=1"), "no element '01' in /objects"),
+    ("set_empty_array_token", render("--set", "/objects/=1"), "/objects/: cannot apply --set: unresolved reference token ''"),
     ("set_deep_value", render("--set", "/camera/fov_deg=" + "[" * 200 + "]" * 200), "nesting deeper than 64 levels"),
     ("set_wrong_type", render("--set", "/camera/fov_deg=true"), "/camera/fov_deg: expected a number, got boolean"),
     ("set_fov_out_of_range", render("--set", "/camera/fov_deg=0"), "/camera/fov_deg"),
