@@ -36,7 +36,8 @@ CommandResult run(const std::filesystem::path& program, const std::vector<std::s
 
 // Like run, but kills the command (SIGKILL) after `timeout_seconds`: then exit_code is -1 and timed_out true.
 struct TimedResult : CommandResult {
-  double seconds = 0.0;  // wall time until it exited or was killed
+  double seconds = 0.0;      // wall time until it exited or was killed
+  double cpu_seconds = 0.0;  // user + system time of the command
   bool timed_out = false;
 };
 TimedResult run_timed(const std::filesystem::path& program, const std::vector<std::string>& args,
