@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes tests/bad_inputs/files/ and tests/bad_inputs/cases.json: the malformed inputs checked by
 tests/cli/bad_inputs_corpus_test.cpp. Re-run after editing (needs oiiotool for the few valid images the bad
-ones are cut from); the output is deterministic. Special files (FIFOs, sockets, devices, a directory) are not
+ones are cut from); the output is deterministic except the EXR and TIFF files (their headers carry the date written). Special files (FIFOs, sockets, devices, a directory) are not
 stored: the test makes them at run time under special/ in its copy of files/ (see the test).
 
 Placeholders in args and messages: {in} is the test's copy of files/, {out} its empty output folder."""
