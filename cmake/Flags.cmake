@@ -4,7 +4,11 @@
 # a draw kernel ("sse4.2", "avx2"), which also puts the code into the namespace qdmr::<isa> (core/isa_namespace.hpp).
 function(qdmr_project_flags target isa)
   # -ffp-contract=off: no fused multiply-add behind our back, so every ISA gives the same bits.
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror -ffp-contract=off -fno-fast-math)
+  set(werror "")
+  if(QDMR_WERROR)
+    set(werror -Werror)
+  endif()
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic ${werror} -ffp-contract=off -fno-fast-math)
   if(isa STREQUAL "avx2")
     # AVX2 without FMA: xsimd's default arch becomes avx2, not fma3<avx2> (which fuses inside its math).
     target_compile_options(${target} PRIVATE -mavx2 -mno-fma -mf16c -mpopcnt)
@@ -18,5 +22,9 @@ function(qdmr_project_flags target isa)
   if(QDMR_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
     target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+  endif()
+  if(QDMR_FUZZ)
+    # Coverage for libFuzzer in every project target; the harnesses add -fsanitize=fuzzer (its main) themselves.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
   endif()
 endfunction()

@@ -6,6 +6,7 @@
 
 #include "bake/content_hash.hpp"
 #include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 
 namespace qdmr {
@@ -31,11 +32,15 @@ std::uint64_t payload_hash(const std::vector<float>& values) {
 
 std::optional<std::vector<float>> read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo,
                                                    float hi) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
+  // Only a regular file of exactly the expected size is opened: a FIFO or device in its place is a miss, not a
+  // hang (the cache is then rewritten over it by rename).
+  if (!non_regular_reason(file).empty()) return std::nullopt;
   const std::size_t count = std::size_t(id.width) * std::size_t(id.height);
   std::error_code ec;
   if (std::filesystem::file_size(file, ec) != sizeof(Header) + count * sizeof(float) || ec) return std::nullopt;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return std::nullopt;
+  note_input(file);
   Header header{};
   if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return std::nullopt;
   if (std::memcmp(header.magic, id.magic.data(), sizeof header.magic) != 0 || header.version != id.version ||

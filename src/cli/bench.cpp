@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
@@ -58,9 +59,11 @@ int run_bench(const BenchArgs& args) {
     throw Error("--frames", "must be between 1 and 100000, got " + std::to_string(args.frames));
   if (args.warmup < 0 || args.warmup > 100000)
     throw Error("--warmup", "must be between 0 and 100000, got " + std::to_string(args.warmup));
-  if (args.threads == 0) throw Error("--threads", "must be at least 1 (omit it to use every core)");
+  if (args.threads && (*args.threads < 1 || *args.threads > limits::kMaxThreads))
+    throw Error("--threads", "must be from 1 to " + std::to_string(limits::kMaxThreads) + ", got " +
+                                 std::to_string(*args.threads) + " (omit it to use every core)");
   RenderOptions options;
-  options.threads = args.threads < 0 ? 0 : args.threads;
+  options.threads = args.threads.value_or(0);
   options.tile_size = args.tile;
   const std::optional<Isa> isa = parse_isa(args.isa);
   if (!isa) throw Error("--isa", "unknown ISA '" + args.isa + "' (valid: auto, sse4.2, avx2, avx512)");

@@ -9,7 +9,7 @@ namespace qdmr::cli {
 struct BenchArgs {
   std::string scene;
   int frames = 10, warmup = 2;
-  int threads = -1;  // absent: every core
+  std::optional<int> threads;  // absent: every core
   int tile = 64;
   std::string isa = "auto";
   std::optional<int> width, height;

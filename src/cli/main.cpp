@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -14,7 +15,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/bench.hpp"
+#include "io/atomic_file.hpp"
+#include "io/output_check.hpp"
 #include "qdmr/bake/cone_map.hpp"
+#include "qdmr/core/limits.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
@@ -35,12 +39,20 @@ struct SceneArgs {
 struct RenderArgs {
   std::string output;
   std::optional<int> width, height;  // absent: the scene's; checked like the scene's values
-  int threads = -1;  // absent: every core
+  std::optional<int> threads;  // absent: every core
   int tile = qdmr::RenderOptions{}.tile_size;
   std::string isa = "auto";
   std::string stats;
   bool timestamp = false;  // write the current time into the images
+  std::optional<std::int64_t> max_memory_mib;  // absent: half the RAM
 };
+
+// The default of --max-memory: half the machine's physical memory, in MiB.
+std::int64_t default_max_memory_mib() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return std::int64_t(1) << 14;  // unknown: 16 GiB
+  return std::int64_t(std::uint64_t(pages) * std::uint64_t(page) / 2 >> 20);
+}
 
 std::vector<qdmr::SceneOverride> overrides(const SceneArgs& args, const RenderArgs* render) {
   std::vector<qdmr::SceneOverride> result;
@@ -57,24 +69,23 @@ qdmr::Aov aov_from(const std::string& name) {
   throw qdmr::Error("--aov", "unknown AOV '" + name + "' (valid: " + valid + ")");
 }
 
-void check_output_path(const std::string& option, const std::filesystem::path& out, const std::filesystem::path& scene) {
+// The image type of an output; where it may be written is checked by check_outputs (io/output_check.hpp).
+void check_output_type(const std::string& option, const std::filesystem::path& out) {
   std::string ext = out.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
     throw qdmr::Error(option + " " + out.string(), "unsupported image type '" + ext + "' (use .png, .exr or .tif)");
-  const std::filesystem::path folder = out.parent_path().empty() ? "." : out.parent_path();
-  if (!std::filesystem::is_directory(folder))
-    throw qdmr::Error(option + " " + out.string(), "folder does not exist: " + folder.string());
-  std::error_code ec;
-  if (std::filesystem::equivalent(out, scene, ec))
-    throw qdmr::Error(option + " " + out.string(), "refusing to overwrite the scene file");
 }
 
 
 qdmr::RenderOptions render_options(const RenderArgs& render) {
   qdmr::RenderOptions options;
-  if (render.threads == 0) throw qdmr::Error("--threads", "must be at least 1 (omit it to use every core)");
-  options.threads = render.threads < 0 ? 0 : render.threads;
+  if (render.threads && (*render.threads < 1 || *render.threads > qdmr::limits::kMaxThreads))
+    throw qdmr::Error("--threads", "must be from 1 to " + std::to_string(qdmr::limits::kMaxThreads) + ", got " +
+                                       std::to_string(*render.threads) + " (omit it to use every core)");
+  options.threads = render.threads.value_or(0);
+  if (render.max_memory_mib && (*render.max_memory_mib < 1 || *render.max_memory_mib > (std::int64_t(1) << 30)))
+    throw qdmr::Error("--max-memory", "must be from 1 to 1073741824 (MiB), got " + std::to_string(*render.max_memory_mib));
   options.tile_size = render.tile;
   const std::optional<qdmr::Isa> isa = qdmr::parse_isa(render.isa);
   if (!isa) throw qdmr::Error("--isa", "unknown ISA '" + render.isa + "' (valid: auto, sse4.2, avx2, avx512)");
@@ -86,7 +97,8 @@ qdmr::RenderOptions render_options(const RenderArgs& render) {
 int run_render(const SceneArgs& args, const RenderArgs& render) {
   using Clock = std::chrono::steady_clock;
   qdmr::RenderOptions options = render_options(render);
-  check_output_path("-o", render.output, args.scene);
+  check_output_type("-o", render.output);
+  std::vector<qdmr::OutputPath> outputs{{"-o", render.output}};
   std::vector<std::pair<qdmr::Aov, std::filesystem::path>> aov_files;
   std::set<std::string> seen;
   for (const std::string& spec : args.aovs) {
@@ -96,20 +108,24 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
     const std::string name = spec.substr(0, eq);
     if (!seen.insert(name).second) throw qdmr::Error("--aov " + spec, "AOV '" + name + "' given twice");
     aov_files.emplace_back(aov_from(name), spec.substr(eq + 1));
-    check_output_path("--aov", aov_files.back().second, args.scene);
+    check_output_type("--aov", aov_files.back().second);
+    outputs.push_back({"--aov", aov_files.back().second});
     options.aovs.push_back(aov_files.back().first);
   }
-  if (!render.stats.empty() && !std::filesystem::is_directory(std::filesystem::path(render.stats).parent_path().empty()
-                                                                  ? std::filesystem::path(".")
-                                                                  : std::filesystem::path(render.stats).parent_path()))
-    throw qdmr::Error("--stats " + render.stats, "folder does not exist");
-  std::error_code ec;
-  if (!render.stats.empty() && std::filesystem::equivalent(render.stats, args.scene, ec))
-    throw qdmr::Error("--stats " + render.stats, "refusing to overwrite the scene file");
+  if (!render.stats.empty()) outputs.push_back({"--stats", render.stats});
+  qdmr::check_outputs(outputs);  // folders, and outputs equal to each other, before the scene is read
 
   auto start = Clock::now();
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  qdmr::check_outputs(outputs);  // the scene, its textures and OBJ files are known inputs now
+  // The plan's estimate (`qdmr plan` prints it part by part) before anything large is allocated.
+  const std::int64_t max_mib = render.max_memory_mib.value_or(default_max_memory_mib());
+  const std::uint64_t estimate = qdmr::plan_frame(scene, qdmr::PlanOptions{options.aovs}).total_bytes();
+  if (estimate > std::uint64_t(max_mib) << 20)
+    throw qdmr::Error(args.scene, "the job needs an estimated " + std::to_string((estimate + (1 << 20) - 1) >> 20) +
+                                      " MiB (see qdmr plan), more than the limit of " + std::to_string(max_mib) +
+                                      " MiB" + (render.max_memory_mib ? " (--max-memory)" : " (half the RAM; raise it with --max-memory)"));
 
   // Progress only on a terminal: logs and CI stay quiet.
   if (::isatty(STDERR_FILENO))
@@ -123,13 +139,17 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   renderer.set_scene(scene, options.aovs);
   qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
+  qdmr::check_outputs(outputs);  // and now also the MTL files, the maps they name and the caches read
 
+  // Every output written to a temporary first, then all renamed: all of them or none.
+  qdmr::OutputBatch batch;
   start = Clock::now();
   const qdmr::WriteOptions write{.timestamp = render.timestamp};
   qdmr::write_frame(frame, render.output, write);
   for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file, write);
   frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (!render.stats.empty()) qdmr::write_stats(frame.stats, render.stats);
+  batch.commit();
   const qdmr::RenderStats& s = frame.stats;
   std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
               frame.width, frame.height, static_cast<unsigned long long>(s.triangles_rasterized),
@@ -172,8 +192,10 @@ int run_bake_cone(const ConeArgs& args) {
     throw qdmr::Error("--channel " + args.channel, "unknown channel (valid: r, g, b, a)");
   const std::filesystem::path out = args.output;
   if (out.extension() != ".exr") throw qdmr::Error("-o " + args.output, "the cone map is written as .exr");
-  check_output_path("-o", out, args.height);
+  const std::vector<qdmr::OutputPath> outputs{{"-o", out}};
+  qdmr::check_outputs(outputs);
   const qdmr::Image image = qdmr::read_image(args.height, args.height);
+  qdmr::check_outputs(outputs);  // the height image is a known input now
   const int channel = int(channels.find(args.channel[0]));
   if (channel >= image.channels)
     throw qdmr::Error(args.height,
@@ -221,7 +243,7 @@ int main(int argc, char** argv) {
       ->required();
   render_cmd->add_option("--width", render.width, "Override /output/width (pixels)");
   render_cmd->add_option("--height", render.height, "Override /output/height (pixels)");
-  render_cmd->add_option("--threads", render.threads, "Worker threads (default: every core)");
+  render_cmd->add_option("--threads", render.threads, "Worker threads, 1 to 256 (default: every core)");
   render_cmd->add_option("--tile", render.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
   render_cmd->add_option("--isa", render.isa,
                          "Draw kernel: auto (default: $QDMR_ISA, else the best this CPU has), sse4.2, avx2 or avx512. "
@@ -236,6 +258,8 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--timestamp", render.timestamp,
                        "Write the current local time into the images (EXR capDate, TIFF DateTime, PNG tIME). Off by "
                        "default: the same scene gives byte-identical files");
+  render_cmd->add_option("--max-memory", render.max_memory_mib,
+                         "Refuse a job whose estimated memory (see qdmr plan) exceeds this many MiB (default: half the RAM)");
 
   SceneArgs plan_scene;
   bool plan_json = false;

@@ -21,7 +21,29 @@ std::filesystem::path temporary_for(const std::filesystem::path& file) {
   return folder / name;
 }
 
+thread_local OutputBatch* current_batch = nullptr;
+
 }  // namespace
+
+OutputBatch::OutputBatch() : previous_(current_batch) { current_batch = this; }
+
+OutputBatch::~OutputBatch() {
+  current_batch = previous_;
+  std::error_code ec;
+  for (const auto& [temporary, target] : pending_) std::filesystem::remove(temporary, ec);
+}
+
+void OutputBatch::commit() {
+  std::error_code ec;
+  for (std::size_t i = 0; i < pending_.size(); ++i) {
+    std::filesystem::rename(pending_[i].first, pending_[i].second, ec);
+    if (ec) {
+      pending_.erase(pending_.begin(), pending_.begin() + std::ptrdiff_t(i));
+      throw Error(pending_.front().second.string(), "cannot write: " + ec.message());
+    }
+  }
+  pending_.clear();
+}
 
 void write_atomically(const std::filesystem::path& file, const std::string& what,
                       const std::function<std::string(const std::filesystem::path&)>& write) {
@@ -35,6 +57,10 @@ void write_atomically(const std::filesystem::path& file, const std::string& what
     message = e.what();
   }
   std::error_code ec;
+  if (message.empty() && current_batch) {
+    current_batch->pending_.emplace_back(temporary, file);
+    return;
+  }
   if (message.empty()) {
     std::filesystem::rename(temporary, file, ec);
     if (!ec) return;

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <OpenImageIO/imageio.h>
 
@@ -19,5 +21,23 @@ void write_image_file(const std::filesystem::path& file, const OIIO::ImageSpec& 
                       const void* data, const std::string& what);
 
 void write_text_file(const std::filesystem::path& file, const std::string& text);
+
+// While an OutputBatch lives, write_atomically on this thread writes the temporary but defers the rename:
+// commit() renames every file (after all of them were written), the destructor removes the temporaries of an
+// uncommitted batch. A job with several outputs thus writes all or none of them.
+class OutputBatch {
+public:
+  OutputBatch();
+  ~OutputBatch();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  void commit();  // throws qdmr::Error when a rename fails (files renamed before it stay)
+
+private:
+  friend void write_atomically(const std::filesystem::path&, const std::string&,
+                               const std::function<std::string(const std::filesystem::path&)>&);
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> pending_;  // temporary, target
+  OutputBatch* previous_;
+};
 
 }  // namespace qdmr

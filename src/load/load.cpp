@@ -1,9 +1,9 @@
 #include "qdmr/load/load.hpp"
 
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "scene/overrides.hpp"
@@ -41,22 +41,20 @@ void resolve_obj_meshes(SceneDesc& scene) {
 
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
   const std::string name = file.string();
-  std::error_code ec;
-  const auto status = std::filesystem::status(file, ec);
-  if (!std::filesystem::exists(status)) throw Error(name, "file not found");
-  if (std::filesystem::is_directory(status)) throw Error(name, "is a directory, not a scene file");
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  if (!(in && text << in.rdbuf())) throw Error(name, "cannot read the file");
-
+  const std::string text = read_input_file(file, name, InputKind::Scene);
   nlohmann::json document;
   try {
-    document = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
+    document = scene_detail::parse_json_bounded(text);
+  } catch (const Error& e) {
+    throw Error(name, e.what());
+  } catch (const nlohmann::json::exception& e) {
     // what() is "[json.exception.parse_error.N] parse error at line L, column C: ..."; keep from "parse error".
+    // Other exceptions of the parser (a number too large for a double: out_of_range.406) lose the bracket.
     const std::string what = e.what();
     const auto start = what.find("parse error");
-    throw Error(name, start == std::string::npos ? what : what.substr(start));
+    const auto bracket = what.find("] ");
+    throw Error(name, start != std::string::npos ? what.substr(start)
+                      : bracket != std::string::npos ? what.substr(bracket + 2) : what);
   }
   return load_scene_json(document, file, file.parent_path(), overrides);
 }

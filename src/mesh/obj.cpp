@@ -15,7 +15,10 @@
 #include <glm/geometric.hpp>
 
 #include "mesh/builders.hpp"
+#include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace qdmr::mesh_detail {
 
@@ -23,16 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_text(const fs::path& file, const std::string& where) {
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw Error(where, "file not found: " + file.string());
-  if (!fs::is_regular_file(file, ec)) throw Error(where, "not a regular file: " + file.string());
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(where, "cannot open " + file.string());
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(where, "cannot read " + file.string());
-  return text;
-}
 
 // 0: v, 1: vt, 2: vn, 3: f, -1: anything else.
 int line_kind(std::string_view line) {
@@ -40,7 +33,7 @@ int line_kind(std::string_view line) {
   if (line.starts_with("vt") && is_space(2)) return 1;
   if (line.starts_with("vn") && is_space(2)) return 2;
   if (line.starts_with('v') && is_space(1)) return 0;
-  if (line.starts_with('f') && is_space(1)) return 3;
+  if (line.starts_with('f') && (is_space(1) || line.size() == 1)) return 3;  // a bare "f" is an empty face
   return -1;
 }
 
@@ -76,7 +69,11 @@ void check_face_indices(const std::string& text, const std::string& where) {
       throw Error(where, "line " + std::to_string(line_no) + ": " + what);
     };
     std::istringstream tokens{std::string(line.substr(1))};
+    long long corners = 0;
     for (std::string token; tokens >> token;) {
+      // tinyobjloader ear-clips polygons in quadratic time: a face line of a megabyte would take minutes.
+      if (++corners > limits::kMaxFaceVertices)
+        fail("a face has more than " + std::to_string(limits::kMaxFaceVertices) + " vertices");
       std::size_t part_start = 0;
       for (int k = 0; k < 3 && part_start <= token.size(); ++k) {
         std::size_t part_end = std::min(token.find('/', part_start), token.size());
@@ -96,6 +93,9 @@ void check_face_indices(const std::string& text, const std::string& where) {
                (index > 0 ? " in the file)" : " before this line)"));
       }
     }
+    if (corners < 3)
+      fail("a face needs at least 3 vertices, this one has " + std::to_string(corners) +
+           " (use 'l' for lines)");
   });
 }
 
@@ -121,27 +121,37 @@ void check_vertex_numbers(const std::string& text, const std::string& where) {
 // MTL file are relative to that file).
 class MtlReader final : public tinyobj::MaterialReader {
 public:
-  explicit MtlReader(fs::path folder) : folder_(std::move(folder)) {}
+  MtlReader(fs::path folder, std::string where) : folder_(std::move(folder)), where_(std::move(where)) {}
 
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* names, std::string* warn, std::string* err) override {
     const fs::path file = (folder_ / name).lexically_normal();
-    std::ifstream in(file);
-    if (!in) {
+    if (non_regular_reason(file) == "file not found") {
       missing_ += (missing_.empty() ? "" : ", ") + file.string();
       return false;
     }
+    // Not a regular file, too large or unreadable: an error, kept until tinyobjloader returns.
+    std::string text;
+    try {
+      text = read_input_file(file, where_, InputKind::Mtl);
+    } catch (const Error& e) {
+      if (error_.empty()) error_ = e.what();
+      return false;
+    }
+    std::istringstream in(text);
     tinyobj::LoadMtl(names, materials, &in, warn, err);
     material_folders_.resize(materials->size(), file.parent_path());
     return true;
   }
 
   const std::string& missing() const { return missing_; }
+  const std::string& error() const { return error_; }
   const fs::path& folder_of(std::size_t material) const { return material_folders_.at(material); }
 
 private:
   fs::path folder_;
-  std::string missing_;
+  std::string where_;
+  std::string missing_, error_;
   std::vector<fs::path> material_folders_;
 };
 
@@ -232,7 +242,7 @@ std::string unique_name(const std::vector<MaterialDesc>& materials, std::string 
 
 MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
-  const std::string text = read_text(file, where);
+  const std::string text = read_input_file(file, where, InputKind::Obj);
   check_face_indices(text, where);
   check_vertex_numbers(text, where);
 
@@ -240,9 +250,10 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> mtls;
   std::string warn, err;
-  MtlReader reader(file.parent_path());
+  MtlReader reader(file.parent_path(), where);
   std::istringstream stream(text);
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &mtls, &warn, &err, &stream, &reader, true, false);
+  if (!reader.error().empty()) throw Error(reader.error());
   if (!ok || !err.empty()) {
     while (!err.empty() && std::isspace(static_cast<unsigned char>(err.back()))) err.pop_back();
     throw Error(where, err.empty() ? "tinyobjloader failed to parse " + file.string() : err);
@@ -262,7 +273,16 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   if (corners == 0) throw Error(where, "no faces in " + file.string());
 
   MeshData m;
-  for (std::size_t i = 0; i < mtls.size(); ++i) m.materials.push_back(convert_material(mtls[i], reader.folder_of(i)));
+  for (std::size_t i = 0; i < mtls.size(); ++i) {
+    m.materials.push_back(convert_material(mtls[i], reader.folder_of(i)));
+    // Every map the MTL file names for qdmr (map_Kd, norm, disp, bump) is checked now, used or not: a damaged or
+    // special file is an error even when the technique would not sample it.
+    for (const std::string* map : {&mtls[i].diffuse_texname, &mtls[i].normal_texname, &mtls[i].displacement_texname,
+                                   &mtls[i].bump_texname})
+      if (!map->empty())
+        static_cast<void>(read_image_header((reader.folder_of(i) / *map).lexically_normal(),
+                                            where + ": material '" + mtls[i].name + "'"));
+  }
   const auto default_material = std::uint32_t(m.materials.size());
   bool uses_default = false;
 

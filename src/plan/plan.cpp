@@ -14,6 +14,7 @@
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/texture/height_texture.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace qdmr {
 namespace {
@@ -70,14 +71,9 @@ SourceInfo texture_source(const TextureDesc& d, const LayerDesc& layer, const st
       if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {};
       return texture_source(layer.height, layer, where);
     case TextureSource::File: {
-      auto input = OIIO::ImageInput::open(d.file.string());
-      if (!input) throw Error(where + "/file", "cannot read '" + d.file.string() + "': " + OIIO::geterror());
-      const OIIO::ImageSpec& spec = input->spec();
-      const bool uniform = spec.channelformats.empty();
-      const int bits = uniform && spec.format == OIIO::TypeDesc::UINT8    ? 8
-                       : uniform && spec.format == OIIO::TypeDesc::UINT16 ? 16
-                                                                         : 32;
-      return {spec.width, spec.height, bits};
+      // The same checks as when the texture is read (kind, size, format, header), nothing decoded.
+      const ImageHeader header = read_image_header(d.file, where + "/file");
+      return {header.width, header.height, header.source_bits};
     }
   }
   return {};

@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "io/input_file.hpp"
 
 namespace qdmr::scene_detail {
 
@@ -37,8 +39,25 @@ std::string join(const std::vector<std::string>& words) {
 
 }  // namespace
 
+nlohmann::json parse_json_bounded(const std::string& text) {
+  const nlohmann::json::parser_callback_t limit_depth = [](int depth, nlohmann::json::parse_event_t event,
+                                                           nlohmann::json&) {
+    if ((event == nlohmann::json::parse_event_t::object_start || event == nlohmann::json::parse_event_t::array_start) &&
+        depth >= limits::kMaxJsonDepth)
+      throw Error("nesting deeper than " + std::to_string(limits::kMaxJsonDepth) + " levels of arrays and objects");
+    return true;
+  };
+  return nlohmann::json::parse(text, limit_depth);
+}
+
+std::string shorten(std::string_view text, std::size_t max) {
+  if (text.size() <= max) return std::string(text);
+  return std::string(text.substr(0, max)) + "...";
+}
+
 std::optional<std::string> closest_match(std::string_view word, const std::vector<std::string>& candidates) {
   std::optional<std::string> best;
+  if (word.size() > 64) return best;  // no key is that long: no suggestion, and no quadratic table
   std::size_t best_distance = std::numeric_limits<std::size_t>::max();
   for (const auto& candidate : candidates) {
     const std::size_t distance = edit_distance(word, candidate);
@@ -166,10 +185,11 @@ std::filesystem::path Value::existing_file() const {
   std::filesystem::path path =
       std::filesystem::absolute(context_->base_dir / std::filesystem::path(text)).lexically_normal();
   if (!path.has_filename()) path = path.parent_path();  // "dir/." normalises to "dir/"
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  require(std::filesystem::exists(status), "file not found: " + path.string());
-  require(!std::filesystem::is_directory(status), "is a directory, not a file: " + path.string());
+  // Devices, FIFOs and sockets are refused here, before anything opens them; sizes are checked when read.
+  const std::string reason = non_regular_reason(path);
+  if (reason == "file not found" || reason == "is a directory, not a file") fail(reason + ": " + path.string());
+  if (!reason.empty()) fail(path.string() + " " + reason);
+  note_input(path);
   return path;
 }
 
@@ -179,7 +199,7 @@ Object::Object(const Value& value, std::initializer_list<std::string_view> keys)
   for (const auto& item : value.json().items()) {
     const std::string& key = item.key();
     if (key == "comment" || std::find(valid.begin(), valid.end(), key) != valid.end()) continue;
-    value.fail("unknown key '" + key + "'" + suggestion(key, valid, "valid keys are"));
+    value.fail("unknown key '" + shorten(key) + "'" + suggestion(key, valid, "valid keys are"));
   }
 }
 

@@ -20,6 +20,14 @@ std::optional<std::string> closest_match(std::string_view word, const std::vecto
 std::string suggestion(std::string_view word, const std::vector<std::string>& candidates, std::string_view what_list);
 
 std::string format_number(double value);
+
+// nlohmann::json::parse with the nesting depth bounded by limits::kMaxJsonDepth (deeper documents would make
+// the recursive copy and destruction of the tree overflow the stack). Throws nlohmann::json::parse_error
+// (deeper than the limit: an out_of_range naming the depth) like parse itself.
+nlohmann::json parse_json_bounded(const std::string& text);
+
+// `text` cut to at most `max` characters with "..." (keys and values quoted in messages stay one short line).
+std::string shorten(std::string_view text, std::size_t max = 64);
 std::string escape_pointer_token(std::string_view token);
 
 struct Context {

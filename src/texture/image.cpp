@@ -2,24 +2,107 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string_view>
 #include <vector>
 
+#include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 
 namespace qdmr {
+namespace {
 
-Image read_image(const std::filesystem::path& file, const std::string& where) {
-  const std::string name = file.string();
-  // OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line.
-  const auto fail = [&](std::string message) {
-    while (!message.empty() && message.back() == '\n') message.pop_back();
-    for (std::size_t at; (at = message.find('\n')) != std::string::npos;) message.replace(at, 1, "; ");
-    return Error(where, "cannot read '" + name + "': " + (message.empty() ? "unknown error" : message));
-  };
-  auto in = OIIO::ImageInput::open(name);
+// The formats whose failure modes (truncation, bad headers) are tested: anything else is refused rather than
+// decoded by a reader that might return a partial image without an error.
+constexpr std::string_view kFormats[] = {"png", "jpeg", "openexr", "tiff", "pnm"};
+
+// Up to `count` bytes from `offset` (negative: from the end) of a regular file already checked.
+std::string bytes_of(const std::filesystem::path& file, std::int64_t offset, std::size_t count) {
+  std::ifstream in(file, std::ios::binary);
+  if (offset < 0)
+    in.seekg(offset, std::ios::end);
+  else
+    in.seekg(offset);
+  std::string out(count, '\0');
+  in.read(out.data(), std::streamsize(count));
+  out.resize(std::size_t(std::max<std::streamsize>(in.gcount(), 0)));
+  return out;
+}
+
+// PGM/PPM/PBM: OpenImageIO takes a maxval of 0 or a pixel array shorter than the header promises without an
+// error. Returns what is wrong, or "".
+std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
+  const std::string head = bytes_of(file, 0, 4096);
+  std::size_t at = 2;
+  std::vector<std::uint64_t> fields;
+  const char magic = head.size() > 1 ? head[1] : '?';
+  const bool bitmap = magic == '1' || magic == '4';
+  const std::size_t wanted = bitmap ? 2 : 3;
+  while (fields.size() < wanted) {
+    while (at < head.size() && (std::isspace(static_cast<unsigned char>(head[at])) || head[at] == '#')) {
+      if (head[at] == '#')
+        while (at < head.size() && head[at] != '\n') ++at;
+      else
+        ++at;
+    }
+    if (at >= head.size() || !std::isdigit(static_cast<unsigned char>(head[at]))) return "PNM header is malformed";
+    std::uint64_t v = 0;
+    while (at < head.size() && std::isdigit(static_cast<unsigned char>(head[at])) && v < (1ull << 40))
+      v = v * 10 + std::uint64_t(head[at++] - '0');
+    fields.push_back(v);
+  }
+  if (fields[0] == 0 || fields[1] == 0) return "PNM size " + std::to_string(fields[0]) + "x" + std::to_string(fields[1]) + " is empty";
+  if (!bitmap && (fields[2] == 0 || fields[2] > 65535))
+    return "PNM maxval " + std::to_string(fields[2]) + " is outside 1..65535";
+  if (fields[0] > std::uint64_t(limits::kMaxTextureSide) || fields[1] > std::uint64_t(limits::kMaxTextureSide))
+    return "size " + std::to_string(fields[0]) + "x" + std::to_string(fields[1]) + " is outside 1.." +
+           std::to_string(limits::kMaxTextureSide);
+  // Binary variants: exactly one whitespace byte after the header, then the pixels.
+  if (magic == '4' || magic == '5' || magic == '6') {
+    const std::uint64_t channels = magic == '6' ? 3 : 1;
+    const std::uint64_t bytes = magic == '4' ? (fields[0] + 7) / 8 * fields[1]
+                                             : fields[0] * fields[1] * channels * (fields[2] > 255 ? 2 : 1);
+    if (size < at + 1 + bytes)
+      return "truncated: the header promises " + std::to_string(bytes) + " bytes of pixels, the file has " +
+             std::to_string(size > at + 1 ? size - at - 1 : 0);
+  }
+  return "";
+}
+
+// OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line.
+Error read_error(const std::string& where, const std::filesystem::path& file, std::string message) {
+  while (!message.empty() && message.back() == '\n') message.pop_back();
+  for (std::size_t at; (at = message.find('\n')) != std::string::npos;) message.replace(at, 1, "; ");
+  return Error(where, "cannot read '" + file.string() + "': " + (message.empty() ? "unknown error" : message));
+}
+
+// The file checked (kind, size), opened, and its header checked (format, size, channels, PNM fields, a
+// JPEG's end marker): nothing decoded yet.
+std::unique_ptr<OIIO::ImageInput> open_checked(const std::filesystem::path& file, const std::string& where) {
+  const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
+  const std::uint64_t size = check_input_file(file, where, InputKind::Image);
+  auto in = OIIO::ImageInput::open(file.string());
   if (!in) throw fail(OIIO::geterror());
+  const std::string format = in->format_name();
+  if (std::find(std::begin(kFormats), std::end(kFormats), format) == std::end(kFormats))
+    throw fail("unsupported image format '" + format + "' (textures are PNG, JPEG, OpenEXR, TIFF or PGM/PPM)");
+  if (format == "pnm")
+    if (const std::string problem = check_pnm(file, size); !problem.empty()) throw fail(problem);
+  // A JPEG ends with the EOI marker FF D9 (which cannot occur inside entropy-coded data); libjpeg pads a
+  // truncated file with grey and only warns.
+  if (format == "jpeg" && bytes_of(file, -std::int64_t(std::min<std::uint64_t>(size, 64)), 64).find("\xFF\xD9") ==
+                              std::string::npos)
+    throw fail("truncated JPEG (no end-of-image marker)");
+  // A PNG ends with its IEND chunk (length 0, "IEND", its CRC): checked here so a truncated map is refused even
+  // when no pixel of it is ever decoded.
+  if (format == "png" && bytes_of(file, -std::int64_t(std::min<std::uint64_t>(size, 12)), 12) !=
+                             std::string("\0\0\0\0IEND\xAE\x42\x60\x82", 12))
+    throw fail("truncated PNG (it does not end with an IEND chunk)");
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.width > limits::kMaxTextureSide ||
       spec.height > limits::kMaxTextureSide)
@@ -28,13 +111,34 @@ Image read_image(const std::filesystem::path& file, const std::string& where) {
   if (spec.depth > 1) throw fail("volume images are not supported");
   if (spec.nchannels < 1 || spec.nchannels > 4)
     throw fail(std::to_string(spec.nchannels) + " channels (textures take 1 to 4)");
+  return in;
+}
+
+int source_bits(const OIIO::ImageSpec& spec) {
+  const bool uniform = spec.channelformats.empty();
+  return uniform && spec.format == OIIO::TypeDesc::UINT8 ? 8 : uniform && spec.format == OIIO::TypeDesc::UINT16 ? 16 : 32;
+}
+
+}  // namespace
+
+ImageHeader read_image_header(const std::filesystem::path& file, const std::string& where) {
+  const auto in = open_checked(file, where);
+  const OIIO::ImageSpec& spec = in->spec();
+  return {spec.width, spec.height, spec.nchannels, source_bits(spec)};
+}
+
+Image read_image(const std::filesystem::path& file, const std::string& where) {
+  const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
+  const auto in = open_checked(file, where);
+  const OIIO::ImageSpec& spec = in->spec();
   Image image(spec.width, spec.height, spec.nchannels);
   // Rows are stored bottom-up: the file's last row becomes row 0 (v = 0), the OpenGL/OBJ convention, so
   // UVs from OBJ files and +Y-up (GL) normal maps need no flipping.
   const auto read = [&](OIIO::TypeDesc type, void* data) {
     const OIIO::stride_t row = OIIO::stride_t(type.size()) * spec.nchannels * spec.width;
     char* last_row = static_cast<char*>(data) + row * (spec.height - 1);
-    if (!in->read_image(0, 0, 0, spec.nchannels, type, last_row, OIIO::AutoStride, -row)) {
+    // A decoder that reports an error but returns true (a warning about damaged data) fails too.
+    if (!in->read_image(0, 0, 0, spec.nchannels, type, last_row, OIIO::AutoStride, -row) || in->has_error()) {
       const std::string message = in->geterror();
       throw fail(message.empty() ? OIIO::geterror() : message);
     }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <cmath>
 #include <string>
 
@@ -326,6 +328,15 @@ TEST(Obj, QuadWithUvsNormalsAndMaterials) {
                    "f 1/1/1 3/3/1 4/4/1\n"
                    "usemtl painted\n"
                    "f 1/1/1 2/2/1 3/3/1 4/4/1\n");
+  // Every map an MTL file names must be a readable image when the OBJ loads (docs/scene-format.md).
+  std::filesystem::create_directories(dir / "mat/tex");
+  for (const char* map : {"mat/tex/albedo.png", "mat/tex/normal.png", "mat/tex/bump.png", "mat/tex/disp.png", "bump.png"}) {
+    const std::string file = (dir / map).string();
+    const unsigned char texel[3] = {128, 128, 255};
+    auto out = OIIO::ImageOutput::create(file);
+    ASSERT_TRUE(out && out->open(file, OIIO::ImageSpec(1, 1, 3, OIIO::TypeDesc::UINT8)) &&
+                out->write_image(OIIO::TypeDesc::UINT8, texel) && out->close()) << file;
+  }
   MeshDesc d = obj(dir / "quad.obj");
   d.uv_scale = {2.0f, 2.0f};
   const MeshData m = build_mesh(d, kWhere);
@@ -423,7 +434,7 @@ TEST(Obj, Errors) {
   EXPECT_EQ(error_of(obj("/nonexistent/qdmr/m.obj")), where + "file not found: /nonexistent/qdmr/m.obj");
   {
     test::TempDir dir;
-    EXPECT_EQ(error_of(obj(dir.path())), where + "not a regular file: " + dir.path().lexically_normal().string());
+    EXPECT_EQ(error_of(obj(dir.path())), where + dir.path().lexically_normal().string() + " is a directory, not a file");
   }
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   // tinyobjloader reads "0e999" as 0 * 5^999 * 2^999 = 0 * inf = nan.

@@ -32,7 +32,7 @@ TEST(SceneFiles, MissingFileAndDirectory) {
   test::TempDir dir;
   const fs::path missing = dir / "nope.json";
   EXPECT_EQ(file_error(missing), missing.string() + ": file not found");
-  EXPECT_EQ(file_error(dir.path()), dir.path().string() + ": is a directory, not a scene file");
+  EXPECT_EQ(file_error(dir.path()), dir.path().string() + ": is a directory, not a file");
 }
 
 TEST(SceneFiles, ParseErrorGivesLineAndColumn) {

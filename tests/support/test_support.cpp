@@ -1,7 +1,13 @@
 #include "support/test_support.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
 
 #include <array>
 #include <atomic>
@@ -61,6 +67,70 @@ CommandResult run(const std::filesystem::path& program, const std::vector<std::s
   ::waitpid(pid, &status, 0);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
+}
+
+namespace {
+
+pid_t start(const std::filesystem::path& program, const std::vector<std::string>& args, int out_fd) {
+  std::vector<std::string> copy = args;
+  std::string prog = program.string();
+  std::vector<char*> argv{prog.data()};
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    const int in = ::open("/dev/null", O_RDONLY);
+    if (in >= 0) ::dup2(in, 0);
+    ::dup2(out_fd, 1);
+    ::dup2(out_fd, 2);
+    ::execv(prog.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+}  // namespace
+
+TimedResult run_timed(const std::filesystem::path& program, const std::vector<std::string>& args,
+                      double timeout_seconds) {
+  using Clock = std::chrono::steady_clock;
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const auto begin = Clock::now();
+  const pid_t pid = start(program, args, fds[1]);
+  ::close(fds[1]);
+  TimedResult result;
+  std::array<char, 4096> buffer;
+  for (;;) {
+    const double left = timeout_seconds - std::chrono::duration<double>(Clock::now() - begin).count();
+    if (left <= 0) {
+      result.timed_out = true;
+      ::kill(pid, SIGKILL);
+      break;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    if (::poll(&p, 1, int(left * 1000) + 1) <= 0) continue;
+    const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
+    if (n <= 0) break;
+    result.output.append(buffer.data(), std::size_t(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  rusage usage{};
+  ::wait4(pid, &status, 0, &usage);
+  result.cpu_seconds = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                       double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+  result.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
+  result.exit_code = result.timed_out ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+int spawn(const std::filesystem::path& program, const std::vector<std::string>& args) {
+  const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+  const pid_t pid = start(program, args, null);
+  ::close(null);
+  return pid;
 }
 
 std::string read_file(const std::filesystem::path& file) {

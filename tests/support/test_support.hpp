@@ -33,6 +33,19 @@ struct CommandResult {
 // Runs `program args...` without a shell; stdin is /dev/null.
 CommandResult run(const std::filesystem::path& program, const std::vector<std::string>& args);
 
+// Like run, but kills the command (SIGKILL) after `timeout_seconds`: then exit_code is -1 and timed_out true.
+struct TimedResult : CommandResult {
+  double seconds = 0.0;      // wall time until it exited or was killed
+  double cpu_seconds = 0.0;  // user + system time of the command
+  bool timed_out = false;
+};
+TimedResult run_timed(const std::filesystem::path& program, const std::vector<std::string>& args,
+                      double timeout_seconds);
+
+// Starts `program args...` with stdout and stderr to /dev/null and returns its process id (for tests that
+// signal it); reap it with waitpid.
+int spawn(const std::filesystem::path& program, const std::vector<std::string>& args);
+
 std::string read_file(const std::filesystem::path& file);
 void write_file(const std::filesystem::path& file, const std::string& text);
 

@@ -21,4 +21,13 @@ inline constexpr int kMaxDirectionalLights = 4;
 inline constexpr int kMaxThreads = 256;
 inline constexpr std::uint64_t kMaxTriangles = 1ull << 28;
 
+// Inputs (see docs/testing.md, "Bad input"): every file read is a regular file of at most this many bytes,
+// checked before it is opened; image dimensions are checked from the header (kMaxTextureSide) before decoding.
+inline constexpr std::uint64_t kMaxSceneFileBytes = 16ull << 20;  // JSON scenes are a few KiB
+inline constexpr std::uint64_t kMaxObjFileBytes = 1ull << 30;     // ~30 M triangles of text
+inline constexpr std::uint64_t kMaxMtlFileBytes = 16ull << 20;
+inline constexpr std::uint64_t kMaxImageFileBytes = 4ull << 30;  // a 16384^2 RGBA float image, uncompressed
+inline constexpr int kMaxJsonDepth = 64;                          // nesting of arrays/objects in scenes and --set
+inline constexpr int kMaxFaceVertices = 256;                      // corners of one OBJ face (polygons are ear-clipped)
+
 }  // namespace qdmr::limits

@@ -24,6 +24,17 @@ struct Image {
 
 // Reads any image OpenImageIO can read (8/16-bit, half, float) as normalised floats, no colour conversion.
 // Throws qdmr::Error(where, ...) for missing, unreadable or corrupt files and sizes over the limits.
+// Every check on the file and its header is made before any pixel is decoded (see docs/scene-format.md, "What
+// qdmr accepts as an input file"): a regular file within the size limit, PNG, JPEG, OpenEXR, TIFF or PNM,
+// 1..16384 pixels a side, 1 to 4 channels, sane PNM fields, a JPEG with its end marker. Then a decoder error or
+// warning, or a short read, is an error too: never a partial image.
 Image read_image(const std::filesystem::path& file, const std::string& where);
+
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0;
+  int source_bits = 32;  // as Image::source_bits
+};
+// The checks of read_image up to the header; nothing decoded (for plans and memory estimates).
+ImageHeader read_image_header(const std::filesystem::path& file, const std::string& where);
 
 }  // namespace qdmr

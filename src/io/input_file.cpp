@@ -1,0 +1,146 @@
+#include "io/input_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <mutex>
+
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+
+namespace qdmr {
+namespace {
+
+std::mutex inputs_mutex;
+std::vector<KnownInput>& inputs() {
+  static std::vector<KnownInput> list;
+  return list;
+}
+
+std::string type_reason(mode_t mode) {
+  if (S_ISREG(mode)) return "";
+  if (S_ISDIR(mode)) return "is a directory, not a file";
+  if (S_ISFIFO(mode)) return "is a FIFO (named pipe), not a regular file";
+  if (S_ISSOCK(mode)) return "is a socket, not a regular file";
+  if (S_ISCHR(mode)) return "is a character device, not a regular file";
+  if (S_ISBLK(mode)) return "is a block device, not a regular file";
+  return "is not a regular file";
+}
+
+std::string size_reason(std::uint64_t size, InputKind kind) {
+  if (size == 0) return "is empty (0 bytes)";
+  const std::uint64_t limit = input_size_limit(kind);
+  if (size > limit)
+    return "is " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(limit) + " bytes for a " +
+           input_kind_name(kind);
+  return "";
+}
+
+// "<reason>" when the message already starts with the file (where == file), else "<file> <reason>".
+std::string about(const std::filesystem::path& file, const std::string& where, const std::string& reason) {
+  if (where == file.string()) return reason;
+  if (reason == "file not found") return reason + ": " + file.string();
+  return file.string() + " " + reason;
+}
+
+}  // namespace
+
+const char* input_kind_name(InputKind kind) {
+  switch (kind) {
+    case InputKind::Scene: return "scene file";
+    case InputKind::Obj: return "OBJ file";
+    case InputKind::Mtl: return "MTL file";
+    case InputKind::Image: return "image file";
+    case InputKind::Cache: return "cache file";
+  }
+  return "file";
+}
+
+std::uint64_t input_size_limit(InputKind kind) {
+  switch (kind) {
+    case InputKind::Scene: return limits::kMaxSceneFileBytes;
+    case InputKind::Obj: return limits::kMaxObjFileBytes;
+    case InputKind::Mtl: return limits::kMaxMtlFileBytes;
+    case InputKind::Image: return limits::kMaxImageFileBytes;
+    case InputKind::Cache: return limits::kMaxImageFileBytes;
+  }
+  return 0;
+}
+
+std::string non_regular_reason(const std::filesystem::path& file) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) return "file not found";
+    return std::string("cannot access the file (") + std::strerror(errno) + ")";
+  }
+  return type_reason(st.st_mode);
+}
+
+std::uint64_t check_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) throw Error(where, about(file, where, "file not found"));
+    throw Error(where, about(file, where, std::string("cannot be accessed (") + std::strerror(errno) + ")"));
+  }
+  std::string reason = type_reason(st.st_mode);
+  if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
+  if (!reason.empty()) throw Error(where, about(file, where, reason));
+  note_input(file);
+  return std::uint64_t(st.st_size);
+}
+
+std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
+  check_input_file(file, where, kind);
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) throw Error(where, "cannot open " + file.string() + ": " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw Error(where, "cannot read " + file.string() + ": " + std::strerror(errno));
+  std::string reason = type_reason(st.st_mode);
+  if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
+  if (!reason.empty()) throw Error(where, about(file, where, reason));
+  // Read up to the limit + 1: a file growing while it is read is still bounded.
+  const std::uint64_t limit = input_size_limit(kind);
+  std::string text;
+  text.resize(std::size_t(st.st_size));
+  std::size_t have = 0;
+  for (;;) {
+    if (have == text.size()) {
+      if (text.size() > limit) break;
+      text.resize(std::min<std::size_t>(std::size_t(limit) + 1, text.size() + 65536));
+    }
+    const ssize_t n = ::read(fd, text.data() + have, text.size() - have);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw Error(where, "cannot read " + file.string() + ": " + std::strerror(errno));
+    }
+    if (n == 0) break;
+    have += std::size_t(n);
+  }
+  text.resize(have);
+  if (have > limit || have == 0) throw Error(where, about(file, where, size_reason(have, kind)));
+  return text;
+}
+
+void note_input(const std::filesystem::path& file) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) return;
+  const FileIdentity id{st.st_dev, st.st_ino};
+  const std::lock_guard lock(inputs_mutex);
+  for (const KnownInput& k : inputs())
+    if (k.id == id) return;
+  inputs().push_back({id, file});
+}
+
+std::vector<KnownInput> known_inputs() {
+  const std::lock_guard lock(inputs_mutex);
+  return inputs();
+}
+
+}  // namespace qdmr

@@ -1,0 +1,367 @@
+#!/usr/bin/env python3
+"""Writes tests/bad_inputs/files/ and tests/bad_inputs/cases.json: the malformed inputs checked by
+tests/cli/bad_inputs_corpus_test.cpp. Re-run after editing (needs oiiotool for the few valid images the bad
+ones are cut from); the output is deterministic except the EXR and TIFF files (their headers carry the date written). Special files (FIFOs, sockets, devices, a directory) are not
+stored: the test makes them at run time under special/ in its copy of files/ (see the test).
+
+Placeholders in args and messages: {in} is the test's copy of files/, {out} its empty output folder."""
+import json, os, shutil, struct, subprocess, zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FILES = os.path.join(HERE, "files")
+cases = []
+generated = []  # large files: written by the test from prefix + repeat * count + suffix, not stored
+
+
+def put(rel, data):
+    if data is None:
+        return  # written by put_big
+    path = os.path.join(FILES, rel)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "wb") as f:
+        f.write(data.encode() if isinstance(data, str) else data)
+
+
+def put_big(rel, *parts):
+    """A large file, not stored: the test writes text * count for each (text, count) of parts, in order."""
+    generated.append({"path": rel, "parts": [[t, n] for t, n in parts]})
+    return "".join(t * n for t, n in parts)
+
+
+def case(name, args, message, code=2):
+    assert all(c["name"] != name for c in cases), name
+    cases.append({"name": name, "args": args, "exit": code, "message": message})
+
+
+def render(*extra, scene="{in}/base.json"):
+    return ["render", scene, "-o", "{out}/image.png", *extra]
+
+
+if os.path.isdir(FILES):
+    shutil.rmtree(FILES)
+os.makedirs(FILES)
+
+# --- valid inputs the bad ones are made from ------------------------------------------------------------
+def oiio(*args):
+    subprocess.run(["oiiotool", *args], check=True, capture_output=True)
+
+put("images/.keep", "")
+os.remove(os.path.join(FILES, "images/.keep"))
+oiio("--pattern", "checker:width=8:height=8", "64x64", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/good.png"))
+oiio("--pattern", "fill:topleft=0:topright=1:bottomleft=0:bottomright=1", "64x64", "1", "-d", "uint8",
+     "-o", os.path.join(FILES, "images/good_h.png"))
+oiio("--pattern", "noise:type=white:seed=3", "64x64", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/noise.jpg"))
+oiio("--pattern", "noise:type=white:seed=4", "64x64", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/noise.png"))
+oiio("--pattern", "noise:type=white:seed=5", "64x64", "3", "-d", "float", "-o", os.path.join(FILES, "images/noise.exr"))
+oiio("--pattern", "noise:type=white:seed=6", "64x64", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/noise.tif"))
+oiio("--pattern", "constant:color=0.5,0.5,0.5,0.5,0.5", "8x8", "5", "-d", "uint8", "-o", os.path.join(FILES, "images/five_channels.tif"))
+oiio("--pattern", "constant:color=0.5,0.5,0.5", "8x8", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/image.bmp"))
+oiio("--pattern", "constant:color=0.5,0.5,0.5", "8x8", "3", "-d", "uint8", "-o", os.path.join(FILES, "images/image.tga"))
+
+def read(rel):
+    with open(os.path.join(FILES, rel), "rb") as f:
+        return f.read()
+
+png, jpg, exr, tif = read("images/noise.png"), read("images/noise.jpg"), read("images/noise.exr"), read("images/noise.tif")
+os.remove(os.path.join(FILES, "images/noise.png"))
+
+base = {
+    "output": {"width": 1920, "height": 1080},
+    "materials": {"m": {"layers": [{"albedo": "images/good.png", "height": {"file": "images/good_h.png"}}],
+                        "technique": {"name": "pom"}}},
+    "objects": [{"mesh": {"type": "plane"}, "material": "m"}],
+}
+put("base.json", json.dumps(base, indent=1))
+
+def png_chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+def png_header_only(w, h, color=2, depth=8):
+    return b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, color, 0, 0, 0))
+
+# --- bad images: (file, reason fragment) --------------------------------------------------------------
+images = [
+    ("empty.png", b"", "is empty (0 bytes)"),
+    ("text.png", b"this is not an image\n", "cannot read"),
+    ("garbage.png", bytes((i * 7919) % 256 for i in range(4096)), "cannot read"),
+    ("png_signature_only.png", png[:8], "cannot read"),
+    ("png_header_only.png", png_header_only(64, 64), "cannot read"),
+    ("png_truncated_half.png", png[: len(png) // 2], "cannot read"),
+    ("png_truncated_last_byte.png", png[:-13], "cannot read"),
+    ("png_bad_crc.png", png[:40] + bytes([png[40] ^ 0xFF]) + png[41:], "cannot read"),
+    ("png_zero_width.png", png_header_only(0, 64) + png[33:], "cannot read"),
+    ("png_huge.png", png_header_only(100000, 100000) + png[33:], "cannot read"),
+    ("png_wide.png", png_header_only(20000, 1) + png[33:], "outside 1..16384"),
+    ("jpeg_truncated_half.jpg", jpg[: len(jpg) // 2], "truncated JPEG"),
+    ("jpeg_truncated_end.jpg", jpg[:-2], "truncated JPEG"),
+    ("jpeg_soi_only.jpg", jpg[:2], "cannot read"),
+    ("jpeg_header_only.jpg", jpg[:300], "cannot read"),
+    ("exr_truncated.exr", exr[: len(exr) // 2], "cannot read"),
+    ("exr_magic_only.exr", exr[:4], "cannot read"),
+    ("tiff_truncated.tif", tif[: len(tif) // 2], "cannot read"),
+    ("tiff_header_only.tif", tif[:8], "cannot read"),
+    ("five_channels.tif", None, "5 channels (textures take 1 to 4)"),
+    ("image.bmp", None, "unsupported image format 'bmp'"),
+    ("image.tga", None, "unsupported image format"),
+    ("pgm_maxval_0.pgm", b"P5\n4 4\n0\n" + bytes(16), "PNM maxval 0 is outside 1..65535"),
+    ("ppm_maxval_0.ppm", b"P6\n4 4\n0\n" + bytes(48), "PNM maxval 0 is outside 1..65535"),
+    ("pgm_ascii_maxval_0.pgm", b"P2\n2 2\n0\n0 0 0 0\n", "PNM maxval 0 is outside 1..65535"),
+    ("pgm_maxval_too_big.pgm", b"P5\n4 4\n70000\n" + bytes(32), "PNM maxval 70000 is outside 1..65535"),
+    ("pgm_zero_width.pgm", b"P5\n0 4\n255\n", "is empty"),
+    ("pgm_zero_height.pgm", b"P5\n4 0\n255\n", "is empty"),
+    ("pgm_negative_width.pgm", b"P5\n-4 4\n255\n" + bytes(16), "cannot read"),
+    ("pgm_no_maxval.pgm", b"P5\n4 4\n", "cannot read"),
+    ("pgm_truncated.pgm", b"P5\n64 64\n255\n" + bytes(100), "truncated"),
+    ("pgm_16bit_truncated.pgm", b"P5\n16 16\n65535\n" + bytes(256), "truncated"),
+    ("ppm_truncated.ppm", b"P6\n16 16\n255\n" + bytes(16 * 16 * 3 - 1), "truncated"),
+    ("pbm_truncated.pbm", b"P4\n64 64\n" + bytes(10), "truncated"),
+    ("pgm_huge.pgm", b"P5\n100000 100000\n255\n" + bytes(16), "outside 1..16384"),
+    ("pgm_garbage_header.pgm", b"P5\nfoo bar\n255\n", "cannot read"),
+]
+for name, data, _ in images:
+    if data is not None:
+        put("images/" + name, data)
+
+roles = {
+    "albedo": lambda f: ["--set", "/materials/m/layers/0/albedo=" + f],
+    "height": lambda f: ["--set", '/materials/m/layers/0/height={"file": "%s"}' % f],
+    "normal": lambda f: ["--set", "/materials/m/layers/0/normal=" + f],
+}
+for name, _, reason in images:
+    stem = name.replace(".", "_")
+    for role, option in roles.items():
+        case("image_%s_as_%s" % (stem, role), render(*option("images/" + name)), reason)
+    case("image_%s_as_bake_input" % stem, ["bake", "cone", "{in}/images/" + name, "-o", "{out}/cone.exr"], reason)
+# The blend weights map, another image input.
+for name in ["empty.png", "png_truncated_half.png", "pgm_maxval_0.pgm", "jpeg_truncated_half.jpg"]:
+    case("image_%s_as_weights" % name.replace(".", "_"),
+         render("--set", '/materials/m/layers/-={"height": {"file": "images/good_h.png"}}',
+                "--set", "/materials/m/blend/weights/source=file", "--set", "/materials/m/blend/weights/file=images/" + name),
+         [r for n, _, r in images if n == name][0])
+
+# --- special files (made by the test under special/): every input kind --------------------------------
+specials = {
+    "fifo": "is a FIFO (named pipe), not a regular file",
+    "socket": "is a socket, not a regular file",
+    "zero": "is a character device, not a regular file",
+    "urandom": "is a character device, not a regular file",
+    "null": "is a character device, not a regular file",
+    "folder": "is a directory, not a file",
+}
+for s, reason in specials.items():
+    case("special_%s_as_scene" % s, render(scene="{in}/special/" + s), reason)
+    for role, option in roles.items():
+        case("special_%s_as_%s" % (s, role), render(*option("special/" + s)), reason)
+    case("special_%s_as_obj" % s, render("--set", '/objects/0={"mesh": {"type": "obj", "file": "special/%s"}}' % s), reason)
+    put("obj/mtl_is_%s.mtl" % s, "")  # placeholder name kept free; the OBJ names the special file directly
+    os.remove(os.path.join(FILES, "obj/mtl_is_%s.mtl" % s))
+    put("obj/mtllib_%s.obj" % s, "mtllib ../special/%s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n" % s)
+    case("special_%s_as_mtl" % s, render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/mtllib_%s.obj"}}' % s),
+         reason if s != "folder" else "is a directory")
+    put("obj/map_%s.mtl" % s, "newmtl a\nmap_Kd ../special/%s\n" % s)
+    put("obj/map_%s.obj" % s, "mtllib map_%s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n" % s)
+    case("special_%s_as_mtl_map" % s, render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/map_%s.obj"}}' % s), reason)
+    case("special_%s_as_bake_input" % s, ["bake", "cone", "{in}/special/" + s, "-o", "{out}/cone.exr"], reason)
+case("device_path_dev_zero_as_scene", render(scene="/dev/zero"), "is a character device")
+case("device_path_dev_zero_as_height", render("--set", '/materials/m/layers/0/height={"file": "/dev/zero"}'), "is a character device")
+case("device_path_dev_urandom_as_albedo", render("--set", "/materials/m/layers/0/albedo=/dev/urandom"), "is a character device")
+
+# --- MTL maps that are bad files ----------------------------------------------------------------------
+for name in ["empty.png", "png_truncated_half.png", "jpeg_truncated_half.jpg", "pgm_maxval_0.pgm", "garbage.png"]:
+    stem = name.replace(".", "_")
+    for key in ["map_Kd", "disp", "bump", "norm"]:
+        put("obj/%s_%s.mtl" % (key, stem), "newmtl a\n%s ../images/%s\n" % (key, name))
+        put("obj/%s_%s.obj" % (key, stem), "mtllib %s_%s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n" % (key, stem))
+        case("mtl_%s_%s" % (key, stem), render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/%s_%s.obj"}}' % (key, stem)),
+             [r for n, _, r in images if n == name][0])
+
+# --- OBJ and MTL files --------------------------------------------------------------------------------
+tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+objs = [
+    ("empty.obj", "", "is empty (0 bytes)"),
+    ("comments_only.obj", "# nothing\n# here\n", "no faces"),
+    ("vertices_only.obj", tri, "no faces"),
+    ("face_two_vertices.obj", tri + "f 1 2\n", "line 4: a face needs at least 3 vertices, this one has 2"),
+    ("face_one_vertex.obj", tri + "f 1\n", "line 4: a face needs at least 3 vertices, this one has 1"),
+    ("face_no_vertices.obj", tri + "f\n", "line 4: a face needs at least 3 vertices, this one has 0"),
+    ("face_two_then_good.obj", tri + "f 1 2 3\nf 2 3\n", "line 5: a face needs at least 3 vertices"),
+    ("face_index_zero.obj", tri + "f 0 1 2\n", "line 4: face index 0"),
+    ("face_index_too_big.obj", tri + "f 1 2 4\n", "line 4: position index 4 in '4' is out of range"),
+    ("face_index_huge.obj", tri + "f 1 2 99999999999999999999\n", "line 4: cannot read the face index"),
+    ("face_index_negative_too_far.obj", tri + "f -1 -2 -4\n", "line 4: position index -4"),
+    ("face_index_forward_negative.obj", "f -1 -2 -3\n" + tri, "line 1: position index -1"),
+    ("face_uv_out_of_range.obj", tri + "vt 0 0\nf 1/1 2/2 3/1\n", "texture coordinate index 2"),
+    ("face_normal_out_of_range.obj", tri + "vn 0 0 1\nf 1//1 2//2 3//1\n", "normal index 2"),
+    ("face_index_word.obj", tri + "f a b c\n", "line 4: cannot read the face index 'a'"),
+    ("face_index_float.obj", tri + "f 1.5 2 3\n", "cannot read the face index '1.5'"),
+    ("face_too_many_slashes.obj", tri + "f 1/1/1/1 2 3\n", "line 4:"),
+    ("face_too_many_vertices.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf " + " ".join(["1", "2", "3"] * 100) + "\n",
+     "line 4: a face has more than 256 vertices"),
+    ("face_one_megabyte_line.obj", put_big("obj/face_one_megabyte_line.obj", (tri + "f", 1), (" 1 2 3", 180000), ("\n", 1)) and None, "a face has more than 256 vertices"),
+    ("vertex_nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component 'nan' is not a finite number"),
+    ("vertex_inf.obj", "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component 'inf'"),
+    ("vertex_minus_inf.obj", "v 0 0 0\nv 0 -inf 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component '-inf'"),
+    ("vertex_overflow.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n", "position of vertex 2 is not finite"),
+    ("vertex_huge_exponent.obj", "v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component '1e999'"),
+    ("vertex_word.obj", "v 0 0 0\nv one 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component 'one'"),
+    ("uv_nan.obj", tri + "vt nan 0\nf 1/1 2/1 3/1\n", "line 4: texture coordinate component 'nan'"),
+    ("normal_inf.obj", tri + "vn 0 0 inf\nf 1//1 2//1 3//1\n", "line 4: normal component 'inf'"),
+    ("binary_garbage.obj", bytes((i * 31337) % 256 for i in range(2048)), None),
+    ("missing_mtl.obj", "mtllib nowhere.mtl\n" + tri + "f 1 2 3\n", "material library not found"),
+    ("unknown_material.obj", "mtllib one.mtl\n" + tri + "usemtl other\nf 1 2 3\n", "not found in .mtl"),
+    ("empty_mtl.obj", "mtllib empty.mtl\n" + tri + "f 1 2 3\n", "empty.mtl is empty (0 bytes)"),
+    ("mtl_map_missing.obj", "mtllib map_missing.mtl\n" + tri + "usemtl a\nf 1 2 3\n", "file not found"),
+    ("long_comment_line.obj", put_big("obj/long_comment_line.obj", ("#", 1), ("x", 2000000), ("\n" + tri + "f 1 2\n", 1)) and None, "line 5: a face needs at least 3 vertices"),
+    ("long_vertex_line.obj", put_big("obj/long_vertex_line.obj", ("v 0 0 0 ", 1), ("1 ", 500000), ("\nv 1 0 0\nv 0 1 0\nf 1 2\n", 1)) and None, "line 4: a face needs at least 3 vertices"),
+]
+for name, text, message in objs:
+    put("obj/" + name, text)
+put("obj/one.mtl", "newmtl one\nKd 1 0 0\n")
+put("obj/empty.mtl", "")
+put("obj/map_missing.mtl", "newmtl a\nmap_Kd nowhere.png\n")
+for name, _, message in objs:
+    if message is None:
+        continue
+    case("obj_" + name.replace(".", "_"), render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/%s"}}' % name), message)
+case("obj_binary_garbage_obj", render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/binary_garbage.obj"}}'), "obj/binary_garbage.obj")
+
+# --- scene files -------------------------------------------------------------------------------------
+scenes = [
+    ("empty.json", "", "is empty (0 bytes)"),
+    ("whitespace.json", "  \n\n ", "parse error at line 3"),
+    ("truncated.json", json.dumps(base)[:60], "parse error"),
+    ("trailing_comma.json", '{"objects": [],}', "parse error"),
+    ("comment.json", '// a scene\n{"objects": []}', "parse error at line 1"),
+    ("nan_literal.json", '{"output": {"width": NaN}, "objects": []}', "parse error"),
+    ("number_overflow.json", '{"output": {"width": 1e400}, "objects": []}', "number_overflow.json: number overflow parsing '1e400'"),
+    ("width_float_overflow.json", '{"output": {"width": 1e300}, "objects": []}', "expected a finite number"),
+    ("null_root.json", "null", "expected an object, got null"),
+    ("array_root.json", "[]", "expected an object, got array"),
+    ("string_root.json", '"scene"', "expected an object, got string"),
+    ("nested_100.json", "[" * 100 + "]" * 100, "nesting deeper than 64 levels"),
+    ("nested_100000.json", put_big("scenes/nested_100000.json", ("[", 100000), ("]", 100000)) and None, "nesting deeper than 64 levels"),
+    ("nested_objects.json", '{"a":' * 1000 + "1" + "}" * 1000, "nesting deeper than 64 levels"),
+    ("nested_unclosed.json", put_big("scenes/nested_unclosed.json", ("[", 1000000)) and None, "nesting deeper than 64 levels"),
+    ("binary.json", bytes((i * 7) % 256 for i in range(1000)), "parse error"),
+    ("utf16.json", '{"objects": []}'.encode("utf-16"), "parse error"),
+    ("long_key.json", put_big("scenes/long_key.json", ('{"', 1), ("k", 1000000), ('": 1, "objects": []}', 1)) and None, "unknown key 'kkkkkkkk"),
+    ("long_string.json", put_big("scenes/long_string.json", ('{"materials": {"m": {"layers": [{"albedo": "', 1), ("a", 100000), ('"}]}}, "objects": []}', 1)) and None, "File name too long"),
+    ("width_zero.json", '{"output": {"width": 0}, "objects": []}', "/output/width: must be an integer from 1 to 16384, got 0"),
+    ("width_negative.json", '{"output": {"width": -1}, "objects": []}', "/output/width: must be an integer from 1 to 16384, got -1"),
+    ("width_fraction.json", '{"output": {"width": 1.5}, "objects": []}', "/output/width: expected an integer, got 1.5"),
+    ("width_string.json", '{"output": {"width": "wide"}, "objects": []}', "/output/width: expected a number, got string"),
+    ("too_many_pixels.json", '{"output": {"width": 16384, "height": 16384}, "objects": []}', "more than the limit"),
+    ("fov_zero.json", '{"camera": {"fov_deg": 0}, "objects": []}', "/camera/fov_deg"),
+    ("fov_180.json", '{"camera": {"fov_deg": 180}, "objects": []}', "/camera/fov_deg"),
+    ("near_after_far.json", '{"camera": {"near": 10, "far": 1}, "objects": []}', "/camera/"),
+    ("unknown_key.json", '{"outptu": {}, "objects": []}', "unknown key 'outptu'; did you mean 'output'?"),
+    ("unknown_material.json", '{"objects": [{"mesh": {"type": "plane"}, "material": "none"}]}', "/objects/0/material"),
+    ("objects_not_array.json", '{"objects": {}}', "/objects: expected an array"),
+    ("mesh_unknown_type.json", '{"objects": [{"mesh": {"type": "teapot"}}]}', "/objects/0/mesh/type: unknown value 'teapot'"),
+    ("obj_missing_file.json", '{"objects": [{"mesh": {"type": "obj", "file": "nothing.obj"}}]}', "file not found"),
+    ("obj_empty_path.json", '{"objects": [{"mesh": {"type": "obj", "file": ""}}]}', "expected a file path, got an empty string"),
+    ("obj_path_is_folder.json", '{"objects": [{"mesh": {"type": "obj", "file": "."}}]}', "is a directory, not a file"),
+    ("texture_path_is_folder.json", '{"materials": {"m": {"layers": [{"albedo": "."}]}}, "objects": [{"mesh": {"type": "plane"}, "material": "m"}]}', "is a directory, not a file"),
+    ("procedural_size_zero.json", '{"materials": {"m": {"layers": [{"height": {"procedural": "noise", "size": 0}}]}}, "objects": [{"mesh": {"type": "plane"}, "material": "m"}]}', "/materials/m/layers/0/height/size"),
+    ("procedural_size_huge.json", '{"materials": {"m": {"layers": [{"height": {"procedural": "noise", "size": 1000000}}]}}, "objects": [{"mesh": {"type": "plane"}, "material": "m"}]}', "/materials/m/layers/0/height/size"),
+    ("too_many_layers.json", '{"materials": {"m": {"layers": [{}, {}, {}, {}, {}]}}, "objects": [{"mesh": {"type": "plane"}, "material": "m"}]}', "/materials/m/layers"),
+    ("light_nan_direction.json", '{"lights": [{"type": "directional", "direction": [0, 0, 0]}], "objects": []}', "/lights/0/direction"),
+]
+for name, text, message in scenes:
+    put("scenes/" + name, text)
+    case("scene_" + name.replace(".", "_"), render(scene="{in}/scenes/" + name), message)
+case("scene_missing", render(scene="{in}/scenes/nothing.json"), "file not found")
+# A scene larger than the 16 MiB limit: a valid JSON document padded with spaces.
+put_big("scenes/oversized.json", ('{"objects": []}', 1), (" ", 16 * 1024 * 1024))
+case("scene_oversized", render(scene="{in}/scenes/oversized.json"), "more than the limit of 16777216 bytes for a scene file")
+
+# --- command-line arguments ---------------------------------------------------------------------------
+args = [
+    ("threads_zero", render("--threads", "0"), "--threads: must be from 1 to 256, got 0"),
+    ("threads_negative", render("--threads", "-3"), "--threads: must be from 1 to 256, got -3"),
+    ("threads_too_many", render("--threads", "257"), "--threads: must be from 1 to 256, got 257"),
+    ("threads_overflow", render("--threads", "99999999999"), "--threads"),
+    ("threads_word", render("--threads", "many"), "--threads"),
+    ("tile_zero", render("--tile", "0"), "--tile: must be a multiple of 8 between 8 and 1024, got 0"),
+    ("tile_seven", render("--tile", "7"), "--tile: must be a multiple of 8 between 8 and 1024, got 7"),
+    ("tile_negative", render("--tile", "-8"), "--tile: must be a multiple of 8 between 8 and 1024, got -8"),
+    ("tile_huge", render("--tile", "2048"), "--tile: must be a multiple of 8 between 8 and 1024, got 2048"),
+    ("width_zero", render("--width", "0"), "/output/width: must be an integer from 1 to 16384, got 0"),
+    ("width_negative", render("--width", "-1920"), "/output/width: must be an integer from 1 to 16384, got -1920"),
+    ("width_huge", render("--width", "65536"), "/output/width: must be an integer from 1 to 16384, got 65536"),
+    ("width_word", render("--width", "wide"), "--width"),
+    ("height_zero", render("--height", "0"), "/output/height: must be an integer from 1 to 16384, got 0"),
+    ("height_huge", render("--height", "100000"), "/output/height: must be an integer from 1 to 16384"),
+    ("pixels_over_limit", render("--width", "16384", "--height", "16384"), "more than the limit"),
+    ("max_memory_zero", render("--max-memory", "0"), "--max-memory: must be from 1 to 1073741824 (MiB), got 0"),
+    ("max_memory_negative", render("--max-memory", "-5"), "--max-memory: must be from 1 to 1073741824 (MiB), got -5"),
+    ("max_memory_exceeded", render("--max-memory", "16"), "more than the limit of 16 MiB (--max-memory)"),
+    ("max_memory_big_output", render("--width", "16384", "--height", "8192", "--max-memory", "1024"), "more than the limit of 1024 MiB"),
+    ("set_no_equals", render("--set", "camera"), "expected POINTER=VALUE"),
+    ("set_no_slash", render("--set", "camera/fov_deg=30"), "the JSON pointer must start with '/'"),
+    ("set_bad_escape", render("--set", "/camera~2/fov=1"), "invalid JSON pointer"),
+    ("set_root", render("--set", "/=1"), "unknown key ''"),
+    ("set_through_number", render("--set", "/output/width/x=1"), "cannot apply --set"),
+    ("set_array_index_out_of_range", render("--set", "/objects/7=1"), "no element '7' in /objects"),
+    ("set_array_bad_index", render("--set", "/objects/01=1"), "no element '01' in /objects"),
+    ("set_empty_array_token", render("--set", "/objects/=1"), "/objects/: cannot apply --set: unresolved reference token ''"),
+    ("set_deep_value", render("--set", "/camera/fov_deg=" + "[" * 200 + "]" * 200), "nesting deeper than 64 levels"),
+    ("set_wrong_type", render("--set", "/camera/fov_deg=true"), "/camera/fov_deg: expected a number, got boolean"),
+    ("set_fov_out_of_range", render("--set", "/camera/fov_deg=0"), "/camera/fov_deg"),
+    ("set_long_value", render("--set", "/camera/fov_deg=" + "9" * 5000), "/camera/fov_deg"),
+    ("aov_unknown", render("--aov", "albedo={out}/a.exr"), "unknown AOV 'albedo'"),
+    ("aov_no_file", render("--aov", "depth"), "expected NAME=FILE"),
+    ("aov_empty_name", render("--aov", "={out}/a.exr"), "expected NAME=FILE"),
+    ("aov_twice", render("--aov", "depth={out}/a.exr", "--aov", "depth={out}/b.exr"), "AOV 'depth' given twice"),
+    ("aov_same_as_output", render("--aov", "depth={out}/image.png"), "is the same file as -o"),
+    ("aov_same_as_output_other_spelling", render("--aov", "depth={out}/../out/image.png"), "is the same file as -o"),
+    ("aov_same_as_other_aov", render("--aov", "depth={out}/a.exr", "--aov", "normal={out}/./a.exr"), "is the same file as --aov"),
+    ("stats_same_as_output", render("--stats", "{out}/image.png"), "is the same file as -o"),
+    ("output_jpg", ["render", "{in}/base.json", "-o", "{out}/image.jpg"], "unsupported image type '.jpg'"),
+    ("output_no_extension", ["render", "{in}/base.json", "-o", "{out}/image"], "unsupported image type ''"),
+    ("output_folder_missing", ["render", "{in}/base.json", "-o", "{out}/missing/image.png"], "folder does not exist"),
+    ("output_is_folder", ["render", "{in}/base.json", "-o", "{in}/special/folder.png"], "is a directory, not a file"),
+    ("output_is_fifo", ["render", "{in}/base.json", "-o", "{in}/special/fifo.png"], "is a FIFO (named pipe)"),
+    ("output_is_device", ["render", "{in}/base.json", "-o", "{in}/special/null.png"], "is a character device"),
+    ("output_is_scene", ["render", "{in}/scenes/scene.exr", "-o", "{in}/scenes/scene.exr"], "refusing to overwrite an input of this job"),
+    ("output_is_scene_other_spelling", ["render", "{in}/scenes/scene.exr", "-o", "{in}/images/../scenes/scene.exr"], "refusing to overwrite an input of this job"),
+    ("output_is_albedo", ["render", "{in}/base.json", "-o", "{in}/images/good.png"], "refusing to overwrite an input of this job: {in}/images/good.png"),
+    ("output_is_height", ["render", "{in}/base.json", "-o", "{in}/images/good_h.png"], "refusing to overwrite an input of this job: {in}/images/good_h.png"),
+    ("output_is_albedo_via_dots", ["render", "{in}/base.json", "-o", "{in}/obj/../images/good.png"], "refusing to overwrite an input of this job"),
+    ("output_is_symlink_to_albedo", ["render", "{in}/base.json", "-o", "{in}/special/link_to_good.png"], "refusing to overwrite an input of this job"),
+    ("output_is_hard_link_to_albedo", ["render", "{in}/base.json", "-o", "{in}/special/hardlink_to_good.png"], "refusing to overwrite an input of this job"),
+    ("aov_is_height", render("--aov", "depth={in}/images/good_h.png"), "refusing to overwrite an input of this job"),
+    ("stats_is_scene", render("--stats", "{in}/base.json"), "refusing to overwrite an input of this job: {in}/base.json"),
+    ("output_is_mtl_map", ["render", "{in}/base.json", "--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/textured.obj"}}',
+                           "-o", "{in}/obj/textured.png"], "refusing to overwrite an input of this job"),
+    ("output_is_obj_texture_hard_link", ["render", "{in}/base.json", "--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/textured.obj"}}',
+                                         "-o", "{in}/special/hardlink_to_textured.png"], "refusing to overwrite an input of this job"),
+    ("bake_output_is_input", ["bake", "cone", "{in}/images/good.exr", "-o", "{in}/images/good.exr"], "refusing to overwrite an input of this job"),
+    ("bake_output_not_exr", ["bake", "cone", "{in}/images/good_h.png", "-o", "{out}/cone.png"], "the cone map is written as .exr"),
+    ("bake_kind", ["bake", "cone", "{in}/images/good_h.png", "-o", "{out}/cone.exr", "--kind", "loose"], "unknown cone kind"),
+    ("bake_channel", ["bake", "cone", "{in}/images/good_h.png", "-o", "{out}/cone.exr", "--channel", "x"], "unknown channel"),
+    ("bake_channel_absent", ["bake", "cone", "{in}/images/good_h.png", "-o", "{out}/cone.exr", "--channel", "a"], "no channel 'a'"),
+    ("bake_address", ["bake", "cone", "{in}/images/good_h.png", "-o", "{out}/cone.exr", "--address", "repeat"], "unknown address mode"),
+    ("bake_missing_input", ["bake", "cone", "{in}/images/none.png", "-o", "{out}/cone.exr"], "file not found"),
+    ("plan_unknown_aov", ["plan", "{in}/base.json", "--aov", "albedo"], "unknown AOV 'albedo'"),
+    ("plan_special_scene", ["plan", "{in}/special/fifo"], "is a FIFO"),
+    ("unknown_subcommand", ["draw", "{in}/base.json"], "A subcommand is required"),
+    ("unknown_option", render("--widht", "5"), "--widht"),
+    ("missing_output", ["render", "{in}/base.json"], "--output is required"),
+    ("missing_scene", ["render", "-o", "{out}/image.png"], "scene is required"),
+    ("bake_no_subcommand", ["bake"], "A subcommand is required"),
+]
+for name, a, message in args:
+    case("arg_" + name, a, message)
+put("scenes/scene.exr", json.dumps(base).replace("images/", "../images/"))
+oiio("--pattern", "constant:color=0.5", "16x16", "1", "-d", "float", "-o", os.path.join(FILES, "images/good.exr"))
+shutil.copy(os.path.join(FILES, "images/good.png"), os.path.join(FILES, "obj/textured.png"))
+put("obj/textured.mtl", "newmtl a\nmap_Kd textured.png\n")
+put("obj/textured.obj", "mtllib textured.mtl\n" + tri + "vt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n")
+
+with open(os.path.join(HERE, "cases.json"), "w") as f:
+    json.dump({"comment": "Written by make_corpus.py; checked by tests/cli/bad_inputs_corpus_test.cpp.",
+               "generated": generated, "cases": cases},
+              f, indent=1)
+files = sum(len(fs) for _, _, fs in os.walk(FILES))
+print("%d cases, %d files stored, %d generated by the test" % (len(cases), files, len(generated)))
