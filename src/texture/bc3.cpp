@@ -1,8 +1,7 @@
 #include "qdmr/texture/bc3.hpp"
 
-#include <emmintrin.h>  // SSE2: part of x86-64, so the AVX2 and SSE4.2 builds run the same integer kernel
-
 #include <tbb/parallel_for.h>
+#include <xsimd/xsimd.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +12,9 @@ namespace qdmr {
 namespace {
 
 using Palette = std::array<std::uint8_t, 8>;
+// The 16 texels of a block in one SSE2 register (part of x86-64: the same integer kernel on every CPU).
+using Texels = xsimd::batch<std::uint8_t, xsimd::sse2>;
+static_assert(Texels::size == 16);
 
 // A mode's palette in ascending order, and the block index that selects each entry.
 constexpr Palette kIndexOf8 = {1, 7, 6, 5, 4, 3, 2, 0};
@@ -35,20 +37,17 @@ Palette ascending6(int a0, int a1) {
 }
 
 // Sum over the 16 texels of the squared distance to the nearest palette entry.
-int squared_error(__m128i texels, const Palette& q) {
-  __m128i nearest = _mm_set1_epi8(-1);
+int squared_error(const Texels& texels, const Palette& q) {
+  Texels nearest(std::uint8_t(255));
   for (std::uint8_t p : q) {
-    const __m128i entry = _mm_set1_epi8(static_cast<char>(p));
-    const __m128i distance = _mm_or_si128(_mm_subs_epu8(texels, entry), _mm_subs_epu8(entry, texels));
-    nearest = _mm_min_epu8(nearest, distance);
+    const Texels entry(p);
+    nearest = xsimd::min(nearest, xsimd::ssub(texels, entry) | xsimd::ssub(entry, texels));  // |t - p|
   }
-  const __m128i zero = _mm_setzero_si128();
-  const __m128i lo = _mm_unpacklo_epi8(nearest, zero);
-  const __m128i hi = _mm_unpackhi_epi8(nearest, zero);
-  __m128i sum = _mm_add_epi32(_mm_madd_epi16(lo, lo), _mm_madd_epi16(hi, hi));
-  sum = _mm_add_epi32(sum, _mm_shuffle_epi32(sum, _MM_SHUFFLE(1, 0, 3, 2)));
-  sum = _mm_add_epi32(sum, _mm_shuffle_epi32(sum, _MM_SHUFFLE(2, 3, 0, 1)));
-  return _mm_cvtsi128_si32(sum);
+  alignas(16) std::uint8_t distance[16];
+  nearest.store_aligned(distance);
+  int sum = 0;
+  for (const int d : distance) sum += d * d;
+  return sum;
 }
 
 struct Candidate {
@@ -61,7 +60,7 @@ struct Candidate {
 constexpr int kMaxShrink = 3;
 
 template <class MakePalette>
-void search(__m128i texels, int a0_from, int a0_to, int a1_from, int a1_to, bool eight, MakePalette make,
+void search(const Texels& texels, int a0_from, int a0_to, int a1_from, int a1_to, bool eight, MakePalette make,
             Candidate& best) {
   for (int a0 = std::max(a0_from, 0); a0 <= std::min(a0_to, 255); ++a0) {
     for (int a1 = std::max(a1_from, 0); a1 <= std::min(a1_to, 255); ++a1) {
@@ -90,7 +89,7 @@ Bc3AlphaBlock pack(int a0, int a1, const Palette& ascending, const Palette& inde
 }  // namespace
 
 Bc3AlphaBlock encode_bc3_alpha(const std::uint8_t texels[16]) {
-  const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(texels));
+  const Texels v = Texels::load_unaligned(texels);
   int lo = 255, hi = 0, lo6 = 255, hi6 = 0;
   for (int i = 0; i < 16; ++i) {
     const int t = texels[i];

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # One binary for every x86-64 CPU: runs the qdmr command under QEMU's user-mode emulation of a CPU without AVX
 # (Nehalem: SSE4.2, no AVX/AVX2/FMA). It must render with the SSE4.2 kernel, give the same pixels as this
-# machine's native SSE4.2 run, and refuse --isa avx2 with exit 2 and a message (never SIGILL).
+# machine's native SSE4.2 run, and refuse --isa avx2 and --isa avx512 with exit 2 and a message (never SIGILL).
 # Skipped (exit 77) when qemu-x86_64 is not installed.
 set -u
 qdmr="$1"
@@ -25,10 +25,12 @@ case "$out" in *sse4.2*) ;; *) echo "FAIL: the emulated run did not report the s
 if ! idiff -q -fail 0 "$dir/native.exr" "$dir/emulated.exr" >/dev/null 2>&1; then
   echo "FAIL: the emulated pixels differ from the native SSE4.2 pixels"; exit 1
 fi
-out=$(qemu-x86_64 -cpu Nehalem "$qdmr" "${common[@]}" --isa avx2 -o "$dir/x.png" 2>&1)
-code=$?
-echo "$out"
-if [ $code -ne 2 ]; then echo "FAIL: --isa avx2 on a CPU without AVX2 exited $code, expected 2"; exit 1; fi
-case "$out" in *"does not support avx2"*) ;; *) echo "FAIL: no message naming avx2"; exit 1;; esac
-[ ! -e "$dir/x.png" ] || { echo "FAIL: an output was written"; exit 1; }
+for isa in avx2 avx512; do
+  out=$(qemu-x86_64 -cpu Nehalem "$qdmr" "${common[@]}" --isa $isa -o "$dir/x.png" 2>&1)
+  code=$?
+  echo "$out"
+  if [ $code -ne 2 ]; then echo "FAIL: --isa $isa on a CPU without it exited $code, expected 2"; exit 1; fi
+  case "$out" in *"does not support $isa"*) ;; *) echo "FAIL: no message naming $isa"; exit 1;; esac
+  [ ! -e "$dir/x.png" ] || { echo "FAIL: an output was written"; exit 1; }
+done
 echo "PASS"
