@@ -9,15 +9,6 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
-using simd::Float;
-using simd::Int;
-using simd::IntMask;
-using simd::kLanes;
-using simd::Mask;
-using simd::count;
-using simd::float_mask;
-using simd::int_mask;
-
 // The level-0 texels cone stepping reads: a height and a cone ratio each, addressed like the height map.
 struct ConeTexels {
   const ConeMap* cones;

@@ -5,15 +5,6 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
-using simd::Float;
-using simd::Int;
-using simd::IntMask;
-using simd::kLanes;
-using simd::Mask;
-using simd::count;
-using simd::float_mask;
-using simd::int_mask;
-
 // Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
 // the ray with the line through the last two height samples.
 template <class Surface>

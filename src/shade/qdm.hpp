@@ -7,15 +7,6 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
-using simd::Float;
-using simd::Int;
-using simd::IntMask;
-using simd::kLanes;
-using simd::Mask;
-using simd::count;
-using simd::float_mask;
-using simd::int_mask;
-
 // Quadtree displacement mapping (Drobot 2009) over the max-quadtree: from the root, advance to the nearer of
 // the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
 // level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped

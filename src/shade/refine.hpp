@@ -6,15 +6,6 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
-using simd::Float;
-using simd::Int;
-using simd::IntMask;
-using simd::kLanes;
-using simd::Mask;
-using simd::count;
-using simd::float_mask;
-using simd::int_mask;
-
 // The exact bilinear-patch hit (refine.cpp): from the point where the ray reached the conservative bound, the
 // patches of `surface` are walked cell by cell and solved analytically in fp64 (the reference's traversal).
 Float bilinear_patch(const Ray& ray, const Float& ds, const Float& s_start, Float& iterations, Mask active,

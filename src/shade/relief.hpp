@@ -5,15 +5,6 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
-using simd::Float;
-using simd::Int;
-using simd::IntMask;
-using simd::kLanes;
-using simd::Mask;
-using simd::count;
-using simd::float_mask;
-using simd::int_mask;
-
 // Relief mapping (Policarpo 2005): fixed linear steps from the top, then a binary search in the last step.
 template <class Surface>
 Hit relief(const Surface& surface, const Ray& ray, const Float& ds,

@@ -6,6 +6,7 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
+// The SIMD vocabulary of every technique file (they all live in this namespace and include this header).
 using simd::Float;
 using simd::Int;
 using simd::IntMask;
