@@ -1,5 +1,7 @@
 #include "qdmr/core/isa.hpp"
 
+#include <cpuid.h>
+
 #include <algorithm>
 #include <cstdlib>
 
@@ -23,13 +25,23 @@ std::optional<Isa> parse_isa(std::string_view name) {
   return std::nullopt;
 }
 
+namespace {
+
+// F16C from CPUID leaf 1, ECX bit 29 (clang's __builtin_cpu_supports does not know "f16c").
+bool cpu_has_f16c() {
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  return __get_cpuid(1, &a, &b, &c, &d) && (c & (1u << 29)) != 0;
+}
+
+}  // namespace
+
 bool cpu_supports(Isa isa) {
   // GCC's CPUID probe (it also checks that the OS saves the wider registers).
   __builtin_cpu_init();
   switch (isa) {
     case Isa::Auto: return true;
     case Isa::Sse42: return __builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt");
-    case Isa::Avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("f16c") && __builtin_cpu_supports("popcnt");
+    case Isa::Avx2: return __builtin_cpu_supports("avx2") && cpu_has_f16c() && __builtin_cpu_supports("popcnt");
     case Isa::Avx512: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
   }
   return false;
