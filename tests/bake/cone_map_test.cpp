@@ -303,8 +303,9 @@ void march_all(const HeightField& f, const ConeMap& cones, bool stop_below,
               }
               const double ratio = cones.ratio[std::size_t(my * f.width + mx)];
               // S_p along the ray: { t' : dist(uv(t'), cell) <= ratio (h(t') - hp) }, an interval (S_p is convex).
-              auto inside = [&](double tt) {
-                return distance_to_cell(f, r.u + tt * r.du, r.v + tt * r.dv, x, y) <= ratio * (1.0 - tt - hp) + kInside;
+              // Captured by copy: clang 14 cannot capture structured bindings (C++20 allows it; clang 16 does).
+              auto inside = [&, cx = x, cy = y](double tt) {
+                return distance_to_cell(f, r.u + tt * r.du, r.v + tt * r.dv, cx, cy) <= ratio * (1.0 - tt - hp) + kInside;
               };
               double lo = t, hi = t + (h - hp);
               const bool to_top = inside(hi);  // the step reaches p's top: a hit
