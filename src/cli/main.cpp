@@ -15,11 +15,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/bench.hpp"
+#include "cli/check.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_check.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/version.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
 #include "qdmr/load/load.hpp"
@@ -231,9 +233,13 @@ int main(int argc, char** argv) {
       "  qdmr render scenes/plane.json -o plane.png\n"
       "  qdmr render scenes/terrain.json -o t.exr --set /camera/fov_deg=30 --aov depth=depth.exr --stats stats.json\n"
       "  qdmr plan scenes/terrain.json\n"
-      "  qdmr bench scenes/terrain.json --frames 20 --json bench.json\n\n"
+      "  qdmr bench scenes/terrain.json --frames 20 --json bench.json\n"
+      "  qdmr check tests/golden/shipped_scenes.json --junit junit.xml --report check-report\n"
+      "  qdmr diff a.exr b.exr --max-abs 0.01 --heatmap diff.png\n\n"
       "The scene format is described in docs/scene-format.md."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("qdmr ") + qdmr::version() + " (bits version " +
+                                        std::to_string(qdmr::kBitsVersion) + ")");
 
   SceneArgs render_scene;
   RenderArgs render;
@@ -297,6 +303,35 @@ int main(int argc, char** argv) {
   cone_cmd->add_option("--channel", cone.channel, "Channel holding the heights: r (default), g, b or a");
   cone_cmd->add_option("--address", cone.address, "Address mode of the map: wrap (default), clamp or mirror");
 
+  qdmr::cli::CheckArgs check;
+  CLI::App* check_cmd = app.add_subcommand(
+      "check", "Golden-image checks: render every check of a manifest (or one scene) and compare with its golden "
+               "hash or image (docs/checks.md). Exit 0: all pass, 1: some fail, 2: cannot run");
+  check_cmd->add_option("target", check.target, "Check manifest (JSON), or a scene with --golden or --hash")->required();
+  check_cmd->add_option("--golden", check.golden, "One-off form: compare the scene's image with this golden image");
+  check_cmd->add_option("--hash", check.hash, "One-off form: the scene's image must have this canonical hash (sha1:...)");
+  check_cmd->add_option("--set", check.sets, "One-off form: override a scene value, /json/pointer=VALUE (repeatable)");
+  check_cmd->add_option("--width", check.width, "One-off form: override /output/width");
+  check_cmd->add_option("--height", check.height, "One-off form: override /output/height");
+  check.tolerance.add_to(*check_cmd);
+  check_cmd->add_flag("--update", check.update,
+                      "Rewrite the goldens (or hashes) of failing and missing checks, atomically, and print what changed");
+  check_cmd->add_option("--junit", check.junit, "Write JUnit XML here (one test case per check)");
+  check_cmd->add_option("--report", check.report,
+                        "Write an HTML page of every failure to DIR/index.html (the diff folders go into DIR)");
+  check_cmd->add_option("--diff-dir", check.diff_dir, "Where the diff folder of each failed check goes (default qdmr-check-failures)");
+  check_cmd->add_option("--jobs", check.jobs, "Checks rendered at once, each with its own renderer (default 1)");
+  check_cmd->add_option("--threads", check.threads, "Worker threads over all jobs (default: every core)");
+
+  qdmr::cli::DiffArgs diff;
+  CLI::App* diff_cmd = app.add_subcommand(
+      "diff", "Compare two images (any format OpenImageIO reads) with the check metrics. Exit 0: within the "
+              "tolerance, 1: not, 2: unreadable");
+  diff_cmd->add_option("a", diff.a, "First image (e.g. the new render)")->required();
+  diff_cmd->add_option("b", diff.b, "Second image (e.g. the golden)")->required();
+  diff.tolerance.add_to(*diff_cmd);
+  diff_cmd->add_option("--heatmap", diff.heatmap, "Write the difference heatmap (largest channel, magma) to this .png");
+
   // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
     return std::string("qdmr: error: ") + e.what() + " (see qdmr --help)\n";
@@ -316,6 +351,8 @@ int main(int argc, char** argv) {
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);
     if (bench_cmd->parsed()) return qdmr::cli::run_bench(bench);
     if (cone_cmd->parsed()) return run_bake_cone(cone);
+    if (check_cmd->parsed()) return qdmr::cli::run_check(check);
+    if (diff_cmd->parsed()) return qdmr::cli::run_diff(diff);
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());
     return kExitBadInput;

@@ -2,10 +2,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "qdmr/core/version.hpp"
+
 namespace qdmr {
 
 nlohmann::json RenderStats::to_json() const {
   nlohmann::json j;
+  j["qdmr_version"] = version();
+  j["bits_version"] = kBitsVersion;
   j["time_ms"] = {{"load", load_ms},         {"plan", plan_ms},         {"prepare", prepare_ms},
                   {"geometry", geometry_ms}, {"binning", binning_ms},   {"raster_shade", raster_shade_ms},
                   {"draw", draw_ms()},       {"write", write_ms},

@@ -55,6 +55,7 @@ const char* input_kind_name(InputKind kind) {
     case InputKind::Mtl: return "MTL file";
     case InputKind::Image: return "image file";
     case InputKind::Cache: return "cache file";
+    case InputKind::Manifest: return "check manifest";
   }
   return "file";
 }
@@ -66,6 +67,7 @@ std::uint64_t input_size_limit(InputKind kind) {
     case InputKind::Mtl: return limits::kMaxMtlFileBytes;
     case InputKind::Image: return limits::kMaxImageFileBytes;
     case InputKind::Cache: return limits::kMaxImageFileBytes;
+    case InputKind::Manifest: return limits::kMaxManifestFileBytes;
   }
   return 0;
 }

@@ -13,6 +13,7 @@
 
 #include "core/det_math.hpp"
 #include "io/atomic_file.hpp"
+#include "qdmr/core/version.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/write/write.hpp"
 
@@ -61,55 +62,64 @@ std::string local_time_now() {
   return text;
 }
 
+// Pixels as a file of `container` stores them: 8-bit sRGB codes for PNG, 16-bit sRGB codes for a colour TIFF,
+// floats otherwise.
+struct Encoded {
+  OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
+  std::vector<std::uint8_t> bytes8;
+  std::vector<std::uint16_t> bytes16;
+  std::vector<float> floats;
+  const void* data() const {
+    if (format == OIIO::TypeDesc::UINT8) return bytes8.data();
+    if (format == OIIO::TypeDesc::UINT16) return bytes16.data();
+    return floats.data();
+  }
+};
+
+Encoded encode(Container container, std::span<const float> pixels, bool srgb) {
+  Encoded encoded;
+  if (container == Container::Png) {
+    encoded.format = OIIO::TypeDesc::UINT8;
+    encoded.bytes8 = quantize<std::uint8_t>(pixels, 255.0f, srgb);
+  } else if (container == Container::Tiff && srgb) {
+    encoded.format = OIIO::TypeDesc::UINT16;
+    encoded.bytes16 = quantize<std::uint16_t>(pixels, 65535.0f, true);
+  } else {
+    encoded.floats.assign(pixels.begin(), pixels.end());  // EXR keeps full float precision
+  }
+  return encoded;
+}
+
 // Writes pixels (float, `channels` per pixel), atomically.
 void write_pixels(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
                   bool srgb, const WriteOptions& write) {
   const Container container = container_of(file);
-  OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
-  std::vector<std::uint8_t> bytes8;
-  std::vector<std::uint16_t> bytes16;
-  const void* data = pixels.data();
-  if (container == Container::Png) {
-    format = OIIO::TypeDesc::UINT8;
-    bytes8 = quantize<std::uint8_t>(pixels, 255.0f, srgb);
-    data = bytes8.data();
-  } else if (container == Container::Tiff && srgb) {
-    format = OIIO::TypeDesc::UINT16;
-    bytes16 = quantize<std::uint16_t>(pixels, 65535.0f, true);
-    data = bytes16.data();
-  }
-  // EXR keeps full float precision, so files can be compared bit for bit.
-  OIIO::ImageSpec spec(width, height, channels, format);
-  if (container == Container::Png || (container == Container::Tiff && srgb)) spec.attribute("oiio:ColorSpace", "sRGB");
+  const Encoded encoded = encode(container, pixels, srgb);
+  OIIO::ImageSpec spec(width, height, channels, encoded.format);
+  if (encoded.format != OIIO::TypeDesc::FLOAT) spec.attribute("oiio:ColorSpace", "sRGB");
   // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
   if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
+  spec.attribute("qdmr:bits_version", std::to_string(kBitsVersion));
   if (write.timestamp) spec.attribute("DateTime", local_time_now());
-  write_image_file(file, spec, format, data, "image");
+  write_image_file(file, spec, encoded.format, encoded.data(), "image");
 }
 
-}  // namespace
+struct AovPixels {
+  int channels = 0;
+  std::vector<float> values;
+};
 
-void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write) {
-  write_pixels(file, frame.width, frame.height, 3, frame.color, true, write);
-}
-
-void write_stats(const RenderStats& stats, const std::filesystem::path& file) { write_json(stats.to_json(), file); }
-
-void write_json(const nlohmann::json& document, const std::filesystem::path& file) {
-  write_text_file(file, document.dump(2) + "\n");
-}
-
-void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write) {
+// An AOV's values as a file of `container` holds them: as they are in float files; mapped into [0, 1] for an
+// 8-bit PNG so the picture is readable (normals to 0.5 + 0.5 n, UVs to their fractional part, depth,
+// iterations, hit depth and errors divided by their maximum; two channels into red and green).
+AovPixels aov_pixels(const Frame& frame, Aov aov, Container container, const std::filesystem::path& file) {
   const AovImage* image = nullptr;
   for (const AovImage& a : frame.aovs)
     if (a.aov == aov) image = &a;
   if (!image) throw Error(file.string(), "AOV '" + aov_name(aov) + "' was not rendered");
-  if (container_of(file) != Container::Png) {
-    write_pixels(file, frame.width, frame.height, image->channels, image->pixels, false, write);
-    return;
-  }
-  // 8-bit PNG: map the values into [0, 1] so the picture is readable.
-  std::vector<float> mapped(image->pixels.begin(), image->pixels.end());
+  AovPixels out{image->channels, std::vector<float>(image->pixels.begin(), image->pixels.end())};
+  if (container != Container::Png) return out;
+  std::vector<float>& mapped = out.values;
   if (aov == Aov::Normal)
     for (float& v : mapped) v = 0.5f + 0.5f * v;
   if (aov == Aov::UV || aov == Aov::HitUV)
@@ -127,8 +137,42 @@ void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, c
       rgb[3 * i + 1] = mapped[2 * i + 1];
     }
     mapped = std::move(rgb);
+    out.channels = 3;
   }
-  write_pixels(file, frame.width, frame.height, image->channels == 2 ? 3 : image->channels, mapped, false, write);
+  return out;
+}
+
+}  // namespace
+
+void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write) {
+  write_pixels(file, frame.width, frame.height, 3, frame.color, true, write);
+}
+
+void write_stats(const RenderStats& stats, const std::filesystem::path& file) { write_json(stats.to_json(), file); }
+
+void write_json(const nlohmann::json& document, const std::filesystem::path& file) {
+  write_text_file(file, document.dump(2) + "\n");
+}
+
+void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write) {
+  const AovPixels pixels = aov_pixels(frame, aov, container_of(file), file);
+  write_pixels(file, frame.width, frame.height, pixels.channels, pixels.values, false, write);
+}
+
+Image stored_pixels(const Frame& frame, std::optional<Aov> aov, const std::filesystem::path& file) {
+  const Container container = container_of(file);
+  const AovPixels source = aov ? aov_pixels(frame, *aov, container, file)
+                               : AovPixels{3, std::vector<float>(frame.color.begin(), frame.color.end())};
+  const Encoded encoded = encode(container, source.values, !aov);
+  Image image(frame.width, frame.height, source.channels);
+  if (encoded.format == OIIO::TypeDesc::UINT8)
+    for (std::size_t i = 0; i < image.texels.size(); ++i) image.texels[i] = float(encoded.bytes8[i]) / 255.0f;
+  else if (encoded.format == OIIO::TypeDesc::UINT16)
+    for (std::size_t i = 0; i < image.texels.size(); ++i) image.texels[i] = float(encoded.bytes16[i]) / 65535.0f;
+  else
+    image.texels = encoded.floats;
+  image.source_bits = int(encoded.format.size()) * 8;
+  return image;
 }
 
 }  // namespace qdmr

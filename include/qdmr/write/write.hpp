@@ -2,12 +2,14 @@
 // The write stage: a frame's pixels, AOVs and statistics to files, each through a temporary file in the same
 // folder and a rename, so a failed or killed write leaves the previous file (or none), never a torn one.
 #include <filesystem>
+#include <optional>
 
 #include <nlohmann/json_fwd.hpp>
 
 #include "qdmr/core/aov.hpp"
 #include "qdmr/core/stats.hpp"
 #include "qdmr/render/render.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace qdmr {
 
@@ -18,7 +20,8 @@ struct WriteOptions {
                            // TIFF tag 306, PNG tIME chunk)
 };
 
-// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear). Throws qdmr::Error.
+// Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear), with the metadata
+// "qdmr:bits_version" (qdmr/core/bits_version.hpp). Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write = {});
 // Writes the stats as JSON.
 void write_stats(const RenderStats& stats, const std::filesystem::path& file);
@@ -27,5 +30,10 @@ void write_json(const nlohmann::json& document, const std::filesystem::path& fil
 // Writes one AOV (EXR/TIFF: float data; PNG: 8-bit for viewing: normals mapped to 0.5 + 0.5 n, UVs to their
 // fractional part, depth, iterations, hit depth and errors divided by their maximum).
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write = {});
+
+// What a file of `file`'s type (by extension) would hold for the colour image (no `aov`) or an AOV of the frame,
+// as read_image returns such a file (codes / 255 for PNG, / 65535 for a colour TIFF, floats for EXR) but with
+// rows from the top. `qdmr check` compares renders with golden files in this form.
+Image stored_pixels(const Frame& frame, std::optional<Aov> aov, const std::filesystem::path& file);
 
 }  // namespace qdmr
