@@ -6,6 +6,7 @@
 #include <thread>
 
 #include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include "draw/draw.hpp"
@@ -52,8 +53,9 @@ struct Renderer::State {
   RenderOptions options;
   int threads;
   const Kernel* kernel;
-  // Lets an arena larger than the core count run without oneTBB's warning.
-  tbb::global_control parallelism;
+  // Lets an arena larger than the core count run without oneTBB's warning. Only then: the limit is process-wide
+  // (the smallest of the active ones wins), so a one-thread renderer must not set it for every other renderer.
+  std::optional<tbb::global_control> parallelism;
   tbb::task_arena arena;
   std::optional<FramePlan> plan;
   Assets assets;
@@ -65,7 +67,10 @@ struct Renderer::State {
 
   explicit State(const RenderOptions& o)
       : options(o), threads(thread_count(o)), kernel(&kernel_for(resolve_isa(o.isa))),
-        parallelism(tbb::global_control::max_allowed_parallelism, std::size_t(threads)), arena(threads) {}
+        arena(threads) {
+    if (threads > tbb::info::default_concurrency())
+      parallelism.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+  }
 };
 
 Renderer::Renderer(const RenderOptions& options) {
