@@ -162,7 +162,12 @@ Image read_comparable_image(const std::filesystem::path& file, int* bits_version
     *bits_version = 0;
     if (auto in = OIIO::ImageInput::open(file.string())) {
       const std::string text = in->spec().get_string_attribute("qdmr:bits_version");
-      if (!text.empty()) *bits_version = std::atoi(text.c_str());
+      const std::string software = in->spec().get_string_attribute("Software");  // TIFF: "qdmr 0.1.0 (bits version 1)"
+      const auto at = software.find("(bits version ");
+      if (!text.empty())
+        *bits_version = std::atoi(text.c_str());
+      else if (software.starts_with("qdmr ") && at != std::string::npos)
+        *bits_version = std::atoi(software.c_str() + at + 14);
     }
   }
   return image;

@@ -243,6 +243,7 @@ private:
 
 // Rewrites the manifest with new hashes and the current bits version, keeping its key order and layout style.
 bool rewrite_manifest(const Manifest& manifest, const std::map<std::size_t, std::map<std::string, std::string>>& hashes) {
+  if (manifest.text.empty()) return false;  // built in memory (the one-off form): no file to rewrite
   if (hashes.empty() && manifest.bits_version == kBitsVersion) return false;
   nlohmann::ordered_json document = nlohmann::ordered_json::parse(manifest.text);
   document["bits_version"] = kBitsVersion;

@@ -99,7 +99,9 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
   if (encoded.format != OIIO::TypeDesc::FLOAT) spec.attribute("oiio:ColorSpace", "sRGB");
   // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
   if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
+  // TIFF keeps only its own tags: there the bits version is in Software (tag 305) alone.
   spec.attribute("qdmr:bits_version", std::to_string(kBitsVersion));
+  spec.attribute("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");
   if (write.timestamp) spec.attribute("DateTime", local_time_now());
   write_image_file(file, spec, encoded.format, encoded.data(), "image");
 }

@@ -41,7 +41,8 @@ struct Comparison {
 Comparison compare_images(const Image& rendered, const Image& golden, const Tolerance& tolerance);
 
 // An image file as compare_images takes it: any file read_image accepts, as floats (8-bit codes / 255 ...),
-// rows from the top. `bits_version` (optional) gets the file's "qdmr:bits_version", 0 when it has none.
+// rows from the top. `bits_version` (optional) gets the bits version of the qdmr that wrote it (metadata
+// "qdmr:bits_version", or in TIFF the Software tag), 0 when it has none.
 // Throws qdmr::Error naming the file.
 Image read_comparable_image(const std::filesystem::path& file, int* bits_version = nullptr);
 

@@ -49,7 +49,8 @@ struct Manifest {
   int bits_version = 0;  // the bits version its goldens were made with
   std::vector<CheckSpec> checks;
   nlohmann::json document;  // as read
-  std::string text;         // the file's text, for --update to rewrite hashes keeping the key order
+  std::string text;         // the file's text, for --update to rewrite hashes keeping the key order; empty for a
+                            // manifest built in memory, which --update does not write
 };
 
 // Reads and validates a manifest. Throws qdmr::Error("FILE: /pointer", what) for anything wrong with it; the

@@ -21,7 +21,8 @@ struct WriteOptions {
 };
 
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear), with the metadata
-// "qdmr:bits_version" (qdmr/core/bits_version.hpp). Throws qdmr::Error.
+// "qdmr:bits_version" and Software = "qdmr <version> (bits version N)" (qdmr/core/version.hpp; TIFF keeps
+// only the latter). Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write = {});
 // Writes the stats as JSON.
 void write_stats(const RenderStats& stats, const std::filesystem::path& file);
