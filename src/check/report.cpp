@@ -1,5 +1,7 @@
 // JUnit XML and the HTML report of a check run: see qdmr/check/check.hpp.
 #include <iomanip>
+
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "io/atomic_file.hpp"
@@ -87,6 +89,26 @@ void write_junit(const Manifest& manifest, const CheckRun& run, const std::files
   }
   xml << "  </testsuite>\n</testsuites>\n";
   write_text_file(file, xml.str());
+}
+
+void write_results_json(const Manifest& manifest, const CheckRun& run, const std::filesystem::path& file) {
+  nlohmann::ordered_json document;
+  document["manifest"] = manifest.file.string();
+  document["qdmr_version"] = version();
+  document["bits_version"] = kBitsVersion;
+  document["seconds"] = run.seconds;
+  document["exit_code"] = run.exit_code();
+  document["checks"] = nlohmann::ordered_json::array();
+  for (const CheckResult& r : run.results) {
+    nlohmann::ordered_json check{{"name", r.name}, {"status", check_status_name(r.status)}, {"lines", r.lines}};
+    for (const OutputResult& o : r.outputs) check["hashes"][o.output] = o.hash;
+    check["prepare_ms"] = r.prepare_ms;
+    check["draw_ms"] = r.draw_ms;
+    check["seconds"] = r.seconds;
+    if (!r.diff_folder.empty()) check["diff_folder"] = r.diff_folder.string();
+    document["checks"].push_back(std::move(check));
+  }
+  write_text_file(file, document.dump(2) + "\n");
 }
 
 void write_html_report(const Manifest& manifest, const CheckRun& run, const std::filesystem::path& dir) {

@@ -102,6 +102,7 @@ int run_check(const CheckArgs& args) {
 
   std::vector<OutputPath> outputs;
   if (!args.junit.empty()) outputs.push_back({"--junit", args.junit});
+  if (!args.json.empty()) outputs.push_back({"--json", args.json});
   check_outputs(outputs);
   if (!args.report.empty()) {
     std::filesystem::create_directories(args.report);
@@ -127,6 +128,7 @@ int run_check(const CheckArgs& args) {
   if (one_off && args.update && !args.hash.empty())
     std::printf("hash of %s: %s\n", args.target.c_str(), run.results.front().outputs.empty() ? "-" : run.results.front().outputs.front().hash.c_str());
   if (!args.junit.empty()) write_junit(manifest, run, args.junit);
+  if (!args.json.empty()) write_results_json(manifest, run, args.json);
   if (!args.report.empty()) {
     write_html_report(manifest, run, args.report);
     std::printf("report: %s\n", (std::filesystem::path(args.report) / "index.html").c_str());

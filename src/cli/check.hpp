@@ -22,7 +22,7 @@ struct CheckArgs {
   std::vector<std::string> sets;
   std::optional<int> width, height;
   bool update = false;
-  std::string junit, report, diff_dir = "qdmr-check-failures";
+  std::string junit, report, json, diff_dir = "qdmr-check-failures";
   int jobs = 1;
   std::optional<int> threads;
   ToleranceArgs tolerance;

@@ -317,6 +317,7 @@ int main(int argc, char** argv) {
   check_cmd->add_flag("--update", check.update,
                       "Rewrite the goldens (or hashes) of failing and missing checks, atomically, and print what changed");
   check_cmd->add_option("--junit", check.junit, "Write JUnit XML here (one test case per check)");
+  check_cmd->add_option("--json", check.json, "Write every result (status, hashes, prepare and draw times) as JSON here");
   check_cmd->add_option("--report", check.report,
                         "Write an HTML page of every failure to DIR/index.html (the diff folders go into DIR)");
   check_cmd->add_option("--diff-dir", check.diff_dir, "Where the diff folder of each failed check goes (default qdmr-check-failures)");

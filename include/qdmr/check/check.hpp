@@ -64,6 +64,10 @@ CheckRun run_checks(const Manifest& manifest, const CheckOptions& options);
 // the failed metrics.
 void write_junit(const Manifest& manifest, const CheckRun& run, const std::filesystem::path& file);
 
+// Every result as JSON: per check its name, status, lines, output hashes, prepare_ms, draw_ms and seconds; the
+// run's seconds, qdmr version and bits version. For scripts (bench/check_overhead.py reads it).
+void write_results_json(const Manifest& manifest, const CheckRun& run, const std::filesystem::path& file);
+
 // index.html in `dir`: a summary of every check and, per failure, its metrics and images (the diff folders,
 // which must be inside `dir`). Viewable from disk: no scripts from elsewhere, no server.
 void write_html_report(const Manifest& manifest, const CheckRun& run, const std::filesystem::path& dir);
