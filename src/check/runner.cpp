@@ -57,7 +57,7 @@ public:
     RenderOptions options;
     options.threads = variant.threads.value_or(threads_);
     options.tile_size = variant.tile.value_or(options.tile_size);
-    options.isa = variant.isa.value_or(Isa::Auto);
+    options.isa = resolve_isa(variant.isa.value_or(Isa::Auto));  // "auto" and its ISA share one renderer
     const auto key = std::make_tuple(options.threads, options.tile_size, int(options.isa));
     auto& slot = renderers_[key];
     if (!slot) slot = std::make_unique<Renderer>(options);
