@@ -100,9 +100,12 @@ int run_check(const CheckArgs& args) {
                              "--golden or --hash); a manifest sets them per check");
   Manifest manifest = one_off ? one_off_manifest(args) : read_manifest(args.target);
 
+  // Report files may go into folders that do not exist yet (CI artefact folders): they are created.
   std::vector<OutputPath> outputs;
   if (!args.junit.empty()) outputs.push_back({"--junit", args.junit});
   if (!args.json.empty()) outputs.push_back({"--json", args.json});
+  for (const OutputPath& o : outputs)
+    if (o.path.has_parent_path()) std::filesystem::create_directories(o.path.parent_path());
   check_outputs(outputs);
   if (!args.report.empty()) {
     std::filesystem::create_directories(args.report);
