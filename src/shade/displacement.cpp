@@ -6,7 +6,7 @@
 
 #include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 #include "qdmr/core/limits.hpp"
 #include "shade/ambient_occlusion.hpp"
 #include "shade/self_shadow.hpp"

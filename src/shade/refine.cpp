@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

@@ -10,7 +10,7 @@
 // Modes (ShadowDesc, scene.hpp):
 // - Off: visibility 1, 0 iterations.
 // - Hard: the box surface (each level-0 texel a closed column down from depth ds (1 - h); texel indices wrap)
-//   as the exact reference light_visibility() (qdmr/study/reference.hpp) defines it: visibility 0 iff the
+//   as the exact reference light_visibility() (qdmr/reference/reference.hpp) defines it: visibility 0 iff the
 //   ray passes through the interior of a column other than the start texel T0, i.e. enters a texel strictly
 //   below its top (a rising ray is lowest where it enters). Grazing a top face, an edge or a corner, or
 //   running along a wall, is lit. T0 is the texel holding (u, v); on a texel boundary, the one behind along

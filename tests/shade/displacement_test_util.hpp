@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "qdmr/bake/cone_map.hpp"
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/displacement.hpp"

@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/height_surface.hpp"
 #include "shade/self_shadow.hpp"
-#include "study/shadow_shapes.hpp"
+#include "reference/shadow_shapes.hpp"
 
 namespace qdmr::test {
 namespace {

@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "qdmr/study/reference.hpp"
-#include "study/shadow_shapes.hpp"
+#include "qdmr/reference/reference.hpp"
+#include "reference/shadow_shapes.hpp"
 
 namespace qdmr::test {
 namespace {

@@ -1,4 +1,4 @@
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 
 #include <algorithm>
 #include <cmath>

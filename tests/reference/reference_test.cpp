@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "qdmr/study/reference.hpp"
+#include "qdmr/reference/reference.hpp"
 
 namespace qdmr {
 namespace {
