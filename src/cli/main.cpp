@@ -16,6 +16,7 @@
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
+#include "cli/study.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_check.hpp"
 #include "qdmr/bake/cone_map.hpp"
@@ -333,6 +334,22 @@ int main(int argc, char** argv) {
   diff.tolerance.add_to(*diff_cmd);
   diff_cmd->add_option("--heatmap", diff.heatmap, "Write the difference heatmap (largest channel, magma) to this .png");
 
+  qdmr::cli::StudyArgs study;
+  CLI::App* study_cmd = app.add_subcommand(
+      "study", "Sweep a scene's settings in one process: time, iterations and error against the exact reference per "
+               "configuration, and the Pareto fronts (docs/studies.md)");
+  study_cmd->add_option("spec", study.spec, "Study spec (JSON)");
+  study_cmd->add_option("-o,--output", study.output, "Results folder (created)");
+  study_cmd->add_option("--shard", study.shard, "Run shard I of N (I/N), balanced by estimated cost; merge with qdmr study merge");
+  study_cmd->add_flag("--resume", study.resume, "Continue an interrupted run of the same spec in the same folder");
+  study_cmd->add_flag("--force", study.force, "Run more configurations than the spec's max_configurations");
+  study_cmd->add_option("--threads", study.threads, "Worker threads (default: every core)");
+  qdmr::cli::StudyMergeArgs merge;
+  CLI::App* merge_cmd = study_cmd->add_subcommand("merge", "Merge the folders of every shard of a study");
+  merge_cmd->add_option("folders", merge.folders, "The shard folders")->required();
+  merge_cmd->add_option("-o,--output", merge.output, "Merged results folder")->required();
+  study_cmd->require_subcommand(0, 1);
+
   // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
     return std::string("qdmr: error: ") + e.what() + " (see qdmr --help)\n";
@@ -353,6 +370,12 @@ int main(int argc, char** argv) {
     if (bench_cmd->parsed()) return qdmr::cli::run_bench(bench);
     if (cone_cmd->parsed()) return run_bake_cone(cone);
     if (check_cmd->parsed()) return qdmr::cli::run_check(check);
+    if (merge_cmd->parsed()) return qdmr::cli::run_study_merge(merge);
+    if (study_cmd->parsed()) {
+      if (study.spec.empty() || study.output.empty())
+        throw qdmr::Error("qdmr study", "expected SPEC.json -o FOLDER (or: qdmr study merge FOLDER... -o FOLDER)");
+      return qdmr::cli::run_study(study);
+    }
     if (diff_cmd->parsed()) return qdmr::cli::run_diff(diff);
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());

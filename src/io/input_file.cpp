@@ -56,6 +56,7 @@ const char* input_kind_name(InputKind kind) {
     case InputKind::Image: return "image file";
     case InputKind::Cache: return "cache file";
     case InputKind::Manifest: return "check manifest";
+    case InputKind::StudySpec: return "study spec";
   }
   return "file";
 }
@@ -68,6 +69,7 @@ std::uint64_t input_size_limit(InputKind kind) {
     case InputKind::Image: return limits::kMaxImageFileBytes;
     case InputKind::Cache: return limits::kMaxImageFileBytes;
     case InputKind::Manifest: return limits::kMaxManifestFileBytes;
+    case InputKind::StudySpec: return limits::kMaxSceneFileBytes;
   }
   return 0;
 }

@@ -1,0 +1,60 @@
+#pragma once
+// Running a study: every configuration of a spec rendered by persistent renderers in one process, one row of
+// metrics each, appended to the results folder as it finishes (docs/studies.md describes the folder, the
+// columns, sharding, resuming and merging).
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "qdmr/study/spec.hpp"
+
+namespace qdmr {
+
+using StudyRow = nlohmann::ordered_json;  // "index", "config", "deterministic", "timing" (docs/studies.md)
+
+struct StudyShard {
+  int index = 1, count = 1;  // 1-based: shard `index` of `count`
+};
+
+struct StudyOptions {
+  int threads = 0;                   // 0: every core
+  StudyShard shard;
+  bool resume = false;               // keep the rows of an interrupted run of the same spec and shard
+  bool force = false;                // allow more than the spec's max_configurations
+  // After each configuration: done, total (of this shard), the configuration's label. Never concurrently.
+  std::function<void(std::size_t done, std::size_t total, const std::string& label)> progress;
+  // Polled between configurations: true stops the run with a valid partial result (Ctrl-C).
+  std::function<bool()> stop_requested;
+};
+
+struct StudyRun {
+  std::size_t total = 0;     // configurations of this shard
+  std::size_t rendered = 0;  // in this run
+  std::size_t resumed = 0;   // kept from an earlier run
+  bool stopped = false;
+  double seconds = 0;
+};
+
+// The configurations of shard I of N: balanced by an estimate of their cost (iteration caps, step counts,
+// techniques, grazing angles), not by index; every configuration is in exactly one shard. Indices, ascending.
+std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::vector<StudyConfig>& configs,
+                                              StudyShard shard);
+
+// Runs the spec into `out` (created): study.json (what the rows belong to), rows.jsonl (a row per line, appended
+// as each finishes), results.json, results.csv and pareto.csv (rewritten from the rows), images/ (keep).
+StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, const StudyOptions& options);
+
+// Merges the folders of every shard of one spec into `out`, with the outputs of an unsharded run. Throws
+// qdmr::Error when a folder is of another spec, a shard is missing or given twice, or rows are missing.
+void merge_studies(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& out);
+
+// Indices (into rows) of the rows no other row dominates in (timing.draw_ms_median, deterministic.error_p99,
+// deterministic.missed_fraction), all to be minimised; a missing metric counts as 0. Ascending.
+std::vector<std::size_t> pareto_front(const std::vector<StudyRow>& rows);
+
+}  // namespace qdmr

@@ -1,0 +1,380 @@
+// Runs a study: see qdmr/study/study.hpp.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "io/atomic_file.hpp"
+#include "qdmr/check/canonical_hash.hpp"
+#include "qdmr/check/compare.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/version.hpp"
+#include "qdmr/load/load.hpp"
+#include "qdmr/plan/plan.hpp"
+#include "qdmr/render/render.hpp"
+#include "qdmr/study/study.hpp"
+#include "qdmr/write/write.hpp"
+#include "study/results.hpp"
+
+namespace qdmr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.starts_with("model name")) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+RenderOptions with_threads(int threads) {
+  RenderOptions options;
+  options.threads = threads;
+  return options;
+}
+
+double number_or(const nlohmann::json& v, double fallback) { return v.is_number() ? v.get<double>() : fallback; }
+
+// A relative cost estimate of a configuration, for balancing shards: iteration caps and step counts multiply,
+// techniques weigh by their typical cost, grazing views cost more.
+double estimated_cost(const StudySpec& spec, const StudyConfig& config) {
+  static const std::map<std::string, double> technique{{"normal", 1}, {"pom", 2}, {"csm", 2}, {"rcsm", 2},
+                                                       {"relief", 3}, {"qdm", 3}, {"qdmhb", 4}};
+  double cost = 1;
+  for (std::size_t i = 0; i < spec.axes.size(); ++i) {
+    const StudyAxis& axis = spec.axes[i];
+    const nlohmann::json& v = config.values[i];
+    if (v.is_null()) continue;
+    if (axis.kind == StudyAxis::Kind::Elevation) cost *= 1 + std::min(10.0, 1 / std::sin(number_or(v, 45) * 0.0174533));
+    if (axis.kind != StudyAxis::Kind::Set) continue;
+    if (v.is_string() && technique.count(v.get<std::string>())) cost *= technique.at(v.get<std::string>());
+    const std::string& p = axis.pointer;
+    if (v.is_number() && (p.ends_with("iterations") || p.ends_with("steps") || p.ends_with("samples")))
+      cost *= 1 + std::max(0.0, v.get<double>()) / 16;
+  }
+  return cost;
+}
+
+// One configuration's row: everything deterministic from a frame without AOVs (timing) and one with the error
+// AOVs, against the baseline's colour.
+class Measurer {
+public:
+  Measurer(const StudySpec& spec, int threads)
+      : spec_(spec), timing_(with_threads(threads)), measuring_(with_threads(threads)),
+        baseline_renderer_(with_threads(threads)) {}
+
+  // The colour of the baseline configuration for `config`: its values with the spec's baseline values put in
+  // (the other axes stay, so each row is compared at its own angle, depth, ...). Rendered once per distinct one.
+  const Image& baseline_for(const StudyConfig& config, const std::array<double, 9>& camera) {
+    StudyConfig base = config;
+    for (std::size_t i = 0; i < spec_.axes.size(); ++i) {
+      const auto it = spec_.baseline.find(spec_.axes[i].name);
+      if (it != spec_.baseline.end()) base.values[i] = it->second;
+    }
+    const std::string key = nlohmann::json(base.values).dump();
+    auto found = baselines_.find(key);
+    if (found != baselines_.end()) return found->second;
+    baseline_renderer_.set_scene(load_scene(spec_.scene, study_overrides(spec_, base, camera)), {});
+    const Frame& frame = baseline_renderer_.draw();
+    Image image(frame.width, frame.height, 3);
+    std::copy(frame.color.begin(), frame.color.end(), image.texels.begin());
+    return baselines_.emplace(key, std::move(image)).first->second;
+  }
+
+  const Renderer& renderer() const { return timing_; }
+
+  StudyRow measure(const StudyConfig& config, const SceneDesc& scene, const std::filesystem::path& images,
+                   const std::array<double, 9>& camera) {
+    StudyRow row;
+    row["index"] = config.index;
+    nlohmann::ordered_json values = nlohmann::ordered_json::object();
+    for (std::size_t i = 0; i < spec_.axes.size(); ++i) values[spec_.axes[i].name] = config.values[i];
+    row["config"] = values;
+    nlohmann::ordered_json det = nlohmann::ordered_json::object(), timing = nlohmann::ordered_json::object();
+
+    timing_.set_scene(scene, {});
+    std::vector<double> draws;
+    double prepare_ms = 0;
+    for (int f = 0; f < spec_.warmup + spec_.frames; ++f) {
+      const Frame& frame = timing_.draw();
+      if (f == 0) prepare_ms = frame.stats.plan_ms + frame.stats.prepare_ms;
+      if (f >= spec_.warmup) draws.push_back(frame.stats.draw_ms());
+    }
+    const Frame& frame = timing_.frame();
+    const RenderStats& s = frame.stats;
+    det["hash"] = canonical_hash(frame.width, frame.height, 3, frame.color);
+    std::uint64_t nonfinite = 0;
+    for (float v : frame.color) nonfinite += std::isfinite(v) ? 0 : 1;
+    det["nonfinite"] = nonfinite;
+    det["pixels_shaded"] = s.pixels_shaded;
+    if (spec_.wants(StudyMetric::Iterations)) {
+      det["iterations_mean"] = s.iterations_mean;
+      det["iterations_p99"] = s.iterations_p99;
+      det["iterations_max"] = s.iterations_max;
+      det["lane_utilisation"] = s.lane_utilisation;
+    }
+    if (spec_.wants(StudyMetric::ImageDiff) && !spec_.baseline.empty()) {
+      Image color(frame.width, frame.height, 3);
+      std::copy(frame.color.begin(), frame.color.end(), color.texels.begin());
+      Tolerance t;
+      t.max_abs = spec_.diff_threshold;
+      const Comparison c = compare_images(color, baseline_for(config, camera), t);
+      det["diff_rmse"] = c.rmse;
+      det["diff_max"] = std::isfinite(c.max_abs) ? nlohmann::json(c.max_abs) : nlohmann::json("inf");
+      det["diff_pixels"] = c.pixels_over;
+    }
+    const bool keep_image = std::find(spec_.keep.begin(), spec_.keep.end(), "image") != spec_.keep.end();
+    if (keep_image) write_frame(frame, images / (std::to_string(config.index) + ".png"));
+    if (spec_.wants(StudyMetric::Time)) {
+      std::vector<double> sorted = draws;
+      std::sort(sorted.begin(), sorted.end());
+      timing["draw_ms_median"] = sorted[sorted.size() / 2];
+      timing["draw_ms_min"] = sorted.front();
+      timing["prepare_ms"] = prepare_ms;
+    }
+
+    if (spec_.wants(StudyMetric::Error) || !keep_aovs().empty()) measure_error(config, scene, images, det);
+    row["deterministic"] = det;
+    row["timing"] = timing;
+    return row;
+  }
+
+private:
+  std::vector<Aov> keep_aovs() const {
+    std::vector<Aov> aovs;
+    for (const std::string& k : spec_.keep)
+      if (k != "image") aovs.push_back(*parse_aov(k));
+    return aovs;
+  }
+
+  void measure_error(const StudyConfig& config, const SceneDesc& scene, const std::filesystem::path& images,
+                     nlohmann::ordered_json& det) {
+    std::vector<Aov> aovs{Aov::Depth, Aov::ErrorTexels, Aov::Missed};
+    for (Aov a : keep_aovs())
+      if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
+    measuring_.set_scene(scene, aovs);
+    const Frame& frame = measuring_.draw();
+    for (Aov a : keep_aovs()) write_aov(frame, a, images / (std::to_string(config.index) + "." + aov_name(a) + ".exr"));
+    if (!spec_.wants(StudyMetric::Error)) return;
+    const auto plane = [&](Aov a) -> const PixelBuffer& {
+      for (const AovImage& image : frame.aovs)
+        if (image.aov == a) return image.pixels;
+      throw Error("study", "AOV not rendered");
+    };
+    const PixelBuffer &depth = plane(Aov::Depth), &error = plane(Aov::ErrorTexels), &missed = plane(Aov::Missed);
+    std::vector<float> errors;
+    double sum = 0, missed_sum = 0;
+    std::uint64_t nonfinite = 0;
+    for (std::size_t p = 0; p < depth.size(); ++p) {
+      if (!(depth[p] > 0)) continue;  // not covered
+      if (!std::isfinite(error[p])) {
+        ++nonfinite;
+        continue;
+      }
+      errors.push_back(error[p]);
+      sum += error[p];
+      missed_sum += missed[p];
+    }
+    det["covered_pixels"] = errors.size();
+    det["error_nonfinite"] = nonfinite;
+    if (errors.empty()) return;
+    const std::size_t k = std::min(errors.size() - 1, std::size_t(std::ceil(0.99 * double(errors.size()))) - 1);
+    std::nth_element(errors.begin(), errors.begin() + std::ptrdiff_t(k), errors.end());
+    det["error_mean"] = sum / double(errors.size());
+    det["error_p99"] = errors[k];
+    det["error_max"] = *std::max_element(errors.begin(), errors.end());
+    det["missed_fraction"] = missed_sum / double(errors.size());
+  }
+
+  const StudySpec& spec_;
+  Renderer timing_, measuring_, baseline_renderer_;
+  std::map<std::string, Image> baselines_;
+};
+
+std::array<double, 9> base_camera(const StudySpec& spec) {
+  const SceneDesc base = load_scene(spec.scene, spec.overrides);
+  const CameraDesc& c = base.camera;
+  return {c.position.x, c.position.y, c.position.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z};
+}
+
+nlohmann::ordered_json make_header(const StudySpec& spec, std::size_t configurations, StudyShard shard, int threads,
+                                   const char* isa) {
+  nlohmann::ordered_json header;
+  header["spec_hash"] = spec.hash;
+  header["spec"] = nlohmann::ordered_json::parse(spec.document.dump());
+  header["spec_file"] = spec.file.string();
+  header["qdmr_version"] = version();
+  header["bits_version"] = kBitsVersion;
+  header["configurations"] = configurations;
+  header["shard"] = {shard.index, shard.count};
+  std::vector<std::string> axes;
+  for (const StudyAxis& a : spec.axes) axes.push_back(a.name);
+  header["axes"] = axes;
+  header["group_by"] = spec.group_axis;
+  header["machine"] = {{"cpu", cpu_model()}, {"isa", isa}, {"threads", threads},
+                       {"cores", std::thread::hardware_concurrency()}};
+  return header;
+}
+
+// Appends one line with one write() and syncs it: a kill leaves whole lines and at most one torn last line.
+void append_line(const std::filesystem::path& file, const std::string& line) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(file.string(), "cannot open for appending");
+  const std::string text = line + "\n";
+  const ssize_t written = ::write(fd, text.data(), text.size());
+  ::fdatasync(fd);
+  ::close(fd);
+  if (written != ssize_t(text.size())) throw Error(file.string(), "short write (disk full?)");
+}
+
+}  // namespace
+
+std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::vector<StudyConfig>& configs,
+                                              StudyShard shard) {
+  // Longest first onto the least loaded shard (ties: the lower index), deterministic.
+  std::vector<std::pair<double, std::size_t>> by_cost;
+  for (const StudyConfig& c : configs) by_cost.emplace_back(estimated_cost(spec, c), c.index);
+  std::stable_sort(by_cost.begin(), by_cost.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<double> load(std::size_t(shard.count), 0.0);
+  std::vector<std::size_t> mine;
+  for (const auto& [cost, index] : by_cost) {
+    const std::size_t target = std::size_t(std::min_element(load.begin(), load.end()) - load.begin());
+    load[target] += cost;
+    if (int(target) + 1 == shard.index) mine.push_back(index);
+  }
+  std::sort(mine.begin(), mine.end());
+  return mine;
+}
+
+StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, const StudyOptions& options) {
+  const auto start = Clock::now();
+  if (options.shard.count < 1 || options.shard.index < 1 || options.shard.index > options.shard.count)
+    throw Error("--shard", "expected I/N with 1 <= I <= N");
+  const std::vector<StudyConfig> configs = expand_study(spec, options.force);
+  const std::vector<std::size_t> mine = shard_configurations(spec, configs, options.shard);
+  const std::array<double, 9> camera = base_camera(spec);
+
+  Measurer measurer(spec, options.threads);
+  const nlohmann::ordered_json header = make_header(spec, configs.size(), options.shard, measurer.renderer().threads(),
+                                                    isa_name(measurer.renderer().isa()));
+
+  std::filesystem::create_directories(out);
+  const std::filesystem::path rows_file = out / "rows.jsonl", header_file = out / "study.json";
+  std::vector<StudyRow> rows;
+  if (std::filesystem::exists(rows_file) || std::filesystem::exists(header_file)) {
+    if (!options.resume)
+      throw Error(out.string(), "holds the results of a study already: add --resume to continue it, or choose another -o");
+    nlohmann::ordered_json old;
+    try {
+      old = nlohmann::ordered_json::parse(std::ifstream(header_file));
+    } catch (const nlohmann::json::exception&) {
+      throw Error(header_file.string(), "unreadable: cannot resume (remove the folder to start again)");
+    }
+    if (old.value("spec_hash", "") != spec.hash)
+      throw Error(out.string(), "holds results of another spec (" + old.value("spec_hash", std::string("?")) + ", this one is " +
+                                    spec.hash + "): --resume continues the same spec only");
+    if (old["shard"] != header["shard"])
+      throw Error(out.string(), "holds shard " + old["shard"].dump() + ", not " + header["shard"].dump());
+    std::uint64_t valid = 0;
+    rows = read_study_rows(rows_file, &valid);
+    std::filesystem::resize_file(rows_file, valid);  // drop a torn last line
+  }
+  write_text_file(header_file, header.dump(2) + "\n");
+  const bool keep = !spec.keep.empty();
+  if (keep) std::filesystem::create_directories(out / "images");
+
+  std::set<std::size_t> done;
+  for (const StudyRow& r : rows) done.insert(r["index"].get<std::size_t>());
+  StudyRun run;
+  run.total = mine.size();
+  run.resumed = done.size();
+
+  auto last_write = Clock::now();
+  std::size_t finished = done.size();
+  for (std::size_t index : mine) {
+    if (done.count(index)) continue;
+    if (options.stop_requested && options.stop_requested()) {
+      run.stopped = true;
+      break;
+    }
+    const StudyConfig& config = configs[index];
+    const SceneDesc scene = load_scene(spec.scene, study_overrides(spec, config, camera));
+    StudyRow row;
+    try {
+      row = measurer.measure(config, scene, out / "images", camera);
+    } catch (const Error& e) {
+      throw Error(study_label(spec, config), e.what());
+    }
+    append_line(rows_file, row.dump());
+    rows.push_back(std::move(row));
+    ++run.rendered;
+    ++finished;
+    if (options.progress) options.progress(finished, mine.size(), study_label(spec, config));
+    if (Clock::now() - last_write > std::chrono::seconds(2)) {
+      write_study_results(header, rows, out);
+      last_write = Clock::now();
+    }
+  }
+  write_study_results(header, rows, out);
+  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+void merge_studies(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& out) {
+  if (shards.empty()) throw Error("study merge", "no shard folders given");
+  nlohmann::ordered_json header;
+  std::map<int, std::filesystem::path> seen;
+  std::vector<StudyRow> rows;
+  int count = 0;
+  for (const std::filesystem::path& folder : shards) {
+    const std::filesystem::path file = folder / "study.json";
+    nlohmann::ordered_json h;
+    try {
+      h = nlohmann::ordered_json::parse(std::ifstream(file));
+    } catch (const nlohmann::json::exception&) {
+      throw Error(file.string(), "missing or unreadable: not a study folder");
+    }
+    if (header.is_null()) {
+      header = h;
+      count = h["shard"][1].get<int>();
+    } else if (h["spec_hash"] != header["spec_hash"]) {
+      throw Error(folder.string(), "is a shard of another spec (" + h["spec_hash"].get<std::string>() + ", not " +
+                                       header["spec_hash"].get<std::string>() + ")");
+    }
+    const int index = h["shard"][0].get<int>();
+    if (h["shard"][1].get<int>() != count)
+      throw Error(folder.string(), "is shard " + std::to_string(index) + " of " + h["shard"][1].dump() + ", the others are of " + std::to_string(count));
+    if (seen.count(index)) throw Error(folder.string(), "is shard " + std::to_string(index) + " again (also " + seen[index].string() + ")");
+    seen[index] = folder;
+    for (StudyRow& r : read_study_rows(folder / "rows.jsonl")) rows.push_back(std::move(r));
+  }
+  for (int i = 1; i <= count; ++i)
+    if (!seen.count(i)) throw Error("study merge", "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing");
+  const std::size_t total = header["configurations"].get<std::size_t>();
+  std::vector<int> present(total, 0);
+  for (const StudyRow& r : rows) {
+    const std::size_t index = r["index"].get<std::size_t>();
+    if (index >= total || present[index]++) throw Error("study merge", "configuration " + std::to_string(index) + " is in two shards");
+  }
+  std::size_t missing = 0;
+  for (int p : present) missing += p == 0 ? 1 : 0;
+  if (missing) throw Error("study merge", std::to_string(missing) + " configuration(s) have no row: resume the unfinished shards first");
+  header["shard"] = {1, 1};
+  std::filesystem::create_directories(out);
+  write_text_file(out / "study.json", header.dump(2) + "\n");
+  std::sort(rows.begin(), rows.end(),
+            [](const StudyRow& a, const StudyRow& b) { return a["index"].get<std::size_t>() < b["index"].get<std::size_t>(); });
+  std::string lines;
+  for (const StudyRow& r : rows) lines += r.dump() + "\n";
+  write_text_file(out / "rows.jsonl", lines);
+  write_study_results(header, rows, out);
+}
+
+}  // namespace qdmr
