@@ -1,0 +1,142 @@
+// qdmr study through the command: deterministic columns identical across thread counts and shardings, resume
+// after a kill equal to an uninterrupted run, merge refusing missing or foreign shards, folders never mixed.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace qdmr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+void write_spec(const TempDir& dir, const std::string& extra = "") {
+  write_file(dir / "s.json", R"({"scene": ")" + (source_dir() / "scenes" / "plane.json").string() + R"(",
+    "width": 48, "height": 27, "frames": 1, "warmup": 0, )" + extra + R"(
+    "axes": [{"name": "technique", "path": "/materials/bricks/technique/name", "values": ["normal", "pom", "qdm"]},
+             {"name": "elevation", "camera": "elevation", "values": [60, 20]}],
+    "baseline": {"technique": "qdm"}})");
+}
+
+// rows.jsonl's rows by index: "index", "config" and "deterministic" only (timing differs run to run).
+std::vector<nlohmann::json> deterministic_rows(const fs::path& folder) {
+  std::vector<nlohmann::json> rows;
+  std::ifstream in(folder / "rows.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    auto row = nlohmann::json::parse(line);
+    row.erase("timing");
+    rows.push_back(row);
+  }
+  std::sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a["index"] < b["index"]; });
+  return rows;
+}
+
+CommandResult study(const TempDir& dir, std::vector<std::string> args) {
+  args.insert(args.begin(), {"study", (dir / "s.json").string()});
+  return run(cli(), args);
+}
+
+TEST(StudyCommand, RowsAreTheSameForAnyThreadCountAndSharding) {
+  TempDir dir;
+  write_spec(dir);
+  const CommandResult one = study(dir, {"-o", (dir / "one").string(), "--threads", "1"});
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  ASSERT_EQ(study(dir, {"-o", (dir / "two").string(), "--threads", "2"}).exit_code, 0);
+  ASSERT_EQ(study(dir, {"-o", (dir / "a").string(), "--shard", "1/2"}).exit_code, 0);
+  ASSERT_EQ(study(dir, {"-o", (dir / "b").string(), "--shard", "2/2"}).exit_code, 0);
+  const CommandResult merged = run(cli(), {"study", "merge", (dir / "a").string(), (dir / "b").string(), "-o", (dir / "m").string()});
+  ASSERT_EQ(merged.exit_code, 0) << merged.output;
+
+  const auto reference = deterministic_rows(dir / "one");
+  ASSERT_EQ(reference.size(), 6u);
+  EXPECT_EQ(deterministic_rows(dir / "two"), reference);
+  EXPECT_EQ(deterministic_rows(dir / "m"), reference);
+  EXPECT_LT(deterministic_rows(dir / "a").size(), 6u);  // each shard has a part
+  // The displaced techniques did iterate, QDM is its own baseline, and nothing is NaN.
+  for (const auto& row : reference) {
+    EXPECT_EQ(row["deterministic"]["nonfinite"], 0);
+    if (row["config"]["technique"] == "qdm") {
+      EXPECT_EQ(row["deterministic"]["diff_pixels"], 0);
+      EXPECT_GT(row["deterministic"]["iterations_mean"].get<double>(), 0);
+    }
+    EXPECT_TRUE(row["deterministic"].contains("error_p99"));
+  }
+  for (const char* file : {"results.csv", "results.json", "pareto.csv", "study.json"}) {
+    EXPECT_TRUE(fs::exists(dir / "one" / file)) << file;
+    EXPECT_TRUE(fs::exists(dir / "m" / file)) << file;
+  }
+  const auto results = nlohmann::json::parse(read_file(dir / "m" / "results.json"));
+  EXPECT_EQ(results["rows"].size(), 6u);
+  EXPECT_EQ(results["spec_hash"], nlohmann::json::parse(read_file(dir / "one" / "study.json"))["spec_hash"]);
+  EXPECT_NE(read_file(dir / "one" / "pareto.csv").find("technique=qdm"), std::string::npos);
+}
+
+TEST(StudyCommand, ResumeAfterAKillGivesTheRowsOfAnUninterruptedRun) {
+  TempDir dir;
+  write_spec(dir, R"("frames": 40,)");  // slow enough to be killed halfway
+  ASSERT_EQ(study(dir, {"-o", (dir / "full").string()}).exit_code, 0);
+  const fs::path rows = dir / "cut" / "rows.jsonl";
+  const int pid = spawn(cli(), {"study", (dir / "s.json").string(), "-o", (dir / "cut").string()});
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline && (!fs::exists(rows) || deterministic_rows(dir / "cut").size() < 2))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::size_t kept = deterministic_rows(dir / "cut").size();
+  ASSERT_GE(kept, 2u);
+  if (kept == 6) GTEST_SKIP() << "the run finished before it could be killed";
+
+  const CommandResult refused = study(dir, {"-o", (dir / "cut").string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.output.find("holds the results of a study already: add --resume"), std::string::npos) << refused.output;
+  const CommandResult resumed = study(dir, {"-o", (dir / "cut").string(), "--resume"});
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("kept from before"), std::string::npos);
+  EXPECT_EQ(deterministic_rows(dir / "cut"), deterministic_rows(dir / "full"));
+
+  // Another spec may not continue these rows.
+  write_spec(dir, R"("frames": 2,)");
+  const CommandResult other = study(dir, {"-o", (dir / "cut").string(), "--resume"});
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.output.find("holds results of another spec"), std::string::npos) << other.output;
+}
+
+TEST(StudyCommand, MergeRefusesMissingDuplicateAndForeignShards) {
+  TempDir dir;
+  write_spec(dir);
+  ASSERT_EQ(study(dir, {"-o", (dir / "a").string(), "--shard", "1/2"}).exit_code, 0);
+  ASSERT_EQ(study(dir, {"-o", (dir / "b").string(), "--shard", "2/2"}).exit_code, 0);
+  const auto merge = [&](std::vector<std::string> folders) {
+    std::vector<std::string> args{"study", "merge"};
+    for (const auto& f : folders) args.push_back((dir / f).string());
+    args.insert(args.end(), {"-o", (dir / "m").string()});
+    return run(cli(), args);
+  };
+  const CommandResult missing = merge({"a"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.output.find("shard 2 of 2 is missing"), std::string::npos) << missing.output;
+  const CommandResult twice = merge({"a", "a", "b"});
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.output.find("is shard 1 again"), std::string::npos) << twice.output;
+  write_spec(dir, R"("frames": 2,)");
+  ASSERT_EQ(study(dir, {"-o", (dir / "c").string(), "--shard", "2/2"}).exit_code, 0);
+  const CommandResult foreign = merge({"a", "c"});
+  EXPECT_EQ(foreign.exit_code, 2);
+  EXPECT_NE(foreign.output.find("is a shard of another spec"), std::string::npos) << foreign.output;
+  const CommandResult bad_shard = study(dir, {"-o", (dir / "d").string(), "--shard", "3/2"});
+  EXPECT_EQ(bad_shard.exit_code, 2);
+  EXPECT_NE(bad_shard.output.find("--shard 3/2: expected I/N"), std::string::npos) << bad_shard.output;
+}
+
+}  // namespace
+}  // namespace qdmr::test
