@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli/cli_test_util.hpp"
+#include "qdmr/core/isa.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -63,6 +64,35 @@ TEST(CliMathModes, EveryModeRendersTheSameBitsOnAPowerOfTwoMap) {
   const FloatImage sm4 = render_strip(dir, 16384, "sm4");
   EXPECT_EQ(first_difference(sm4, render_strip(dir, 16384, "sm3")), "");
   EXPECT_EQ(first_difference(sm4, render_strip(dir, 16384, "exact")), "");
+}
+
+// The modes' own arithmetic (the exact texel address on a map that is not a power of two, exact's fp64 crossings,
+// sm3's cells) gives the same bits on every draw kernel this CPU runs.
+TEST(CliMathModes, EveryKernelRendersTheSameBitsInEveryMode) {
+  const std::vector<Isa> isas = usable_isas();
+  if (isas.size() < 2) GTEST_SKIP() << "this CPU runs only one of the binary's kernels: nothing to compare";
+  TempDir dir;
+  render_strip(dir, 16383, "sm4");  // writes the strip and its scene
+  for (const std::string math : {"sm4", "sm3", "exact"}) {
+    std::vector<FloatImage> strip, qdm;
+    for (Isa isa : isas) {
+      const std::string name = math + "_" + isa_name(isa);
+      const std::vector<std::string> set{"--isa", isa_name(isa), "--set", "/materials/m/sampling/math=" + math};
+      std::vector<std::string> args{"render", (dir / "scene.json").string(), "-o", (dir / (name + ".exr")).string(),
+                                    "--width", "240", "--height", "135"};
+      args.insert(args.end(), set.begin(), set.end());
+      const CommandResult result = run(cli(), args);
+      ASSERT_EQ(result.exit_code, 0) << result.output;
+      strip.push_back(read_float_image(dir / (name + ".exr")));
+      render_scene(cli(), {"pom_vs_qdm_depth_5.0", false}, dir / ("qdm_" + name + ".exr"),
+                   {"--isa", isa_name(isa), "--set", "/materials/surface/sampling/math=" + math});
+      qdm.push_back(read_float_image(dir / ("qdm_" + name + ".exr")));
+    }
+    for (std::size_t k = 1; k < isas.size(); ++k) {
+      EXPECT_EQ(first_difference(strip[0], strip[k]), "") << math << ": strip, " << isa_name(isas[k]);
+      EXPECT_EQ(first_difference(qdm[0], qdm[k]), "") << math << ": pom_vs_qdm_depth_5.0, " << isa_name(isas[k]);
+    }
+  }
 }
 
 }  // namespace
