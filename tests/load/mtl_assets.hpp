@@ -40,7 +40,7 @@ inline void write_mtl_assets(const std::filesystem::path& dir) {
   write_image(dir / "tex/normal.png", 2, 3, {160, 128, 240, 160, 128, 240, 160, 128, 240, 160, 128, 240});
   write_file(dir / "lib.mtl",
              "newmtl displaced\nKd 1 1 1\nmap_Kd tex/albedo.png\ndisp tex/height.png\n"
-             "newmtl bumped\nKd 0.8 0.8 0.8\nbump tex/bump.png\n"
+             "newmtl bumped\nKd 0.8 0.8 0.8\nbump -bm 0.3 tex/bump.png\n"
              "newmtl normal_mapped\nKd 0.8 0.8 0.8\nnorm tex/normal.png\n"
              "newmtl plain\nKd 0.5 0.6 0.7\n");
   std::ostringstream obj;

@@ -52,6 +52,7 @@ TEST(MtlMaterials, EachMapKindHasItsMeaning) {
   EXPECT_EQ(bumped.technique.kind, TechniqueKind::Normal);
   EXPECT_EQ(bumped.layers.at(0).height.file, tex / "bump.png");
   EXPECT_EQ(bumped.layers.at(0).normal.source, TextureSource::FromHeight);
+  EXPECT_EQ(bumped.layers.at(0).normal_strength, 1.0f);  // texture options (-bm 0.3) are ignored
   // norm: a tangent-space normal map.
   const MaterialDesc& normal_mapped = material(scene, "normal_mapped");
   EXPECT_EQ(normal_mapped.technique.kind, TechniqueKind::Normal);
