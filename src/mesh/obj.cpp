@@ -169,18 +169,26 @@ TextureDesc constant_texture(glm::vec3 color) {
   return t;
 }
 
+// The MTL maps qdmr reads: map_Kd -> albedo (sRGB); disp -> the height a displacement technique marches (POM
+// by default); bump / map_Bump -> a height for normals only (bump mapping), unless a disp is given; norm -> a
+// tangent-space normal map, which wins over normals derived from a height. Scenes change any of this per MTL
+// material in the object's `mtl` block (scene/validate.cpp, read_mtl_override).
 MaterialDesc convert_material(const tinyobj::material_t& mtl, const fs::path& folder) {
   LayerDesc layer;
   layer.albedo = mtl.diffuse_texname.empty()
                      ? constant_texture({mtl.diffuse[0], mtl.diffuse[1], mtl.diffuse[2]})
                      : file_texture(folder, mtl.diffuse_texname);
-  if (!mtl.normal_texname.empty()) layer.normal = file_texture(folder, mtl.normal_texname);
-  // MTL `bump` is a height map; `disp` is one too and wins when both are given.
-  if (!mtl.displacement_texname.empty())
-    layer.height = file_texture(folder, mtl.displacement_texname);
-  else if (!mtl.bump_texname.empty())
-    layer.height = file_texture(folder, mtl.bump_texname);
   MaterialDesc m;
+  if (!mtl.displacement_texname.empty()) {
+    layer.height = file_texture(folder, mtl.displacement_texname);
+    m.technique.kind = TechniqueKind::Pom;
+  } else if (!mtl.bump_texname.empty()) {
+    layer.height = file_texture(folder, mtl.bump_texname);
+  }
+  if (!mtl.normal_texname.empty())
+    layer.normal = file_texture(folder, mtl.normal_texname);
+  else if (layer.height.source != TextureSource::None)
+    layer.normal.source = TextureSource::FromHeight;
   m.name = mtl.name;
   m.layers = {layer};
   return m;
@@ -275,6 +283,8 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   MeshData m;
   for (std::size_t i = 0; i < mtls.size(); ++i) {
     m.materials.push_back(convert_material(mtls[i], reader.folder_of(i)));
+    m.bump_maps.push_back(mtls[i].bump_texname.empty() ? fs::path()
+                                                        : file_texture(reader.folder_of(i), mtls[i].bump_texname).file);
     // Every map the MTL file names for qdmr (map_Kd, norm, disp, bump) is checked now, used or not: a damaged or
     // special file is an error even when the technique would not sample it.
     for (const std::string* map : {&mtls[i].diffuse_texname, &mtls[i].normal_texname, &mtls[i].displacement_texname,
@@ -340,6 +350,7 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
     material.name = unique_name(m.materials, "default");
     material.layers = {white};
     m.materials.push_back(material);
+    m.bump_maps.emplace_back();
   }
 
   // Missing normals: area-weighted face normals summed per OBJ position (smooth across UV seams).

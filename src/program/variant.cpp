@@ -64,7 +64,7 @@ TraceOptions trace_options(const MaterialDesc& material) {
   TraceOptions o;
   o.technique = material.technique.kind;
   if (o.technique == TechniqueKind::Qdm) {
-    o.sm3_cells = material.sampling.math == MathMode::Sm3;
+    o.math = material.sampling.math;
     o.filtered_max = material.technique.height_fetch == HeightFetch::Trilinear;
     o.level_up = material.technique.level_up;
   }
@@ -74,7 +74,8 @@ TraceOptions trace_options(const MaterialDesc& material) {
 std::string trace_variant_name(const TraceOptions& o) {
   std::string name = technique_name(o.technique);
   if (o.technique == TechniqueKind::Qdm)
-    name += std::string("<") + (o.sm3_cells ? "sm3_cells" : "int_cells") + "," +
+    name += std::string("<") +
+            (o.math == MathMode::Sm3 ? "sm3_cells" : o.math == MathMode::Exact ? "fp64_walls" : "int_cells") + "," +
             (o.filtered_max ? "filtered_max" : "max_fetch") + ",level_up_" + level_up_name(o.level_up) + ">";
   return name;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // Program variants: the options a material fixes that a displacement program's inner loops would otherwise test
 // per iteration are template arguments of the program's trace (shade/displacement.cpp instantiates every
-// combination below, 17 per ISA). The plan derives the options from the material (trace_options) and names the
+// combination below, 23 per ISA). The plan derives the options from the material (trace_options) and names the
 // variant; the program reports the name of the instantiation it runs, from its template arguments. A test checks
 // that the two agree.
 #include <string>
@@ -12,7 +12,9 @@ namespace qdmr {
 
 struct TraceOptions {
   TechniqueKind technique = TechniqueKind::Normal;
-  bool sm3_cells = false;     // qdm: cells found again from the fp32 position after a crossing (SM3 emulation)
+  // qdm: sm4 steps integer cells, sm3 finds them again from the fp32 position after a crossing (SM3 emulation),
+  // exact steps integer cells and computes wall crossings in fp64.
+  MathMode math = MathMode::Sm4;
   bool filtered_max = false;  // qdm: LinearMipMapLinear over the max chain (height_fetch trilinear)
   QdmLevelUp level_up = QdmLevelUp::One;  // qdm
   bool operator==(const TraceOptions&) const = default;
@@ -20,7 +22,7 @@ struct TraceOptions {
 
 // The options of a material, canonical: those its technique ignores are left at their defaults.
 TraceOptions trace_options(const MaterialDesc& material);
-// "relief", "pom", "csm", "rcsm", "normal", "qdm<int_cells,max_fetch,level_up_one>".
+// "relief", "pom", "csm", "rcsm", "normal", "qdm<int_cells,max_fetch,level_up_one>" (sm3_cells, fp64_walls).
 std::string trace_variant_name(const TraceOptions& options);
 
 // The whole variant as `qdmr plan` and the stats name it: the trace variant and the options the program reads

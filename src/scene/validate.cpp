@@ -372,6 +372,99 @@ BlendDesc read_blend(const Value& value) {
   return d;
 }
 
+// Shadows and AO trace the displaced surface: a material with either needs a displacement technique.
+void check_visibility_needs_displacement(const Object& object, const MaterialDesc& material) {
+  const bool displaced = material.technique.kind != TechniqueKind::Normal;
+  if (material.shadow.mode != ShadowMode::Off && !displaced)
+    object.required("shadow").fail("self-shadowing needs a displacement technique (technique/name is 'normal')");
+  if (material.ao.mode != AoMode::Off && !displaced)
+    object.required("ao").fail("ambient occlusion needs a displacement technique (technique/name is 'normal')");
+}
+
+// The keys given in a `technique` block, over what `d` holds (the defaults, or an MTL material's mapping).
+void read_technique(const Value& value, TechniqueDesc& d) {
+  const Object technique(value, {"name", "depth_scale", "write_depth", "linear_steps", "binary_steps", "min_steps",
+                                 "max_steps", "lod_threshold", "lod_fade", "max_iterations", "min_iterations",
+                                 "level_up", "refinement", "height_fetch", "lod_stop", "fade_start", "fade_end"});
+  if (auto t = technique.find("name"))
+    d.kind = t->choice<TechniqueKind>({{"normal", TechniqueKind::Normal},
+                                       {"relief", TechniqueKind::Relief},
+                                       {"pom", TechniqueKind::Pom},
+                                       {"csm", TechniqueKind::Csm},
+                                       {"rcsm", TechniqueKind::Rcsm},
+                                       {"qdm", TechniqueKind::Qdm}});
+  if (auto t = technique.find("depth_scale")) d.depth_scale = static_cast<float>(t->number_in(0.0, 100.0));
+  if (auto t = technique.find("write_depth")) d.write_depth = t->boolean();
+  if (auto t = technique.find("linear_steps")) d.linear_steps = static_cast<int>(t->integer(1, 4096));
+  if (auto t = technique.find("binary_steps")) d.binary_steps = static_cast<int>(t->integer(0, 64));
+  if (auto t = technique.find("min_steps")) d.min_steps = static_cast<int>(t->integer(1, 4096));
+  if (auto t = technique.find("max_steps")) {
+    d.max_steps = static_cast<int>(t->integer(1, 4096));
+    t->require(d.max_steps >= d.min_steps, "must not be below min_steps");
+  }
+  if (auto t = technique.find("lod_threshold")) d.lod_threshold = static_cast<float>(t->number_in(-16.0, 16.0));
+  if (auto t = technique.find("lod_fade")) d.lod_fade = static_cast<float>(t->number_in(0.0, 16.0));
+  if (auto t = technique.find("max_iterations")) d.max_iterations = static_cast<int>(t->integer(1, 1 << 20));
+  if (auto t = technique.find("min_iterations")) {
+    d.min_iterations = static_cast<int>(t->integer(0, 1 << 20));
+    t->require(d.min_iterations <= d.max_iterations, "must not exceed max_iterations");
+  }
+  if (auto t = technique.find("level_up"))
+    d.level_up = t->choice<QdmLevelUp>(
+        {{"stay", QdmLevelUp::Stay}, {"one", QdmLevelUp::One}, {"aligned", QdmLevelUp::Aligned}});
+  if (auto t = technique.find("refinement"))
+    d.refinement = t->choice<QdmRefinement>({{"none", QdmRefinement::None},
+                                             {"linear", QdmRefinement::Linear},
+                                             {"binary", QdmRefinement::Binary},
+                                             {"bilinear_patch", QdmRefinement::BilinearPatch}});
+  if (auto t = technique.find("height_fetch"))
+    d.height_fetch = t->choice<HeightFetch>(
+        {{"point", HeightFetch::Point}, {"bilinear", HeightFetch::Bilinear}, {"trilinear", HeightFetch::Trilinear}});
+  if (auto t = technique.find("lod_stop")) d.lod_stop = t->boolean();
+  if (auto t = technique.find("fade_start")) d.fade_start = static_cast<float>(t->non_negative());
+  if (auto t = technique.find("fade_end")) {
+    d.fade_end = static_cast<float>(t->non_negative());
+    t->require(d.fade_end >= d.fade_start, "must not be below fade_start");
+  }
+}
+
+void read_sampling(const Value& value, SamplingDesc& d) {
+  const Object sampling(value, {"filter", "address", "precision", "lod", "lod_bias", "min_lod", "max_lod", "math"});
+  if (auto s = sampling.find("filter"))
+    d.filter = s->choice<Filter>({{"point", Filter::Point},
+                                  {"bilinear", Filter::Bilinear},
+                                  {"trilinear", Filter::Trilinear},
+                                  {"point_mip_point", Filter::PointMipPoint},
+                                  {"point_mip_linear", Filter::PointMipLinear},
+                                  {"linear_mip_point", Filter::LinearMipPoint}});
+  if (auto s = sampling.find("address"))
+    d.address = s->choice<AddressMode>(
+        {{"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp}, {"mirror", AddressMode::Mirror}});
+  if (auto s = sampling.find("precision"))
+    d.precision = s->choice<SamplePrecision>(
+        {{"exact", SamplePrecision::Exact}, {"hw8", SamplePrecision::Hw8}, {"hw6", SamplePrecision::Hw6}});
+  if (auto s = sampling.find("lod"))
+    d.lod = s->choice<LodMode>({{"per_quad", LodMode::PerQuad}, {"per_pixel", LodMode::PerPixel}});
+  if (auto s = sampling.find("lod_bias")) d.lod_bias = static_cast<float>(s->number_in(-16.0, 16.0));
+  if (auto s = sampling.find("min_lod")) d.min_lod = static_cast<float>(s->number_in(0.0, 16.0));
+  if (auto s = sampling.find("max_lod")) {
+    d.max_lod = static_cast<float>(s->number_in(0.0, 16.0));
+    s->require(d.max_lod >= d.min_lod, "must not be below min_lod");
+  }
+  if (auto s = sampling.find("math"))
+    d.math = s->choice<MathMode>({{"sm4", MathMode::Sm4}, {"sm3", MathMode::Sm3}, {"exact", MathMode::Exact}});
+}
+
+void read_lighting(const Value& value, LightingDesc& d) {
+  const Object lighting(value, {"model", "specular", "shininess", "roughness"});
+  if (auto l = lighting.find("model"))
+    d.model = l->choice<LightingModel>(
+        {{"blinn_phong", LightingModel::BlinnPhong}, {"cook_torrance", LightingModel::CookTorrance}});
+  if (auto l = lighting.find("specular")) d.specular = static_cast<float>(l->non_negative());
+  if (auto l = lighting.find("shininess")) d.shininess = static_cast<float>(l->positive());
+  if (auto l = lighting.find("roughness")) d.roughness = static_cast<float>(l->number_in(0.02, 1.0));
+}
+
 MaterialDesc read_material(const Value& value, const std::string& name) {
   const Object object(value, {"layers", "technique", "sampling", "lighting", "shadow", "ao", "blend"});
   MaterialDesc material;
@@ -383,96 +476,13 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
       "expected 1 to " + std::to_string(limits::kMaxLayers) + " layers, got " + std::to_string(items.size()));
   for (const Value& item : items) material.layers.push_back(read_layer(item));
 
-  if (auto v = object.find("technique")) {
-    const Object technique(*v, {"name", "depth_scale", "write_depth", "linear_steps", "binary_steps", "min_steps",
-                                "max_steps", "lod_threshold", "lod_fade", "max_iterations", "min_iterations", "level_up",
-                                "refinement", "height_fetch", "lod_stop", "fade_start", "fade_end"});
-    TechniqueDesc& d = material.technique;
-    if (auto t = technique.find("name"))
-      d.kind = t->choice<TechniqueKind>({{"normal", TechniqueKind::Normal},
-                                         {"relief", TechniqueKind::Relief},
-                                         {"pom", TechniqueKind::Pom},
-                                         {"csm", TechniqueKind::Csm},
-                                         {"rcsm", TechniqueKind::Rcsm},
-                                         {"qdm", TechniqueKind::Qdm}});
-    if (auto t = technique.find("depth_scale")) d.depth_scale = static_cast<float>(t->number_in(0.0, 100.0));
-    if (auto t = technique.find("write_depth")) d.write_depth = t->boolean();
-    if (auto t = technique.find("linear_steps")) d.linear_steps = static_cast<int>(t->integer(1, 4096));
-    if (auto t = technique.find("binary_steps")) d.binary_steps = static_cast<int>(t->integer(0, 64));
-    if (auto t = technique.find("min_steps")) d.min_steps = static_cast<int>(t->integer(1, 4096));
-    if (auto t = technique.find("max_steps")) {
-      d.max_steps = static_cast<int>(t->integer(1, 4096));
-      t->require(d.max_steps >= d.min_steps, "must not be below min_steps");
-    }
-    if (auto t = technique.find("lod_threshold")) d.lod_threshold = static_cast<float>(t->number_in(-16.0, 16.0));
-    if (auto t = technique.find("lod_fade")) d.lod_fade = static_cast<float>(t->number_in(0.0, 16.0));
-    if (auto t = technique.find("max_iterations")) d.max_iterations = static_cast<int>(t->integer(1, 1 << 20));
-    if (auto t = technique.find("min_iterations")) {
-      d.min_iterations = static_cast<int>(t->integer(0, 1 << 20));
-      t->require(d.min_iterations <= d.max_iterations, "must not exceed max_iterations");
-    }
-    if (auto t = technique.find("level_up"))
-      d.level_up = t->choice<QdmLevelUp>(
-          {{"stay", QdmLevelUp::Stay}, {"one", QdmLevelUp::One}, {"aligned", QdmLevelUp::Aligned}});
-    if (auto t = technique.find("refinement"))
-      d.refinement = t->choice<QdmRefinement>({{"none", QdmRefinement::None},
-                                               {"linear", QdmRefinement::Linear},
-                                               {"binary", QdmRefinement::Binary},
-                                               {"bilinear_patch", QdmRefinement::BilinearPatch}});
-    if (auto t = technique.find("height_fetch"))
-      d.height_fetch = t->choice<HeightFetch>(
-          {{"point", HeightFetch::Point}, {"bilinear", HeightFetch::Bilinear}, {"trilinear", HeightFetch::Trilinear}});
-    if (auto t = technique.find("lod_stop")) d.lod_stop = t->boolean();
-    if (auto t = technique.find("fade_start")) d.fade_start = static_cast<float>(t->non_negative());
-    if (auto t = technique.find("fade_end")) {
-      d.fade_end = static_cast<float>(t->non_negative());
-      t->require(d.fade_end >= d.fade_start, "must not be below fade_start");
-    }
-  }
-  if (auto v = object.find("sampling")) {
-    const Object sampling(*v, {"filter", "address", "precision", "lod", "lod_bias", "min_lod", "max_lod", "math"});
-    SamplingDesc& d = material.sampling;
-    if (auto s = sampling.find("filter"))
-      d.filter = s->choice<Filter>({{"point", Filter::Point},
-                                    {"bilinear", Filter::Bilinear},
-                                    {"trilinear", Filter::Trilinear},
-                                    {"point_mip_point", Filter::PointMipPoint},
-                                    {"point_mip_linear", Filter::PointMipLinear},
-                                    {"linear_mip_point", Filter::LinearMipPoint}});
-    if (auto s = sampling.find("address"))
-      d.address = s->choice<AddressMode>(
-          {{"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp}, {"mirror", AddressMode::Mirror}});
-    if (auto s = sampling.find("precision"))
-      d.precision = s->choice<SamplePrecision>(
-          {{"exact", SamplePrecision::Exact}, {"hw8", SamplePrecision::Hw8}, {"hw6", SamplePrecision::Hw6}});
-    if (auto s = sampling.find("lod"))
-      d.lod = s->choice<LodMode>({{"per_quad", LodMode::PerQuad}, {"per_pixel", LodMode::PerPixel}});
-    if (auto s = sampling.find("lod_bias")) d.lod_bias = static_cast<float>(s->number_in(-16.0, 16.0));
-    if (auto s = sampling.find("min_lod")) d.min_lod = static_cast<float>(s->number_in(0.0, 16.0));
-    if (auto s = sampling.find("max_lod")) {
-      d.max_lod = static_cast<float>(s->number_in(0.0, 16.0));
-      s->require(d.max_lod >= d.min_lod, "must not be below min_lod");
-    }
-    if (auto s = sampling.find("math"))
-      d.math = s->choice<MathMode>({{"sm4", MathMode::Sm4}, {"sm3", MathMode::Sm3}, {"exact", MathMode::Exact}});
-  }
-  if (auto v = object.find("lighting")) {
-    const Object lighting(*v, {"model", "specular", "shininess", "roughness"});
-    if (auto l = lighting.find("model"))
-      material.lighting.model = l->choice<LightingModel>(
-          {{"blinn_phong", LightingModel::BlinnPhong}, {"cook_torrance", LightingModel::CookTorrance}});
-    if (auto l = lighting.find("specular")) material.lighting.specular = static_cast<float>(l->non_negative());
-    if (auto l = lighting.find("shininess")) material.lighting.shininess = static_cast<float>(l->positive());
-    if (auto l = lighting.find("roughness")) material.lighting.roughness = static_cast<float>(l->number_in(0.02, 1.0));
-  }
+  if (auto v = object.find("technique")) read_technique(*v, material.technique);
+  if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);
+  if (auto v = object.find("lighting")) read_lighting(*v, material.lighting);
   if (auto v = object.find("shadow")) material.shadow = read_shadow(*v);
   if (auto v = object.find("ao")) material.ao = read_ao(*v);
   if (auto v = object.find("blend")) material.blend = read_blend(*v);
-  const bool displaced = material.technique.kind != TechniqueKind::Normal;
-  if (material.shadow.mode != ShadowMode::Off && !displaced)
-    object.required("shadow").fail("self-shadowing needs a displacement technique (technique/name is 'normal')");
-  if (material.ao.mode != AoMode::Off && !displaced)
-    object.required("ao").fail("ambient occlusion needs a displacement technique (technique/name is 'normal')");
+  check_visibility_needs_displacement(object, material);
   return material;
 }
 
@@ -545,7 +555,7 @@ TransformDesc read_transform(const Value& value) {
 }
 
 ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<MaterialDesc>& materials) {
-  const Object object(value, {"name", "mesh", "material", "transform"});
+  const Object object(value, {"name", "mesh", "material", "transform", "mtl"});
   ObjectDesc result;
   result.name = "object " + std::to_string(index);
   if (auto v = object.find("name")) {
@@ -568,10 +578,48 @@ ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<
                   "missing key 'material' (only obj meshes may leave it out to use their own MTL materials)");
   }
   if (auto v = object.find("transform")) result.transform = read_transform(*v);
+  if (auto v = object.find("mtl")) {
+    // The entries are checked by read_mtl_override once the OBJ is read and its material names are known.
+    v->require(result.mesh.kind == MeshKind::Obj && result.material.empty(),
+               "only an obj mesh without 'material' has MTL materials to override");
+    v->expect_type(json::value_t::object, "an object mapping MTL material names to overrides");
+  }
   return result;
 }
 
 }  // namespace
+
+void read_mtl_override(const Value& value, MaterialDesc& material, const std::filesystem::path& bump) {
+  const Object object(value, {"technique", "sampling", "lighting", "shadow", "ao", "bump", "normal_strength",
+                              "normal_convention", "height_scale", "height_offset"});
+  LayerDesc& layer = material.layers.front();
+  if (auto v = object.find("bump")) {
+    enum class Bump { Height, Normal };
+    if (v->choice<Bump>({{"height", Bump::Height}, {"normal", Bump::Normal}}) == Bump::Normal) {
+      v->require(!bump.empty(), "the MTL material has no bump map");
+      if (layer.height.source == TextureSource::File && layer.height.file == bump) layer.height = TextureDesc{};
+      if (layer.normal.source != TextureSource::File) {  // a `norm` map wins
+        layer.normal.source = TextureSource::File;
+        layer.normal.file = bump;
+      }
+    }
+  }
+  if (auto v = object.find("normal_convention"))
+    layer.normal_convention = v->choice<NormalConvention>({{"gl", NormalConvention::GL}, {"dx", NormalConvention::DX}});
+  if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
+  if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
+  if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
+  if (auto v = object.find("technique")) read_technique(*v, material.technique);
+  if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);
+  if (auto v = object.find("lighting")) read_lighting(*v, material.lighting);
+  if (auto v = object.find("shadow")) material.shadow = read_shadow(*v);
+  if (auto v = object.find("ao")) material.ao = read_ao(*v);
+  if (material.technique.kind != TechniqueKind::Normal && layer.height.source == TextureSource::None)
+    member_or_self(object, "technique")
+        .fail("a displacement technique needs a height: this MTL material has no disp map, and no bump map read as "
+              "a height");
+  check_visibility_needs_displacement(object, material);
+}
 
 SceneDesc validate_scene(const json& document, const Context& context) {
   const Value root(context, document, "");

@@ -9,4 +9,8 @@ namespace qdmr::scene_detail {
 // Checks the whole document and converts it; the first problem found throws qdmr::Error.
 SceneDesc validate_scene(const nlohmann::json& document, const Context& context);
 
+// One entry of an OBJ object's `mtl` block (value: /objects/N/mtl/NAME) applied over `material`, the mapping of
+// that MTL material (mesh/obj.cpp); `bump` is its bump map file, empty if it has none.
+void read_mtl_override(const Value& value, MaterialDesc& material, const std::filesystem::path& bump);
+
 }  // namespace qdmr::scene_detail

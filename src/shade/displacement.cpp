@@ -392,7 +392,7 @@ DisplacementProgram::Variant DisplacementProgram::variant() {
 }
 
 // Every combination of the trace options is instantiated (program/variant.hpp): 5 techniques, and for qdm
-// 2 cell modes x 2 max fetches x 3 level-up rules.
+// 3 math modes x 2 max fetches x 3 level-up rules.
 DisplacementProgram::Variant DisplacementProgram::select(const TraceOptions& o) {
   using K = TechniqueKind;
   switch (o.technique) {
@@ -403,16 +403,23 @@ DisplacementProgram::Variant DisplacementProgram::select(const TraceOptions& o) 
     case K::Rcsm: return variant<Trace<K::Rcsm>>();
     case K::Qdm: break;
   }
-  const auto qdm = [&]<bool Sm3, bool Filtered>() -> Variant {
+  const auto qdm = [&]<MathMode M, bool Filtered>() -> Variant {
     switch (o.level_up) {
-      case QdmLevelUp::Stay: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::Stay>>();
-      case QdmLevelUp::One: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::One>>();
-      case QdmLevelUp::Aligned: return variant<Trace<K::Qdm, Sm3, Filtered, QdmLevelUp::Aligned>>();
+      case QdmLevelUp::Stay: return variant<Trace<K::Qdm, M, Filtered, QdmLevelUp::Stay>>();
+      case QdmLevelUp::One: return variant<Trace<K::Qdm, M, Filtered, QdmLevelUp::One>>();
+      case QdmLevelUp::Aligned: return variant<Trace<K::Qdm, M, Filtered, QdmLevelUp::Aligned>>();
     }
     throw Error("displacement program", "unknown level_up");
   };
-  if (o.sm3_cells) return o.filtered_max ? qdm.operator()<true, true>() : qdm.operator()<true, false>();
-  return o.filtered_max ? qdm.operator()<false, true>() : qdm.operator()<false, false>();
+  const auto fetch = [&]<MathMode M>() -> Variant {
+    return o.filtered_max ? qdm.template operator()<M, true>() : qdm.template operator()<M, false>();
+  };
+  switch (o.math) {
+    case MathMode::Sm4: return fetch.operator()<MathMode::Sm4>();
+    case MathMode::Sm3: return fetch.operator()<MathMode::Sm3>();
+    case MathMode::Exact: return fetch.operator()<MathMode::Exact>();
+  }
+  throw Error("displacement program", "unknown math mode");
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -22,13 +22,14 @@
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // A trace variant: the options of program/variant.hpp as compile-time constants of the inner loops.
-template <TechniqueKind T, bool Sm3Cells = false, bool FilteredMax = false, QdmLevelUp LevelUp = QdmLevelUp::One>
+template <TechniqueKind T, MathMode Math = MathMode::Sm4, bool FilteredMax = false,
+          QdmLevelUp LevelUp = QdmLevelUp::One>
 struct Trace {
   static constexpr TechniqueKind technique = T;
-  static constexpr bool sm3_cells = Sm3Cells;
+  static constexpr MathMode math = Math;
   static constexpr bool filtered_max = FilteredMax;
   static constexpr QdmLevelUp level_up = LevelUp;
-  static TraceOptions options() { return {T, Sm3Cells, FilteredMax, LevelUp}; }
+  static TraceOptions options() { return {T, Math, FilteredMax, LevelUp}; }
 };
 
 class DisplacementProgram final : public ShadingProgram {

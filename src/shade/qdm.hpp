@@ -9,11 +9,13 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
 // Quadtree displacement mapping (Drobot 2009) over the max-quadtree: from the root, advance to the nearer of
 // the cell's top plane and its wall while the ray is above the cell's highest point, descend otherwise; a
-// level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices (SM4) stepped
-// exactly across walls, or recomputed from the fp32 position (SM3 emulation).
+// level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices stepped exactly
+// across walls (sm4, exact), or recomputed from the fp32 position (sm3 emulation); where the ray crosses walls and
+// mid lines is computed in fp32, or in fp64 and rounded once (exact).
 template <class V, class Surface>
 Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
                                                  const Float& stop_level, const Int& cap, Mask active) {
+  constexpr bool fp64 = V::math == MathMode::Exact;
   const int top = surface.top_level();
   const float width = float(surface.width()), height = float(surface.height());
   const IntMask none = Int(0) != Int(0);
@@ -42,12 +44,12 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
     active = active & !hit;
     // Below the cell's top but not at the last level: descend into the child that holds the ray.
     const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) descend_to_child(descend, s, x0, y0, dx, dy, level, cx, cy);
+    if (xsimd::any(descend)) descend_to_child<fp64>(descend, s, x0, y0, dx, dy, level, cx, cy);
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
     const Mask above = active & !below;
     if (!xsimd::any(above)) continue;
     Float tx, ty;
-    exit_walls(level, cx, cy, x0, y0, dx, dy, step_x_pos, step_y_pos, tx, ty);
+    exit_walls<fp64>(level, cx, cy, x0, y0, dx, dy, step_x_pos, step_y_pos, tx, ty);
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s);
     const Mask to_plane = above & (top_depth <= t_wall);
     s = xsimd::select(to_plane, top_depth, s);
@@ -56,7 +58,7 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
     const IntMask cross_i = int_mask(cross);
     const IntMask cross_x = cross_i & int_mask(tx <= ty);
     const IntMask cross_y = cross_i & int_mask(ty <= tx);
-    if constexpr (V::sm3_cells) {
+    if constexpr (V::math == MathMode::Sm3) {
       // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
       const Float nudge = Float(1.0f / 64.0f);
       const Float cell = xsimd::to_float(Int(1) << level);

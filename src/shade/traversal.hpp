@@ -29,9 +29,27 @@ struct CappedLoop {
   simd::Float iterations() const { return xsimd::to_float(done); }
 };
 
+// Where the ray x(t) = origin + dir t crosses the line x = wall, per lane: (wall - origin) / dir in fp32 (two
+// roundings), or with Fp64 in fp64 rounded once to fp32 (the `exact` math mode's QDM walk). Lanes with dir 0 give
+// an infinity or NaN for the caller to select away.
+template <bool Fp64>
+inline simd::Float crossing(const simd::Float& wall, const simd::Float& origin, const simd::Float& dir) {
+  if constexpr (!Fp64) {
+    return (wall - origin) / dir;
+  } else {
+    alignas(64) float w[simd::kLanes], o[simd::kLanes], d[simd::kLanes], t[simd::kLanes];
+    wall.store_aligned(w);
+    origin.store_aligned(o);
+    dir.store_aligned(d);
+    for (int i = 0; i < simd::kLanes; ++i) t[i] = float((double(w[i]) - double(o[i])) / double(d[i]));
+    return simd::Float::load_aligned(t);
+  }
+}
+
 // Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray x(t) = x0 + dx t,
 // y(t) = y0 + dy t (texel units) at t: t is compared with where the ray crosses the parent's mid lines, computed
 // exactly as wall crossings are, so a ray standing on a wall is never put back into the cell it just left.
+template <bool Fp64 = false>
 inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const simd::Float& x0,
                              const simd::Float& y0, const simd::Float& dx, const simd::Float& dy, simd::Int& level,
                              simd::Int& cx, simd::Int& cy) {
@@ -42,10 +60,9 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
   const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
   const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
   const Float zero(0.0f);
-  const simd::Mask high_x = ((dx > zero) & (t >= (mid_x - x0) / dx)) | ((dx < zero) & (t < (mid_x - x0) / dx)) |
-                            ((dx == zero) & (x0 >= mid_x));
-  const simd::Mask high_y = ((dy > zero) & (t >= (mid_y - y0) / dy)) | ((dy < zero) & (t < (mid_y - y0) / dy)) |
-                            ((dy == zero) & (y0 >= mid_y));
+  const Float tx = crossing<Fp64>(mid_x, x0, dx), ty = crossing<Fp64>(mid_y, y0, dy);
+  const simd::Mask high_x = ((dx > zero) & (t >= tx)) | ((dx < zero) & (t < tx)) | ((dx == zero) & (x0 >= mid_x));
+  const simd::Mask high_y = ((dy > zero) & (t >= ty)) | ((dy < zero) & (t < ty)) | ((dy == zero) & (y0 >= mid_y));
   cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
   cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
   level = xsimd::select(descend, child_level, level);
@@ -53,6 +70,7 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
 
 // Where the ray x(t) = x0 + dx t, y(t) = y0 + dy t (texel units) crosses the exit walls of cell (cx, cy) of `level`
 // (the walls ahead in each axis: step_*_pos says which), as t; infinity in an axis the ray is parallel to.
+template <bool Fp64 = false>
 inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const simd::Float& x0,
                        const simd::Float& y0, const simd::Float& dx, const simd::Float& dy,
                        const simd::IntMask& step_x_pos, const simd::IntMask& step_y_pos, simd::Float& tx,
@@ -63,8 +81,8 @@ inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::
   const Float cell = xsimd::to_float(Int(1) << level);
   const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
   const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
-  tx = xsimd::select(dx != zero, (wall_x - x0) / dx, inf);
-  ty = xsimd::select(dy != zero, (wall_y - y0) / dy, inf);
+  tx = xsimd::select(dx != zero, crossing<Fp64>(wall_x, x0, dx), inf);
+  ty = xsimd::select(dy != zero, crossing<Fp64>(wall_y, y0, dy), inf);
 }
 
 // After a wall crossing, the `climbing` lanes go up while the wall just crossed (cross_x / cross_y) is also a

@@ -53,39 +53,37 @@ int address(std::int64_t i, int n, AddressMode mode) {
 // Size of level k along an axis of n level-0 texels.
 int level_size(int n, int k) { return std::max(1, n >> k); }
 
-// Nearest texel index along an axis: floor(t), with t = u' * size in texels.
-std::int64_t point_index(float t, int bits) {
-  if (bits == 0) return std::int64_t(std::floor(t));
-  const std::int64_t fixed = std::int64_t(std::floor(t * float(1 << bits)));
-  return floor_div(fixed, bits);
-}
-
-// First bilinear tap and the weight of the second, for p = u' * size - 0.5.
-void bilinear_taps(float p, int bits, std::int64_t& first, float& weight) {
+// Texel index along an axis and the weight of the next texel: the texel coordinate x = u * n - offset (offset 0
+// for point sampling, 0.5 for the first bilinear tap) in fixed point with `bits` fractional bits, rounded down:
+// from the fp32 x (sm3) or from the exact x (sm4, exact; in fp64, where u * n - offset is exact or, for
+// |u * n| < 1, far from every multiple of 2^-8 it could round onto). Weight: the fixed-point fraction, or
+// the fp32 x minus the index.
+std::int64_t texel_index(float u, int n, float offset, int bits, MathMode math, float& weight) {
+  const float q = u * float(n) - offset;
+  const double scale = double(std::int64_t(1) << bits);
+  const std::int64_t fixed = math == MathMode::Sm3 ? std::int64_t(std::floor(double(q) * scale))
+                                                   : std::int64_t(std::floor((double(u) * n - offset) * scale));
   if (bits == 0) {
-    const float f = std::floor(p);
-    first = std::int64_t(f);
-    weight = p - f;
-    return;
+    weight = q - float(fixed);
+    return fixed;
   }
-  const std::int64_t fixed = std::int64_t(std::floor(p * float(1 << bits)));
-  first = floor_div(fixed, bits);
-  weight = float(fixed - first * (std::int64_t(1) << bits)) / float(1 << bits);
+  const std::int64_t index = floor_div(fixed, bits);
+  weight = float(fixed - index * (std::int64_t(1) << bits)) / float(1 << bits);
+  return index;
 }
 
 void sample_level(const Texture& t, const SamplingDesc& s, float u, float v, int level, bool linear, float* out) {
   const int w = level_size(t.width(), level), h = level_size(t.height(), level);
   const int bits = fraction_bits(s.precision);
+  float wx, wy;
   if (!linear) {
-    const int x = address(point_index(u * float(w), bits), w, s.address);
-    const int y = address(point_index(v * float(h), bits), h, s.address);
+    const int x = address(texel_index(u, w, 0.0f, bits, s.math, wx), w, s.address);
+    const int y = address(texel_index(v, h, 0.0f, bits, s.math, wy), h, s.address);
     for (int c = 0; c < t.channels(); ++c) out[c] = t.texel(level, x, y, c);
     return;
   }
-  std::int64_t x0, y0;
-  float wx, wy;
-  bilinear_taps(u * float(w) - 0.5f, bits, x0, wx);
-  bilinear_taps(v * float(h) - 0.5f, bits, y0, wy);
+  const std::int64_t x0 = texel_index(u, w, 0.5f, bits, s.math, wx);
+  const std::int64_t y0 = texel_index(v, h, 0.5f, bits, s.math, wy);
   const int xa = address(x0, w, s.address), xb = address(x0 + 1, w, s.address);
   const int ya = address(y0, h, s.address), yb = address(y0 + 1, h, s.address);
   for (int c = 0; c < t.channels(); ++c) {

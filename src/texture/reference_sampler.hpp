@@ -11,14 +11,16 @@
 //  - point/bilinear: level 0; *MipPoint: level floor(l + 0.5); trilinear and point-mip-linear: levels
 //    floor(l) and floor(l) + 1 (at most the last), blended by the fraction of l;
 //  - texel centres at (i + 0.5) / size; hw precision converts texel coordinates to fixed point with 8/6
-//    fractional bits, rounding down, for both the index and the bilinear weight.
+//    fractional bits, rounding down, for both the index and the bilinear weight;
+//  - math: the texel coordinate u * size (- 0.5 for bilinear taps) is floored as computed in fp32 (sm3) or
+//    exactly (sm4, exact); without hw precision the weight is the fp32 coordinate minus the index.
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
 
 // Every channel (texture.channels() of them) of the sample at (u, v) with an explicit LOD; out[c] for
-// c >= channels is left untouched. Only filter, address, precision, lod_bias, min_lod and max_lod of
+// c >= channels is left untouched. Only filter, address, precision, math, lod_bias, min_lod and max_lod of
 // `settings` are used.
 void reference_sample(const Texture& texture, const SamplingDesc& settings, float u, float v, float lod, float out[4]);
 

@@ -97,18 +97,45 @@ LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) 
   decode(t, simd::load_bytes4(t.storage.data(), offset, path), path, out);
 }
 
-// Texel index and bilinear weight of coordinate p (in texels, centres at integers + 0.5 already removed).
-void split(const Float& p, int bits, Int& index, Float& weight) {
+// u * n split into the fp32 product p and its rounding error e, exactly: p + e = u * n (Dekker's product, with
+// -ffp-contract=off; |u| <= 2 and n <= 16384 keep every partial product far from overflow and underflow).
+void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
+  p = u * n;
+  const Float split(4097.0f);  // 2^12 + 1: halves of 12 bits
+  const Float uc = u * split, nc = n * split;
+  const Float uh = uc - (uc - u), nh = nc - (nc - n);
+  const Float ul = u - uh, nl = n - nh;
+  e = ((uh * nh - p) + uh * nl + ul * nh) + ul * nl;
+}
+
+// Texel index and bilinear weight along one axis: the texel coordinate is x = u * n - offset (offset 0 for point
+// sampling, 0.5 for bilinear taps), in fixed point with `bits` fractional bits (0: a float), rounded down.
+// sm3 floors the fp32 x; with `exact`, the exact x is floored instead: the fp32 q = fl(fl(u * n) - offset) is
+// off by the two rounding errors, which together are below the distance from q to any other multiple of
+// 2^-bits (for the coordinates the address modes leave: u * n in [-n, 2n]), so q's floor is right unless q * 2^bits
+// is an integer that the exact x lies just below (docs/sampling.md, "Math modes"). The weight is q minus the
+// index in fixed point or in fp32 (1 when the exact index is the one below q).
+void split(const Float& u, const Float& n, float offset, int bits, bool exact, Int& index, Float& weight) {
+  Float p, e;
+  if (exact)
+    exact_product(u, n, p, e);
+  else
+    p = u * n;
+  const Float q = p - Float(offset);
+  const Float scaled = bits == 0 ? q : q * Float(float(1 << bits));
+  Float fixed = xsimd::floor(scaled);
+  if (exact) {
+    const Float back = q - p, d = (p - (q - back)) + (Float(0.0f) - Float(offset) - back);  // q + d = p - offset
+    fixed = xsimd::select((scaled == fixed) & ((d + e) < Float(0.0f)), fixed - Float(1.0f), fixed);
+  }
   if (bits == 0) {
-    const Float f = xsimd::floor(p);
-    index = xsimd::to_int(f);
-    weight = p - f;
+    index = xsimd::to_int(fixed);
+    weight = q - fixed;
     return;
   }
-  // Fixed point with `bits` fractional bits, rounded down, as the hardware converts coordinates.
-  const Int fixed = xsimd::to_int(xsimd::floor(p * Float(float(1 << bits))));
-  index = fixed >> bits;
-  weight = xsimd::to_float(fixed & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
+  const Int f = xsimd::to_int(fixed);
+  index = f >> bits;
+  weight = xsimd::to_float(f & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
 }
 
 void sample_level(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Int& level,
@@ -117,18 +144,20 @@ void sample_level(const TextureView& view, const SamplerState& s, const Float& u
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
   const int bits = fraction_bits(s.precision);
   const int channels = view.texture().channels();
+  // Power-of-two sizes make fl(u * n) exact and fp32 floors right without fixed point: every mode agrees there.
+  const bool exact = s.math != MathMode::Sm3 && (bits > 0 || !view.power_of_two());
   if (!linear) {
     Int x, y;
     Float unused;
-    split(u * w, bits, x, unused);
-    split(v * h, bits, y, unused);
+    split(u, w, 0.0f, bits, exact, x, unused);
+    split(v, h, 0.0f, bits, exact, y, unused);
     fetch(view, info, address(x, info.width, s.address), address(y, info.height, s.address), s.fetch, out);
     return;
   }
   Int x0, y0;
   Float wx, wy;
-  split(u * w - Float(0.5f), bits, x0, wx);
-  split(v * h - Float(0.5f), bits, y0, wy);
+  split(u, w, 0.5f, bits, exact, x0, wx);
+  split(v, h, 0.5f, bits, exact, y0, wy);
   const Int xa = address(x0, info.width, s.address), xb = address(x0 + Int(1), info.width, s.address);
   const Int ya = address(y0, info.height, s.address), yb = address(y0 + Int(1), info.height, s.address);
   Float t00[4], t10[4], t01[4], t11[4];
@@ -154,6 +183,8 @@ TextureView::TextureView(const Texture& texture) : texture_(&texture), levels_(t
     offset_[std::size_t(i)] = std::int32_t(l.offset);
   }
   for (int c = 0; c < texture.channels(); ++c) first_texel_[std::size_t(c)] = texture.texel(0, 0, 0, c);
+  const auto pow2 = [](int n) { return n > 0 && (n & (n - 1)) == 0; };
+  power_of_two_ = pow2(texture.width()) && pow2(texture.height());
 }
 
 Float lod_from_derivatives(const TextureView& view, const Float& dudx, const Float& dvdx, const Float& dudy,

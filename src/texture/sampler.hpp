@@ -26,18 +26,22 @@ public:
   const std::int32_t* offsets() const { return offset_.data(); }
   // Level-0 texel (0, 0), decoded: what lanes with non-finite coordinates return.
   const std::array<float, 4>& first_texel() const { return first_texel_; }
+  // Both sides of level 0 are powers of two (then so are every level's): fp32 texel coordinates are exact.
+  bool power_of_two() const { return power_of_two_; }
 
 private:
   const Texture* texture_;
   int levels_;
   alignas(64) std::array<std::int32_t, kMaxLevels> width_{}, height_{}, offset_{};
   std::array<float, 4> first_texel_{};
+  bool power_of_two_ = false;
 };
 
 struct SamplerState {
   Filter filter = Filter::Trilinear;
   AddressMode address = AddressMode::Wrap;
   SamplePrecision precision = SamplePrecision::Exact;
+  MathMode math = MathMode::Sm4;  // texel addressing: the exact texel coordinate (sm4, exact) or the fp32 one (sm3)
   float lod_bias = 0.0f;
   float min_lod = 0.0f, max_lod = 16.0f;
   simd::FetchPath fetch = simd::kHasHardwareGather ? simd::FetchPath::Gather : simd::FetchPath::Portable;
@@ -47,6 +51,7 @@ struct SamplerState {
     s.filter = d.filter;
     s.address = d.address;
     s.precision = d.precision;
+    s.math = d.math;
     s.lod_bias = d.lod_bias;
     s.min_lod = d.min_lod;
     s.max_lod = d.max_lod;

@@ -356,11 +356,14 @@ TEST(Obj, QuadWithUvsNormalsAndMaterials) {
   EXPECT_EQ(stone.normal.file, dir.path() / "mat/tex/normal.png");
   EXPECT_EQ(stone.height.source, TextureSource::File);
   EXPECT_EQ(stone.height.file, dir.path() / "mat/tex/disp.png");  // disp wins over bump
+  EXPECT_EQ(m.materials[0].technique.kind, TechniqueKind::Pom);   // and is displaced
+  EXPECT_EQ(m.bump_maps, (std::vector<std::filesystem::path>{dir.path() / "mat/tex/bump.png", dir.path() / "bump.png", {}}));
 
   const LayerDesc& painted = m.materials[1].layers[0];
   EXPECT_EQ(painted.albedo.source, TextureSource::Constant);
   EXPECT_EQ(painted.albedo.constant, glm::vec4(0.2f, 0.4f, 0.6f, 1.0f));
-  EXPECT_EQ(painted.normal.source, TextureSource::None);
+  EXPECT_EQ(painted.normal.source, TextureSource::FromHeight);  // bump mapping: normals from the bump height
+  EXPECT_EQ(m.materials[1].technique.kind, TechniqueKind::Normal);
   EXPECT_EQ(painted.height.file, dir.path() / "bump.png");
   EXPECT_TRUE(painted.height.file.is_absolute());
 

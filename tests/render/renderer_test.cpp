@@ -117,7 +117,11 @@ TEST(Renderer, EveryTraceVariantRunsTheInstantiationThePlanNames) {
             const std::string expected =
                 technique == "normal" ? "normal_mapping"
                 : technique != "qdm"  ? "displacement:" + technique + " "
-                                      : "displacement:qdm<" + std::string(math == "sm3" ? "sm3_cells" : "int_cells") + "," +
+                                      : "displacement:qdm<" +
+                                             std::string(math == "sm3"     ? "sm3_cells"
+                                                         : math == "exact" ? "fp64_walls"
+                                                                           : "int_cells") +
+                                             "," +
                                            (fetch == "trilinear" ? "filtered_max" : "max_fetch") + ",level_up_" +
                                            level_up + ">";
             EXPECT_EQ(ran.rfind(expected, 0), 0u) << ran << " does not start with " << expected;

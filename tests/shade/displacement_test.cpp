@@ -9,6 +9,7 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/displacement_test_util.hpp"
+#include "shade/traversal.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -119,6 +120,70 @@ TEST(Qdm, Sm3DivergesFromSm4WhereFp32PositionsRunOut) {
     else
       EXPECT_EQ(differ, 0) << c.size << " at " << c.offset;
   }
+}
+
+// math: exact computes where the ray crosses a wall or a mid line, (wall - origin) / direction, in fp64 rounded
+// once; sm4 in fp32, rounded twice. The two are the same function of the same floats wherever the fp32 result
+// happens to be correctly rounded, and differ by an ulp elsewhere.
+TEST(Qdm, ExactComputesWallCrossingsInFp64) {
+  using simd::Float;
+  int differ = 0;
+  for (int wall = 1; wall <= 64; ++wall) {
+    const Float w = Float(float(wall)), o = Float(0.3f), d = Float(0.7f);
+    float fp32[simd::kLanes], fp64[simd::kLanes];
+    crossing<false>(w, o, d).store_unaligned(fp32);
+    crossing<true>(w, o, d).store_unaligned(fp64);
+    EXPECT_EQ(fp32[0], (float(wall) - 0.3f) / 0.7f);
+    EXPECT_EQ(fp64[0], float((double(wall) - double(0.3f)) / double(0.7f)));
+    differ += fp32[0] != fp64[0];
+  }
+  EXPECT_GT(differ, 0);  // e.g. 5 - 0.3f is not a float: fp32 rounds it before dividing
+}
+
+// Every pair of math modes gives other hits on some rays, where the arithmetic they differ in decides, and the
+// same bits where it cannot matter.
+TEST(Qdm, EachPairOfMathModesDiffersWhereItsArithmeticDoes) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::None;
+  t.depth_scale = 0.05f;
+  t.max_iterations = 4096;
+  const auto run = [&](const Image& heights, MathMode math, double offset) {
+    TechniqueHarness harness(heights, t);
+    harness.set_math(math);
+    std::vector<TechniqueRay> rs = rays(32, 11);
+    for (TechniqueRay& r : rs) r.u0 += offset, r.v0 += offset;
+    return harness.run(rs);
+  };
+  // How many hits differ in any bit, and the largest distance between two hits in texels of a `size` map.
+  struct Difference {
+    int rays = 0;
+    double texels = 0.0;
+  };
+  const auto compare = [](const std::vector<TechniqueResult>& a, const std::vector<TechniqueResult>& b, int size) {
+    Difference d;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      d.rays += a[i].hit_u != b[i].hit_u || a[i].hit_v != b[i].hit_v || a[i].hit_depth != b[i].hit_depth;
+      d.texels = std::max(d.texels, std::hypot(a[i].hit_u - b[i].hit_u, a[i].hit_v - b[i].hit_v) * size);
+    }
+    return d;
+  };
+  // sm4 against exact: rays starting in the first repeat (u, v in [0, 1)) have texel positions finer than fp32
+  // keeps in wall - x0 for far walls, so fp32 rounds twice where fp64 rounds once; the hits move by far less
+  // than a texel. From the second repeat on, x0's own grid is as coarse as the difference's for walls within about
+  // a repeat of it: wall - x0 is exact in fp32, and on these rays the two modes give the same bits.
+  const Image sine = pattern(ProceduralPattern::Sine, 1024, 4);
+  const Difference first = compare(run(sine, MathMode::Sm4, 0.0), run(sine, MathMode::Exact, 0.0), 1024);
+  EXPECT_GT(first.rays, 0);
+  EXPECT_LT(first.texels, 1e-3);
+  EXPECT_EQ(compare(run(sine, MathMode::Sm4, 1.0), run(sine, MathMode::Exact, 1.0), 1024).rays, 0);
+  EXPECT_EQ(compare(run(sine, MathMode::Sm4, 100.0), run(sine, MathMode::Exact, 100.0), 1024).rays, 0);
+  // sm3 against sm4 and exact: at |uv| = 1000 its fp32 positions lose the cell (Sm3DivergesFromSm4...).
+  const auto sm3_farther = run(sine, MathMode::Sm3, 1000.0);
+  EXPECT_GT(compare(sm3_farther, run(sine, MathMode::Sm4, 1000.0), 1024).rays, 0);
+  EXPECT_GT(compare(sm3_farther, run(sine, MathMode::Exact, 1000.0), 1024).rays, 0);
+  // Near the origin: sm3 finds sm4's cells, and its crossings are sm4's.
+  EXPECT_EQ(compare(run(sine, MathMode::Sm4, 0.0), run(sine, MathMode::Sm3, 0.0), 1024).rays, 0);
 }
 
 TEST(Qdm, LevelUpAfterCrossingsAvoidsDegeneratingIntoLinearSearch) {

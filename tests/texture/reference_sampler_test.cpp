@@ -1,6 +1,6 @@
 // The SIMD sampler against the scalar reference sampler, bit for bit in every lane: both fetch paths, every
-// filter x address x precision, every format, sizes from 1x1 to NPOT, coordinates and LODs including the
-// special values (far outside [0,1], texel boundaries, NaN, infinities).
+// filter x address x precision x math mode, every format, sizes from 1x1 to NPOT, coordinates and LODs including
+// the special values (far outside [0,1], texel boundaries and one float either side, NaN, infinities).
 #include <gtest/gtest.h>
 
 #include "texture/sampler_test_util.hpp"
@@ -63,6 +63,11 @@ float random_coordinate(std::mt19937& rng, int size) {
       const int n = std::max(1, size >> level(rng));
       return (float(k(rng)) + (k(rng) % 2 ? 0.5f : 0.0f)) / float(n);
     }
+    case 2: {  // one float either side of a texel edge or centre, or of an edge of 1/256 texel (hw8 fixed point)
+      const int n = std::max(1, size >> level(rng));
+      const float t = (float(k(rng)) + float(k(rng) % 256) / 256.0f) / float(n);
+      return std::nextafter(t, k(rng) % 2 ? kInf : -kInf);
+    }
     default: return uniform(rng);
   }
 }
@@ -86,7 +91,8 @@ constexpr LodSettings kLodSettings[] = {{0.0f, 0.0f, 16.0f}, {0.3f, 0.0f, 16.0f}
 
 std::string describe(const SamplingDesc& d, const Texture& t, int lane, int c, float u, float v, float lod) {
   std::ostringstream s;
-  s << "filter " << int(d.filter) << " address " << int(d.address) << " precision " << int(d.precision) << " bias "
+  s << "filter " << int(d.filter) << " address " << int(d.address) << " precision " << int(d.precision) << " math "
+    << int(d.math) << " bias "
     << d.lod_bias << " lod clamp [" << d.min_lod << ", " << d.max_lod << "] format " << format_name(t.format)
     << (t.srgb ? " srgb " : " ") << t.width() << "x" << t.height() << " lane " << lane << " channel " << c << " u "
     << u << " v " << v << " lod " << lod;
@@ -119,7 +125,7 @@ TEST(ReferenceSampler, SimdSamplerMatchesBitForBit) {
   struct Size {
     int w, h;
   };
-  constexpr Size kSizes[] = {{1, 1}, {1, 6}, {7, 1}, {2, 2}, {5, 3}, {37, 20}, {64, 64}, {130, 9}};
+  constexpr Size kSizes[] = {{1, 1}, {1, 6}, {7, 1}, {2, 2}, {5, 3}, {37, 20}, {64, 64}, {130, 9}, {16383, 3}};
   std::mt19937 rng(2024);
   for (const FormatCase& format : kFormats)
     for (const Size& size : kSizes) {
@@ -128,25 +134,27 @@ TEST(ReferenceSampler, SimdSamplerMatchesBitForBit) {
       for (Filter filter : kFilters)
         for (AddressMode address : kAddressModes)
           for (SamplePrecision precision : kPrecisions)
-            for (const LodSettings& lod_settings : kLodSettings) {
-              SamplingDesc desc;
-              desc.filter = filter;
-              desc.address = address;
-              desc.precision = precision;
-              desc.lod_bias = lod_settings.bias;
-              desc.min_lod = lod_settings.min_lod;
-              desc.max_lod = lod_settings.max_lod;
-              for (int round = 0; round < 16; ++round) {
-                Lanes u, v, lod;
-                for (int i = 0; i < kLanes; ++i) {
-                  u[std::size_t(i)] = random_coordinate(rng, size.w);
-                  v[std::size_t(i)] = random_coordinate(rng, size.h);
-                  lod[std::size_t(i)] = random_lod(rng);
+            for (MathMode math : kMathModes)
+              for (const LodSettings& lod_settings : kLodSettings) {
+                SamplingDesc desc;
+                desc.math = math;
+                desc.filter = filter;
+                desc.address = address;
+                desc.precision = precision;
+                desc.lod_bias = lod_settings.bias;
+                desc.min_lod = lod_settings.min_lod;
+                desc.max_lod = lod_settings.max_lod;
+                for (int round = 0; round < 16; ++round) {
+                  Lanes u, v, lod;
+                  for (int i = 0; i < kLanes; ++i) {
+                    u[std::size_t(i)] = random_coordinate(rng, size.w);
+                    v[std::size_t(i)] = random_coordinate(rng, size.h);
+                    lod[std::size_t(i)] = random_lod(rng);
+                  }
+                  expect_batch_matches_reference(texture, view, desc, u, v, lod);
+                  if (HasFatalFailure()) return;
                 }
-                expect_batch_matches_reference(texture, view, desc, u, v, lod);
-                if (HasFatalFailure()) return;
               }
-            }
     }
 }
 

@@ -18,6 +18,7 @@ inline constexpr Filter kFilters[] = {Filter::Point,         Filter::Bilinear,  
                                       Filter::PointMipPoint, Filter::PointMipLinear, Filter::LinearMipPoint};
 inline constexpr AddressMode kAddressModes[] = {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror};
 inline constexpr SamplePrecision kPrecisions[] = {SamplePrecision::Exact, SamplePrecision::Hw8, SamplePrecision::Hw6};
+inline constexpr MathMode kMathModes[] = {MathMode::Sm4, MathMode::Sm3, MathMode::Exact};
 
 inline std::uint32_t bits(float f) {
   std::uint32_t b;

@@ -19,7 +19,8 @@ enum class AddressMode { Wrap, Clamp, Mirror };
 enum class SamplePrecision { Exact, Hw8, Hw6 };
 // LOD from the derivatives of the 2x2 quad (what hardware does) or of each pixel's own row/column.
 enum class LodMode { PerQuad, PerPixel };
-// Shader arithmetic for texel and cell addressing: 32-bit integers (SM4), fp32 emulation (SM3), fp64.
+// Shader arithmetic of texel addresses (the sampler) and of QDM's cell walk: exact addresses and integer cells
+// (SM4); fp32 addresses and cells found from fp32 positions (SM3); as SM4 with QDM's wall crossings in fp64.
 enum class MathMode { Sm4, Sm3, Exact };
 
 }  // namespace qdmr

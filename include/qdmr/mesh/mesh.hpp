@@ -1,6 +1,7 @@
 #pragma once
 // MeshData: indexed triangles with per-vertex tangent frames, built from a MeshDesc.
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@ struct MeshData {
   std::vector<std::uint32_t> indices;             // 3 per triangle, counter-clockwise front faces
   std::vector<std::uint32_t> triangle_materials;  // obj only: per triangle, an index into `materials`; empty otherwise
   std::vector<MaterialDesc> materials;            // obj only: materials from the MTL file (named "<mtl name>")
+  std::vector<std::filesystem::path> bump_maps;   // obj only: per entry of `materials`, its bump map (empty if none)
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return indices.size() / 3; }
@@ -31,8 +33,9 @@ struct MeshData {
 // out-of-range indices. Degenerate triangles are kept (the rasterizer culls them) but their tangents are ignored.
 // Grid: the height map spans the whole grid once (sampled at the vertex UV divided by uv_scale), so
 // uv_scale tiles the material without repeating the relief. OBJ: UVs are multiplied by uv_scale; MTL
-// map_Kd -> albedo, norm -> normal, disp (else bump/map_bump) -> height, paths made absolute against the
-// MTL file's folder; faces without a material use an appended constant white "default" material.
+// map_Kd -> albedo, disp -> height with technique pom, else bump/map_Bump -> height for normals only,
+// norm -> normal map (else normals from the height), paths made absolute against the MTL file's folder; faces
+// without a material use an appended constant white "default" material.
 MeshData build_mesh(const MeshDesc& desc, const std::string& where);
 
 // Per-vertex tangent frames from positions, normals and UVs (accumulated per triangle, Gram-Schmidt
