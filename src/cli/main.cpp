@@ -122,13 +122,8 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   qdmr::check_outputs(outputs);  // the scene, its textures and OBJ files are known inputs now
-  // The plan's estimate (`qdmr plan` prints it part by part) before anything large is allocated.
-  const std::int64_t max_mib = render.max_memory_mib.value_or(default_max_memory_mib());
-  const std::uint64_t estimate = qdmr::plan_frame(scene, qdmr::PlanOptions{options.aovs}).total_bytes();
-  if (estimate > std::uint64_t(max_mib) << 20)
-    throw qdmr::Error(args.scene, "the job needs an estimated " + std::to_string((estimate + (1 << 20) - 1) >> 20) +
-                                      " MiB (see qdmr plan), more than the limit of " + std::to_string(max_mib) +
-                                      " MiB" + (render.max_memory_mib ? " (--max-memory)" : " (half the RAM; raise it with --max-memory)"));
+  // The plan's estimate (`qdmr plan` prints it part by part) is checked by set_scene before anything is built.
+  options.max_memory_bytes = std::uint64_t(render.max_memory_mib.value_or(default_max_memory_mib())) << 20;
 
   // Progress only on a terminal: logs and CI stay quiet.
   if (::isatty(STDERR_FILENO))
@@ -139,7 +134,13 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
     };
   // load -> plan -> prepare (set_scene) -> draw -> write.
   qdmr::Renderer renderer(options);
-  renderer.set_scene(scene, options.aovs);
+  try {
+    renderer.set_scene(scene, options.aovs);
+  } catch (const qdmr::Error& e) {
+    const std::string what = e.what();
+    if (what.find("MiB (see qdmr plan), more than the limit of") == std::string::npos) throw;
+    throw qdmr::Error(what + (render.max_memory_mib ? " (--max-memory)" : " (half the RAM; raise it with --max-memory)"));
+  }
   qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
   qdmr::check_outputs(outputs);  // and now also the MTL files, the maps they name and the caches read

@@ -94,6 +94,11 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   auto start = Clock::now();
   FramePlan plan = plan_frame(scene, PlanOptions{aovs});
   s.pending_plan_ms = ms_since(start);
+  const std::uint64_t needed = plan.total_bytes(), limit = s.options.max_memory_bytes;
+  if (limit > 0 && needed > limit)
+    throw Error(scene.file.string(), "the job needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +
+                                         " MiB (see qdmr plan), more than the limit of " + std::to_string(limit >> 20) +
+                                         " MiB");
   start = Clock::now();
   if (s.options.progress) s.options.progress("prepare", 0.0);
   s.arena.execute([&] {

@@ -7,6 +7,7 @@
 //   renderer.set_scene(scene);
 //   const qdmr::Frame& frame = renderer.draw();
 //   qdmr::write_frame(frame, "plane.png");
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,6 +28,9 @@ struct RenderOptions {
   int tile_size = 64;    // pixels, a multiple of 8 in [8, 1024]
   Isa isa = Isa::Auto;   // draw kernel; Auto: $QDMR_ISA, else the best this CPU supports
   std::vector<Aov> aovs;
+  // set_scene refuses a scene whose planned memory (FramePlan::total_bytes, what `qdmr plan` prints) exceeds
+  // this, before anything is built. 0: no limit.
+  std::uint64_t max_memory_bytes = 0;
   // Called with a stage name ("prepare", "raster") and the fraction done, from any worker thread,
   // never concurrently with itself. Optional.
   std::function<void(const char* stage, double fraction)> progress;
@@ -59,7 +63,8 @@ public:
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Plans the scene with these AOVs and prepares what the previous scene did not already have.
+  // Plans the scene with these AOVs and prepares what the previous scene did not already have. Throws
+  // qdmr::Error(scene file, ...) when the plan needs more than max_memory_bytes.
   void set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs);
   void set_scene(const SceneDesc& scene) { set_scene(scene, options_aovs()); }
   const FramePlan& plan() const;  // of the current scene (throws if none)
