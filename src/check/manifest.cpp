@@ -236,17 +236,9 @@ std::vector<std::string> check_output_names() {
 }
 
 Manifest read_manifest(const std::filesystem::path& file) {
-  const std::string text = read_input_file(file, file.string(), InputKind::Manifest);
   Manifest manifest;
   manifest.file = file;
-  manifest.text = text;
-  try {
-    manifest.document = scene_detail::parse_json_bounded(text);
-  } catch (const Error& e) {
-    throw Error(file.string(), e.what());
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file.string(), std::string("not valid JSON: ") + e.what());
-  }
+  manifest.document = scene_detail::parse_json_file(file, InputKind::Manifest, &manifest.text);
   const scene_detail::Context context{file.string(), std::filesystem::absolute(file).parent_path()};
   const Value root(context, manifest.document, "");
   if (manifest.document.is_object() && !manifest.document.contains("checks") && manifest.document.contains("camera"))

@@ -57,22 +57,7 @@ void resolve_obj_meshes(SceneDesc& scene, const nlohmann::json& document, const 
 }  // namespace
 
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
-  const std::string name = file.string();
-  const std::string text = read_input_file(file, name, InputKind::Scene);
-  nlohmann::json document;
-  try {
-    document = scene_detail::parse_json_bounded(text);
-  } catch (const Error& e) {
-    throw Error(name, e.what());
-  } catch (const nlohmann::json::exception& e) {
-    // what() is "[json.exception.parse_error.N] parse error at line L, column C: ..."; keep from "parse error".
-    // Other exceptions of the parser (a number too large for a double: out_of_range.406) lose the bracket.
-    const std::string what = e.what();
-    const auto start = what.find("parse error");
-    const auto bracket = what.find("] ");
-    throw Error(name, start != std::string::npos ? what.substr(start)
-                      : bracket != std::string::npos ? what.substr(bracket + 2) : what);
-  }
+  const nlohmann::json document = scene_detail::parse_json_file(file, InputKind::Scene);
   return load_scene_json(document, file, file.parent_path(), overrides);
 }
 

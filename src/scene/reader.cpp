@@ -50,6 +50,27 @@ nlohmann::json parse_json_bounded(const std::string& text) {
   return nlohmann::json::parse(text, limit_depth);
 }
 
+nlohmann::json parse_json_file(const std::filesystem::path& file, InputKind kind, std::string* text) {
+  const std::string name = file.string();
+  std::string contents = read_input_file(file, name, kind);
+  nlohmann::json document;
+  try {
+    document = parse_json_bounded(contents);
+  } catch (const Error& e) {
+    throw Error(name, e.what());
+  } catch (const nlohmann::json::exception& e) {
+    // what() is "[json.exception.parse_error.N] parse error at line L, column C: ..."; keep from "parse error".
+    // Other exceptions of the parser (a number too large for a double: out_of_range.406) lose the bracket.
+    const std::string what = e.what();
+    const auto start = what.find("parse error");
+    const auto bracket = what.find("] ");
+    throw Error(name, start != std::string::npos ? what.substr(start)
+                      : bracket != std::string::npos ? what.substr(bracket + 2) : what);
+  }
+  if (text) *text = std::move(contents);
+  return document;
+}
+
 std::string shorten(std::string_view text, std::size_t max) {
   if (text.size() <= max) return std::string(text);
   return std::string(text.substr(0, max)) + "...";

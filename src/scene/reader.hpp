@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/input_file.hpp"
+
 namespace qdmr::scene_detail {
 
 // The closest candidate to `word` by edit distance, if it is close enough to be a plausible typo.
@@ -25,6 +27,11 @@ std::string format_number(double value);
 // the recursive copy and destruction of the tree overflow the stack). Throws nlohmann::json::parse_error
 // (deeper than the limit: an out_of_range naming the depth) like parse itself.
 nlohmann::json parse_json_bounded(const std::string& text);
+
+// A JSON file qdmr reads (a scene, check manifest or study spec): checked and read as an input of `kind`, then
+// parsed with parse_json_bounded. Throws qdmr::Error(file, "parse error at line L, column C: ..."). `text` (if
+// given) gets the file's text.
+nlohmann::json parse_json_file(const std::filesystem::path& file, InputKind kind, std::string* text = nullptr);
 
 // `text` cut to at most `max` characters with "..." (keys and values quoted in messages stay one short line).
 std::string shorten(std::string_view text, std::size_t max = 64);

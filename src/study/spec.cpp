@@ -133,16 +133,9 @@ std::string study_label(const StudySpec& spec, const StudyConfig& config) {
 }
 
 StudySpec read_study_spec(const std::filesystem::path& file) {
-  const std::string text = read_input_file(file, file.string(), InputKind::StudySpec);
   StudySpec spec;
   spec.file = file;
-  try {
-    spec.document = scene_detail::parse_json_bounded(text);
-  } catch (const Error& e) {
-    throw Error(file.string(), e.what());
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file.string(), std::string("not valid JSON: ") + e.what());
-  }
+  spec.document = scene_detail::parse_json_file(file, InputKind::StudySpec);
   const scene_detail::Context context{file.string(), std::filesystem::absolute(file).parent_path()};
   const Value root(context, spec.document, "");
   const Object object(root, {"scene", "set", "width", "height", "frames", "warmup", "axes", "zip", "rules",
