@@ -15,7 +15,8 @@ function(qdmr_project_flags target isa)
     target_compile_options(${target} PRIVATE -mavx2 -mno-fma -mf16c -mpopcnt)
     target_compile_definitions(${target} PRIVATE QDMR_ISA=avx2 QDMR_ISA_ENUM=Avx2)
   elseif(isa STREQUAL "avx512")
-    # GCC's -mavx512f does not enable -mfma (no __FMA__: xsimd's default arch is avx512bw, whose fma is a*b+c).
+    # No -mno-fma: clang's AVX512F implies FMA and -mno-fma would switch AVX-512 off (GCC 12's does not imply
+    # it). Either way xsimd's default arch is avx512bw, whose fma is a*b+c; -ffp-contract=off does the rest.
     target_compile_options(${target} PRIVATE -mavx512f -mavx512cd -mavx512bw -mavx512dq -mavx512vl -mpopcnt)
     # GCC (12.2 here) warns inside its own AVX-512 intrinsics: _mm512_undefined_ps() is `__m512 __Y = __Y;`.
     # The SSE4.2 and AVX2 builds of the same sources keep these warnings.
