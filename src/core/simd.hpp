@@ -10,8 +10,8 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 
-// The build flags give sse4_2, avx2 or avx512bw (4, 8 or 16 lanes), never fma3<...>: xsimd's fma and math
-// fuse there, and every kernel must round alike (-mno-fma; GCC's -mavx512f does not turn FMA on).
+// The build flags give sse4_2, avx2 or avx512bw (4, 8 or 16 lanes), never fma3<...>, whose fma and math fuse
+// (every kernel must round alike): -mno-fma for SSE4.2 and AVX2, and with AVX-512 avx512bw ranks above it.
 using Arch = xsimd::default_arch;
 static_assert(!std::is_same_v<Arch, xsimd::fma3<xsimd::sse4_2>> && !std::is_same_v<Arch, xsimd::fma3<xsimd::avx2>>,
               "a kernel's xsimd architecture must not fuse multiply-adds");
