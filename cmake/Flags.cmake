@@ -1,7 +1,8 @@
 # Flags for project code only (dependencies are compiled by Debian).
 #
 # qdmr_project_flags(target ISA): ISA is "baseline" (x86-64: everything outside the draw kernels), or the ISA of
-# a draw kernel ("sse4.2", "avx2"), which also puts the code into the namespace qdmr::<isa> (core/isa_namespace.hpp).
+# a draw kernel ("sse4.2", "avx2", "avx512"), which also puts the code into the namespace qdmr::<isa>
+# (core/isa_namespace.hpp).
 function(qdmr_project_flags target isa)
   # -ffp-contract=off: no fused multiply-add behind our back, so every ISA gives the same bits.
   set(werror "")
@@ -13,11 +14,21 @@ function(qdmr_project_flags target isa)
     # AVX2 without FMA: xsimd's default arch becomes avx2, not fma3<avx2> (which fuses inside its math).
     target_compile_options(${target} PRIVATE -mavx2 -mno-fma -mf16c -mpopcnt)
     target_compile_definitions(${target} PRIVATE QDMR_ISA=avx2 QDMR_ISA_ENUM=Avx2)
+  elseif(isa STREQUAL "avx512")
+    # No -mno-fma: clang's AVX512F implies FMA and -mno-fma would switch AVX-512 off (GCC 12's does not imply
+    # it). Either way xsimd's default arch is avx512bw, whose fma is a*b+c; -ffp-contract=off does the rest.
+    target_compile_options(${target} PRIVATE -mavx512f -mavx512cd -mavx512bw -mavx512dq -mavx512vl -mpopcnt)
+    # GCC (12.2 here) warns inside its own AVX-512 intrinsics: _mm512_undefined_ps() is `__m512 __Y = __Y;`.
+    # The SSE4.2 and AVX2 builds of the same sources keep these warnings.
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      target_compile_options(${target} PRIVATE -Wno-uninitialized -Wno-maybe-uninitialized)
+    endif()
+    target_compile_definitions(${target} PRIVATE QDMR_ISA=avx512 QDMR_ISA_ENUM=Avx512)
   elseif(isa STREQUAL "sse4.2")
     target_compile_options(${target} PRIVATE -msse4.2 -mno-avx -mno-fma -mpopcnt)
     target_compile_definitions(${target} PRIVATE QDMR_ISA=sse42 QDMR_ISA_ENUM=Sse42)
   elseif(NOT isa STREQUAL "baseline")
-    message(FATAL_ERROR "qdmr_project_flags: ISA must be baseline, sse4.2 or avx2, not '${isa}'")
+    message(FATAL_ERROR "qdmr_project_flags: ISA must be baseline, sse4.2, avx2 or avx512, not '${isa}'")
   endif()
   if(QDMR_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)

@@ -1,5 +1,5 @@
 #pragma once
-// Per-lane loads for texel fetch. The AVX2 build uses the hardware gathers (xsimd 8.1 never emits them);
+// Per-lane loads for texel fetch. The AVX2 and AVX-512 builds use the hardware gathers (xsimd 8.1 never emits them);
 // the portable versions load lane by lane. Both return the same bits; FetchPath picks one at run time so
 // they can be measured side by side.
 #include <cstdint>
@@ -15,19 +15,29 @@ namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 
 enum class FetchPath : std::uint8_t { Gather, Portable };
 
-inline constexpr bool kHasHardwareGather =
-#if defined(__AVX2__)
-    true;
+// The gather instructions of this build: 16 lanes with AVX-512, 8 with AVX2, none before. Scale: bytes per index.
+#if defined(__AVX512F__)
+inline constexpr bool kHasHardwareGather = true;
+template <int Scale>
+Int gather_i32(const void* base, const Int& index) { return _mm512_i32gather_epi32(__m512i(index), base, Scale); }
+template <int Scale>
+Float gather_f32(const float* base, const Int& index) { return _mm512_i32gather_ps(__m512i(index), base, Scale); }
+#elif defined(__AVX2__)
+inline constexpr bool kHasHardwareGather = true;
+template <int Scale>
+Int gather_i32(const void* base, const Int& index) {
+  return _mm256_i32gather_epi32(static_cast<const int*>(base), __m256i(index), Scale);
+}
+template <int Scale>
+Float gather_f32(const float* base, const Int& index) { return _mm256_i32gather_ps(base, __m256i(index), Scale); }
 #else
-    false;
+inline constexpr bool kHasHardwareGather = false;
 #endif
 
 // 4 bytes at base + byte_offset[lane] (unaligned), as a little-endian int32 per lane.
 inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPath path) {
 #if defined(__AVX2__)
-  static_assert(kLanes == 8, "the AVX2 gather path holds 8 lanes");
-  if (path == FetchPath::Gather)
-    return Int(_mm256_i32gather_epi32(reinterpret_cast<const int*>(base), __m256i(byte_offset), 1));
+  if (path == FetchPath::Gather) return gather_i32<1>(base, byte_offset);
 #endif
   (void)path;
   alignas(64) std::int32_t offset[kLanes], value[kLanes];
@@ -39,7 +49,7 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
 // table[index[lane]] for int32 and float tables.
 inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path) {
 #if defined(__AVX2__)
-  if (path == FetchPath::Gather) return Int(_mm256_i32gather_epi32(table, __m256i(index), 4));
+  if (path == FetchPath::Gather) return gather_i32<4>(table, index);
 #endif
   (void)path;
   alignas(64) std::int32_t i[kLanes], value[kLanes];
@@ -50,7 +60,7 @@ inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path)
 
 inline Float load_f32(const float* table, const Int& index, FetchPath path) {
 #if defined(__AVX2__)
-  if (path == FetchPath::Gather) return Float(_mm256_i32gather_ps(table, __m256i(index), 4));
+  if (path == FetchPath::Gather) return gather_f32<4>(table, index);
 #endif
   (void)path;
   alignas(64) std::int32_t i[kLanes];

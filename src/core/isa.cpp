@@ -42,13 +42,19 @@ bool cpu_supports(Isa isa) {
     case Isa::Auto: return true;
     case Isa::Sse42: return __builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt");
     case Isa::Avx2: return __builtin_cpu_supports("avx2") && cpu_has_f16c() && __builtin_cpu_supports("popcnt");
-    case Isa::Avx512: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
+    case Isa::Avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+             __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("popcnt");
   }
   return false;
 }
 
 std::vector<Isa> built_isas() {
   std::vector<Isa> isas;
+#ifdef QDMR_KERNEL_AVX512
+  isas.push_back(Isa::Avx512);
+#endif
 #ifdef QDMR_KERNEL_AVX2
   isas.push_back(Isa::Avx2);
 #endif

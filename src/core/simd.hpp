@@ -2,6 +2,7 @@
 // SIMD types of this build. Private to src/: the architecture is fixed by the build flags (QDMR_SIMD),
 // so these types must never appear in a public header.
 #include <cstdint>
+#include <type_traits>
 
 #include <xsimd/xsimd.hpp>
 
@@ -9,7 +10,11 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 
+// The build flags give sse4_2, avx2 or avx512bw (4, 8 or 16 lanes), never fma3<...>, whose fma and math fuse
+// (every kernel must round alike): -mno-fma for SSE4.2 and AVX2, and with AVX-512 avx512bw ranks above it.
 using Arch = xsimd::default_arch;
+static_assert(!std::is_same_v<Arch, xsimd::fma3<xsimd::sse4_2>> && !std::is_same_v<Arch, xsimd::fma3<xsimd::avx2>>,
+              "a kernel's xsimd architecture must not fuse multiply-adds");
 using Float = xsimd::batch<float, Arch>;
 using Int = xsimd::batch<std::int32_t, Arch>;
 using UInt = xsimd::batch<std::uint32_t, Arch>;
@@ -17,7 +22,8 @@ using Mask = xsimd::batch_bool<float, Arch>;
 using IntMask = xsimd::batch_bool<std::int32_t, Arch>;
 
 inline constexpr int kLanes = static_cast<int>(Float::size);
-static_assert(kLanes == 4 || kLanes == 8, "qdmr batches hold one (SSE) or two (AVX2) 2x2 quads");
+static_assert(kLanes == 4 || kLanes == 8 || kLanes == 16,
+              "qdmr batches hold one (SSE4.2), two (AVX2) or four (AVX-512) 2x2 quads");
 inline constexpr int kQuadsPerBatch = kLanes / 4;
 
 // Lane layout inside one quad: 0 1 / 2 3 (x to the right, y down). Quad q occupies lanes 4q..4q+3.

@@ -4,6 +4,11 @@
 
 // The kernels this binary holds (QDMR_KERNEL_<ISA> is defined by the build for each one compiled).
 namespace qdmr {
+#ifdef QDMR_KERNEL_AVX512
+namespace avx512 {
+const Kernel& kernel();
+}
+#endif
 #ifdef QDMR_KERNEL_AVX2
 namespace avx2 {
 const Kernel& kernel();
@@ -17,6 +22,9 @@ const Kernel& kernel();
 
 const Kernel& kernel_for(Isa isa) {
   switch (isa) {
+#ifdef QDMR_KERNEL_AVX512
+    case Isa::Avx512: return avx512::kernel();
+#endif
 #ifdef QDMR_KERNEL_AVX2
     case Isa::Avx2: return avx2::kernel();
 #endif

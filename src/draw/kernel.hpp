@@ -18,7 +18,7 @@ class Kernel {
 public:
   virtual ~Kernel() = default;
   virtual Isa isa() const = 0;
-  virtual int lanes() const = 0;  // pixels per batch: 4 (one quad) or 8 (two quads)
+  virtual int lanes() const = 0;  // pixels per batch: 4, 8 or 16 (one, two or four quads)
   // The shading program of one material (normal mapping, or a displacement technique), for this kernel.
   virtual std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
                                                  const LightRig& lights) const = 0;

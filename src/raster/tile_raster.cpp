@@ -14,7 +14,7 @@ using simd::kLanes;
 
 constexpr int kBatchWidth = 2 * simd::kQuadsPerBatch;  // pixels per batch row
 constexpr int kBlock = limits::kCoarseBlockSize;
-static_assert(kBlock % 4 == 0, "coarse blocks hold whole batches in both SSE and AVX2 builds");
+static_assert(kBlock % kBatchWidth == 0, "coarse blocks hold whole batches in every build");
 
 // Lane layout: quad q covers pixels (2q, 0) .. (2q+1, 1) of the batch, lanes 0 1 / 2 3 inside the quad.
 constexpr int lane_dx(int lane) { return (lane / 4) * 2 + (lane % 2); }
