@@ -46,9 +46,12 @@ def main():
             with open(os.path.join(out, "results.json")) as f:
                 rows = json.load(f)["rows"]
             draws = sum(r["timing"]["draw_ms_median"] * (spec["frames"] + spec["warmup"]) for r in rows) / 1000.0
+            prepares = sum(r["timing"]["prepare_ms"] for r in rows) / 1000.0
             walls.append(wall)
             ratios.append(wall / draws)
-            print(f"run {k + 1}: {len(rows)} configurations, wall {wall:.2f} s, warm draws {draws:.2f} s, ratio {wall / draws:.2f}")
+            print(f"run {k + 1}: {len(rows)} configurations, wall {wall:.2f} s, warm draws {draws:.2f} s, ratio "
+                  f"{wall / draws:.2f}; of the rest {prepares:.2f} s preparing (once per technique), so without it "
+                  f"{(wall - prepares) / draws:.2f}")
     load_after = os.getloadavg()
     print(f"median ratio wall / warm draws: {statistics.median(ratios):.2f} (target <= 1.2); "
           f"load average before {load_before[0]:.2f}, after {load_after[0]:.2f}; {os.cpu_count()} cores")

@@ -20,6 +20,7 @@
 #include "qdmr/render/render.hpp"
 #include "qdmr/study/study.hpp"
 #include "qdmr/write/write.hpp"
+#include "scene/reader.hpp"
 #include "study/results.hpp"
 
 namespace qdmr {
@@ -62,12 +63,26 @@ double estimated_cost(const StudySpec& spec, const StudyConfig& config) {
   return cost;
 }
 
+// The base scene's document, read once; each configuration is its overrides applied in memory.
+class SceneSource {
+public:
+  explicit SceneSource(const std::filesystem::path& file)
+      : file_(file), document_(scene_detail::parse_json_file(file, InputKind::Scene)) {}
+  SceneDesc load(const std::vector<SceneOverride>& overrides) const {
+    return load_scene_json(document_, file_, file_.parent_path(), overrides);
+  }
+
+private:
+  std::filesystem::path file_;
+  nlohmann::json document_;
+};
+
 // One configuration's row: everything deterministic from a frame without AOVs (timing) and one with the error
 // AOVs, against the baseline's colour.
 class Measurer {
 public:
-  Measurer(const StudySpec& spec, int threads)
-      : spec_(spec), timing_(with_threads(threads)), measuring_(with_threads(threads)),
+  Measurer(const StudySpec& spec, const SceneSource& source, int threads)
+      : spec_(spec), source_(source), timing_(with_threads(threads)), measuring_(with_threads(threads)),
         baseline_renderer_(with_threads(threads)) {}
 
   // The colour of the baseline configuration for `config`: its values with the spec's baseline values put in
@@ -81,7 +96,7 @@ public:
     const std::string key = nlohmann::json(base.values).dump();
     auto found = baselines_.find(key);
     if (found != baselines_.end()) return found->second;
-    baseline_renderer_.set_scene(load_scene(spec_.scene, study_overrides(spec_, base, camera)), {});
+    baseline_renderer_.set_scene(source_.load(study_overrides(spec_, base, camera)), {});
     const Frame& frame = baseline_renderer_.draw();
     Image image(frame.width, frame.height, 3);
     std::copy(frame.color.begin(), frame.color.end(), image.texels.begin());
@@ -194,12 +209,13 @@ private:
   }
 
   const StudySpec& spec_;
+  const SceneSource& source_;
   Renderer timing_, measuring_, baseline_renderer_;
   std::map<std::string, Image> baselines_;
 };
 
-std::array<double, 9> base_camera(const StudySpec& spec) {
-  const SceneDesc base = load_scene(spec.scene, spec.overrides);
+std::array<double, 9> base_camera(const StudySpec& spec, const SceneSource& source) {
+  const SceneDesc base = source.load(spec.overrides);
   const CameraDesc& c = base.camera;
   return {c.position.x, c.position.y, c.position.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z};
 }
@@ -259,9 +275,10 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
     throw Error("--shard", "expected I/N with 1 <= I <= N");
   const std::vector<StudyConfig> configs = expand_study(spec, options.force);
   const std::vector<std::size_t> mine = shard_configurations(spec, configs, options.shard);
-  const std::array<double, 9> camera = base_camera(spec);
+  const SceneSource source(spec.scene);
+  const std::array<double, 9> camera = base_camera(spec, source);
 
-  Measurer measurer(spec, options.threads);
+  Measurer measurer(spec, source, options.threads);
   const nlohmann::ordered_json header = make_header(spec, configs.size(), options.shard, measurer.renderer().threads(),
                                                     isa_name(measurer.renderer().isa()));
 
@@ -305,7 +322,7 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
       break;
     }
     const StudyConfig& config = configs[index];
-    const SceneDesc scene = load_scene(spec.scene, study_overrides(spec, config, camera));
+    const SceneDesc scene = source.load(study_overrides(spec, config, camera));
     StudyRow row;
     try {
       row = measurer.measure(config, scene, out / "images", camera);
