@@ -69,6 +69,11 @@ private:
   std::map<std::tuple<int, int, int>, std::unique_ptr<Renderer>> renderers_;
 };
 
+// A tolerance output as compared: the render as a file of the golden's type holds it, and the golden.
+struct Compared {
+  Image rendered, golden;
+};
+
 // What one check found, before diff folders and updates.
 struct Rendered {
   std::vector<Image> images;  // per output, of the first variant
@@ -158,6 +163,7 @@ private:
     }
 
     std::vector<std::string> updates;
+    std::map<std::string, Compared> compared;  // tolerance outputs: what was compared, for the diff folder
     for (std::size_t o = 0; o < check.outputs.size(); ++o) {
       const std::string& output = check.outputs[o];
       OutputResult& out = result.outputs[o];
@@ -181,9 +187,10 @@ private:
       const bool exists = std::filesystem::exists(golden);
       if (exists) {
         int golden_bits = 0;
-        const Image golden_image = read_comparable_image(golden, &golden_bits);
-        out.comparison = compare_images(stored_pixels(first_frame, output_aov(output), golden), golden_image,
-                                        check.tolerance);
+        Compared& c = compared[output];
+        c.golden = read_comparable_image(golden, &golden_bits);
+        c.rendered = stored_pixels(first_frame, output_aov(output), golden);
+        out.comparison = compare_images(c.rendered, c.golden, check.tolerance);
         if (out.comparison->passed()) continue;
         if (!options_.update) {
           for (const std::string& line : out.comparison->failures) failures.push_back(output + ": " + line);
@@ -203,7 +210,7 @@ private:
       result.status = CheckStatus::Failed;
       result.lines = failures;
       result.diff_folder = options_.diff_dir / check.name;
-      write_diff_folder(check, result, first_frame, result.diff_folder);
+      write_diff_folder(check, result, first_frame, compared, result.diff_folder);
     } else if (!updates.empty()) {
       result.status = CheckStatus::Updated;
       result.lines = updates;
@@ -219,16 +226,13 @@ private:
   }
 
   static void write_diff_folder(const CheckSpec& check, const CheckResult& result, const Frame& frame,
-                                const std::filesystem::path& folder) {
+                                const std::map<std::string, Compared>& compared, const std::filesystem::path& folder) {
     DiffFolder diff(folder);
-    for (std::size_t o = 0; o < check.outputs.size(); ++o) {
-      const std::string& output = check.outputs[o];
+    for (const std::string& output : check.outputs) {
       const std::optional<Aov> aov = output_aov(output);
-      if (check.mode == CheckMode::Tolerance && std::filesystem::exists(check.goldens.at(output))) {
-        const std::filesystem::path& golden = check.goldens.at(output);
-        int bits = 0;
-        const Image golden_image = read_comparable_image(golden, &bits);
-        diff.add_comparison(output, frame, aov, stored_pixels(frame, aov, golden), golden_image, golden);
+      const auto c = compared.find(output);
+      if (c != compared.end()) {
+        diff.add_comparison(output, frame, aov, c->second.rendered, c->second.golden, check.goldens.at(output));
       } else {
         diff.add_render(output, frame, aov);
       }
