@@ -264,7 +264,8 @@ public:
     const MaterialDesc& desc = m.desc;
     const std::string& where = m.where;
     const bool displaced = m.technique != TechniqueKind::Normal;
-    m.reference = displaced && std::any_of(plan_.aovs.begin(), plan_.aovs.end(), is_reference_aov);
+    m.reference = displaced && (desc.technique.exact_hits ||
+                                std::any_of(plan_.aovs.begin(), plan_.aovs.end(), is_reference_aov));
     const std::string address = "address=" + std::to_string(int(desc.sampling.address));
     const auto field_of = [&](std::size_t layer) {
       LayerPlan& l = m.layers[layer];
@@ -551,7 +552,9 @@ std::string FramePlan::describe() const {
       if (d >= 0) uses << " [" << d << "]";
     if (!m.layers.empty() && m.layers[0].field >= 0) uses << " [" << m.layers[0].field << "]";
     if (!uses.str().empty()) s << "    derived:" << uses.str() << "\n";
-    if (m.reference) s << "    traces the exact reference (error AOVs)\n";
+    if (m.reference)
+      s << (m.desc.technique.exact_hits ? "    takes its hits from the exact reference (exact_hits)\n"
+                                        : "    traces the exact reference (error AOVs)\n");
   }
   s << "textures to build (" << textures.size() << "):\n";
   for (std::size_t i = 0; i < textures.size(); ++i) {

@@ -383,7 +383,7 @@ void check_visibility_needs_displacement(const Object& object, const MaterialDes
 
 // The keys given in a `technique` block, over what `d` holds (the defaults, or an MTL material's mapping).
 void read_technique(const Value& value, TechniqueDesc& d) {
-  const Object technique(value, {"name", "depth_scale", "write_depth", "linear_steps", "binary_steps", "min_steps",
+  const Object technique(value, {"name", "depth_scale", "write_depth", "exact_hits", "linear_steps", "binary_steps", "min_steps",
                                  "max_steps", "lod_threshold", "lod_fade", "max_iterations", "min_iterations",
                                  "level_up", "refinement", "height_fetch", "lod_stop", "fade_start", "fade_end"});
   if (auto t = technique.find("name"))
@@ -395,6 +395,7 @@ void read_technique(const Value& value, TechniqueDesc& d) {
                                        {"qdm", TechniqueKind::Qdm}});
   if (auto t = technique.find("depth_scale")) d.depth_scale = static_cast<float>(t->number_in(0.0, 100.0));
   if (auto t = technique.find("write_depth")) d.write_depth = t->boolean();
+  if (auto t = technique.find("exact_hits")) d.exact_hits = t->boolean();
   if (auto t = technique.find("linear_steps")) d.linear_steps = static_cast<int>(t->integer(1, 4096));
   if (auto t = technique.find("binary_steps")) d.binary_steps = static_cast<int>(t->integer(0, 64));
   if (auto t = technique.find("min_steps")) d.min_steps = static_cast<int>(t->integer(1, 4096));

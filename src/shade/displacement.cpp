@@ -102,37 +102,62 @@ void DisplacementProgram::displaced_depth(const Fragments& in, const UvDerivativ
   out.writes_depth = true;
 }
 
-void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, const Hit& hit, const Mask& covered,
-                                           ShadeOutput& out) const {
-  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes], s[kLanes], error[kLanes],
-      missed[kLanes];
+template <class PerLane>
+void DisplacementProgram::trace_reference(const Ray& ray, const Float& ds, const Mask& covered,
+                                          PerLane per_lane) const {
+  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], depth[kLanes];
   ray.u0.store_aligned(u0);
   ray.v0.store_aligned(v0);
   ray.du.store_aligned(du);
   ray.dv.store_aligned(dv);
   ds.store_aligned(depth);
-  hit.s.store_aligned(s);
   const std::uint32_t lanes = simd::to_bits(covered);
   // QDM and cone stepping without refinement see the box surface; everything else the filtered surface.
   const bool box = (technique_.kind == TechniqueKind::Qdm || technique_.kind == TechniqueKind::Csm ||
                     technique_.kind == TechniqueKind::Rcsm) &&
                    technique_.refinement == QdmRefinement::None;
   const ReferenceSurface surface = box ? ReferenceSurface::Box : ReferenceSurface::Bilinear;
+  // The reference may span several texture repeats (a blend's weights): its UV is the layers' / scale. The
+  // ray's direction has depth component 1, so its t is the depth s.
+  const double k = 1.0 / reference_scale_;
   for (int l = 0; l < kLanes; ++l) {
-    error[l] = missed[l] = 0.0f;
     if (!((lanes >> l) & 1u)) continue;
-    // The reference may span several texture repeats (a blend's weights): its UV is the layers' / scale.
-    const double k = 1.0 / reference_scale_;
     const SurfaceRay r{{u0[l] * k, v0[l] * k, 0.0}, {du[l] * k, dv[l] * k, 1.0}};
-    const ReferenceHit ref = intersect_reference(*reference_, depth[l], r, surface, 1 << 16);
-    if (!ref.hit) continue;
+    per_lane(l, r, intersect_reference(*reference_, depth[l], r, surface, 1 << 16));
+  }
+}
+
+void DisplacementProgram::reference_errors(const Ray& ray, const Float& ds, const Hit& hit, const Mask& covered,
+                                           ShadeOutput& out) const {
+  alignas(64) float u0[kLanes], v0[kLanes], du[kLanes], dv[kLanes], s[kLanes], error[kLanes] = {},
+      missed[kLanes] = {};
+  ray.u0.store_aligned(u0);
+  ray.v0.store_aligned(v0);
+  ray.du.store_aligned(du);
+  ray.dv.store_aligned(dv);
+  hit.s.store_aligned(s);
+  const double k = 1.0 / reference_scale_;
+  trace_reference(ray, ds, covered, [&](int l, const SurfaceRay&, const ReferenceHit& ref) {
+    if (!ref.hit) return;
     const double eu = ((double(u0[l]) + double(du[l]) * s[l]) * k - ref.point.x) * reference_->width;
     const double ev = ((double(v0[l]) + double(dv[l]) * s[l]) * k - ref.point.y) * reference_->height;
     error[l] = float(std::sqrt(eu * eu + ev * ev));
     missed[l] = error[l] > 1.0f ? 1.0f : 0.0f;
-  }
+  });
   out.error_texels = Float::load_aligned(error);
   out.missed = Float::load_aligned(missed);
+}
+
+DisplacementProgram::Hit DisplacementProgram::exact_hit(const Ray& ray, const Float& ds, const Hit& traced,
+                                                        const Mask& covered) const {
+  alignas(64) float s[kLanes], cells[kLanes] = {};
+  traced.s.store_aligned(s);
+  trace_reference(ray, ds, covered, [&](int l, const SurfaceRay&, const ReferenceHit& ref) {
+    cells[l] = float(ref.cells_visited);
+    if (ref.hit) s[l] = float(ref.t);  // else (the ray leaves the slab) the traced hit stays
+  });
+  const Float hit_s = Float::load_aligned(s);
+  return Hit{hit_s, Float::load_aligned(cells), hit_s};
 }
 
 struct DisplacementProgram::Setup {
@@ -229,7 +254,8 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
   Float ds = setup.ds;
-  const Hit hit = trace<V>(surface, setup, ds);
+  Hit hit = trace<V>(surface, setup, ds);
+  if (technique_.exact_hits) hit = exact_hit(ray, ds, hit, setup.active);
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   // Baked AO is read per layer and blended like the colours.

@@ -71,8 +71,13 @@ private:
   void light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
              const simd::Float* albedo, const simd::Float& specular, const simd::Float& baked_ao,
              const shading::Vec3& shading_normal, ShadeOutput& out) const;
+  // Calls per_lane(lane, ray in the reference's UV, its hit) for each covered lane.
+  template <class PerLane>
+  void trace_reference(const Ray& ray, const simd::Float& depth_scale, const simd::Mask& covered,
+                       PerLane per_lane) const;
   void reference_errors(const Ray& ray, const simd::Float& depth_scale, const Hit& hit, const simd::Mask& covered,
                         ShadeOutput& out) const;
+  Hit exact_hit(const Ray& ray, const simd::Float& depth_scale, const Hit& traced, const simd::Mask& covered) const;
 
   ShadeFn shade_;
   std::vector<Layer> layers_;

@@ -126,6 +126,9 @@ struct TechniqueDesc {
   TechniqueKind kind = TechniqueKind::Normal;
   float depth_scale = 0.05f;
   bool write_depth = false;       // displaced depth into the depth buffer
+  // Take every hit from the exact fp64 reference (on the surface the technique sees) instead of tracing: the
+  // reference image of this configuration, at the reference's cost. The error AOVs are then ~0.
+  bool exact_hits = false;
   // relief: linear search then binary search
   int linear_steps = 32;
   int binary_steps = 6;
