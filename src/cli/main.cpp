@@ -16,6 +16,7 @@
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
+#include "cli/report.hpp"
 #include "cli/study.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_check.hpp"
@@ -349,7 +350,18 @@ int main(int argc, char** argv) {
   CLI::App* merge_cmd = study_cmd->add_subcommand("merge", "Merge the folders of every shard of a study");
   merge_cmd->add_option("folders", merge.folders, "The shard folders")->required();
   merge_cmd->add_option("-o,--output", merge.output, "Merged results folder")->required();
+  study_cmd->add_flag("--report", study.report, "When the study is done, write its report (qdmr report) to FOLDER-report");
   study_cmd->require_subcommand(0, 1);
+
+  qdmr::cli::ReportArgs report;
+  CLI::App* report_cmd = app.add_subcommand(
+      "report", "Write an HTML page of a study's results: Pareto fronts, metrics along each numeric axis, the worst "
+                "artifacts beside the exact reference, every row sortable; opens from disk (docs/studies.md)");
+  report_cmd->add_option("results", report.results, "Results folder of qdmr study (or qdmr study merge)")->required();
+  report_cmd->add_option("-o,--output", report.output, "Report folder (default: RESULTS-report); replaces an earlier report there");
+  report_cmd->add_option("--worst", report.worst, "How many worst artifacts to crop (0 to 100, default 6)");
+  report_cmd->add_option("--crop", report.crop, "Crop size in pixels (8 to 1024, default 96)");
+  report_cmd->add_flag("--partial", report.partial, "Report an unfinished study or one shard instead of refusing it");
 
   // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
@@ -378,6 +390,7 @@ int main(int argc, char** argv) {
       return qdmr::cli::run_study(study);
     }
     if (diff_cmd->parsed()) return qdmr::cli::run_diff(diff);
+    if (report_cmd->parsed()) return qdmr::cli::run_report(report);
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());
     return kExitBadInput;

@@ -1,5 +1,7 @@
 #include "cli/study.hpp"
 
+#include "cli/report.hpp"
+
 #include <unistd.h>
 
 #include <atomic>
@@ -89,6 +91,12 @@ int run_study(const StudyArgs& args) {
   if (run.stopped) {
     std::fprintf(stderr, "study: interrupted; the results so far are valid, continue with --resume\n");
     return 130;
+  }
+  if (args.report) {
+    ReportArgs report;
+    report.results = args.output;
+    report.partial = options.shard.count > 1;
+    return run_report(report);
   }
   return 0;
 }

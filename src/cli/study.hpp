@@ -9,6 +9,7 @@ namespace qdmr::cli {
 struct StudyArgs {
   std::string spec, output, shard;
   bool resume = false, force = false;
+  bool report = false;  // write OUTPUT-report when done
   std::optional<int> threads;
 };
 

@@ -145,8 +145,7 @@ public:
       det["diff_max"] = std::isfinite(c.max_abs) ? nlohmann::json(c.max_abs) : nlohmann::json("inf");
       det["diff_pixels"] = c.pixels_over;
     }
-    const bool keep_image = std::find(spec_.keep.begin(), spec_.keep.end(), "image") != spec_.keep.end();
-    if (keep_image) write_frame(frame, images / (std::to_string(config.index) + ".png"));
+    if (keeps("image")) write_frame(frame, images / (std::to_string(config.index) + ".png"));
     if (spec_.wants(StudyMetric::Time)) {
       std::vector<double> sorted = draws;
       std::sort(sorted.begin(), sorted.end());
@@ -156,17 +155,27 @@ public:
     }
 
     if (spec_.wants(StudyMetric::Error) || !keep_aovs().empty()) measure_error(config, scene, images, det);
+    if (keeps("reference")) write_reference(config, scene, images);
     row["deterministic"] = det;
     row["timing"] = timing;
     return row;
   }
 
 private:
+  bool keeps(const char* what) const { return std::find(spec_.keep.begin(), spec_.keep.end(), what) != spec_.keep.end(); }
+
   std::vector<Aov> keep_aovs() const {
     std::vector<Aov> aovs;
     for (const std::string& k : spec_.keep)
-      if (k != "image") aovs.push_back(*parse_aov(k));
+      if (const std::optional<Aov> aov = parse_aov(k)) aovs.push_back(*aov);
     return aovs;
+  }
+
+  // The configuration's image at the exact reference's hits (every displaced material with exact_hits).
+  void write_reference(const StudyConfig& config, SceneDesc scene, const std::filesystem::path& images) {
+    for (MaterialDesc& material : scene.materials) material.technique.exact_hits = true;
+    measuring_.set_scene(scene, {});
+    write_frame(measuring_.draw(), images / (std::to_string(config.index) + ".reference.png"));
   }
 
   void measure_error(const StudyConfig& config, const SceneDesc& scene, const std::filesystem::path& images,
@@ -313,6 +322,20 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
   run.total = mine.size();
   run.resumed = done.size();
 
+  // The wall time of the study so far (earlier runs of a resumed one included), in results.json.
+  double earlier_seconds = 0;
+  if (!rows.empty()) {
+    try {
+      earlier_seconds = nlohmann::json::parse(std::ifstream(out / "results.json"))["run"].value("wall_seconds", 0.0);
+    } catch (const nlohmann::json::exception&) {
+    }
+  }
+  const auto results_header = [&] {
+    nlohmann::ordered_json h = header;
+    h["run"] = {{"wall_seconds", earlier_seconds + std::chrono::duration<double>(Clock::now() - start).count()},
+                {"shards", 1}};
+    return h;
+  };
   auto last_write = Clock::now();
   std::size_t finished = done.size();
   for (std::size_t index : mine) {
@@ -335,11 +358,11 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
     ++finished;
     if (options.progress) options.progress(finished, mine.size(), study_label(spec, config));
     if (Clock::now() - last_write > std::chrono::seconds(2)) {
-      write_study_results(header, rows, out);
+      write_study_results(results_header(), rows, out);
       last_write = Clock::now();
     }
   }
-  write_study_results(header, rows, out);
+  write_study_results(results_header(), rows, out);
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }
@@ -350,6 +373,7 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
   std::map<int, std::filesystem::path> seen;
   std::vector<StudyRow> rows;
   int count = 0;
+  double wall_seconds = 0, longest_shard = 0;
   for (const std::filesystem::path& folder : shards) {
     const std::filesystem::path file = folder / "study.json";
     nlohmann::ordered_json h;
@@ -371,6 +395,12 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
     if (seen.count(index)) throw Error(folder.string(), "is shard " + std::to_string(index) + " again (also " + seen[index].string() + ")");
     seen[index] = folder;
     for (StudyRow& r : read_study_rows(folder / "rows.jsonl")) rows.push_back(std::move(r));
+    try {
+      const nlohmann::json run = nlohmann::json::parse(std::ifstream(folder / "results.json"))["run"];
+      wall_seconds += run.value("wall_seconds", 0.0);
+      longest_shard = std::max(longest_shard, run.value("wall_seconds", 0.0));
+    } catch (const nlohmann::json::exception&) {
+    }
   }
   for (int i = 1; i <= count; ++i)
     if (!seen.count(i)) throw Error("study merge", "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing");
@@ -391,6 +421,20 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
   std::string lines;
   for (const StudyRow& r : rows) lines += r.dump() + "\n";
   write_text_file(out / "rows.jsonl", lines);
+  // The kept files of every shard (named by configuration index, so they never collide): hard links where the
+  // folders share a file system, copies elsewhere.
+  for (const std::filesystem::path& folder : shards) {
+    std::error_code error;
+    if (!std::filesystem::is_directory(folder / "images", error)) continue;
+    std::filesystem::create_directories(out / "images");
+    for (const auto& entry : std::filesystem::directory_iterator(folder / "images")) {
+      const std::filesystem::path target = out / "images" / entry.path().filename();
+      std::filesystem::remove(target, error);
+      std::filesystem::create_hard_link(entry.path(), target, error);
+      if (error) std::filesystem::copy_file(entry.path(), target);
+    }
+  }
+  header["run"] = {{"wall_seconds", wall_seconds}, {"shards", count}, {"longest_shard_seconds", longest_shard}};
   write_study_results(header, rows, out);
 }
 

@@ -219,7 +219,8 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
   if (auto v = object.find("keep"))
     for (const Value& item : v->array()) {
       const std::string kind = item.choice<std::string>({{"image", "image"}, {"error_texels", "error_texels"},
-                                                         {"iterations", "iterations"}});
+                                                         {"iterations", "iterations"},
+                                                         {"reference", "reference"}});
       spec.keep.push_back(kind);
     }
   if (auto v = object.find("group_by")) {

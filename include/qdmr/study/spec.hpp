@@ -50,7 +50,8 @@ struct StudySpec {
   // {"technique": "relief"} compares every row with relief at the same angle and depth. Empty: no image_diff.
   std::map<std::string, nlohmann::json> baseline;
   double diff_threshold = 1.0 / 255.0;            // a pixel counts as different above this (any channel)
-  std::vector<std::string> keep;                  // "image", "error_texels", "iterations": files per configuration
+  // Files per configuration: "image", "error_texels", "iterations", "reference" (the image with exact_hits).
+  std::vector<std::string> keep;
   std::string group_axis;                          // Pareto fronts per value of this axis ("technique" if present)
   std::size_t max_configurations = 5000;           // a larger product needs --force
 

@@ -1,0 +1,203 @@
+"""The report's charts, drawn with matplotlib: Pareto fronts, metrics along each numeric axis, cache bars.
+
+Every chart is an SVG string for inlining in the page, so the points of a Pareto chart can link to the
+configurations' sections. Colour maps are perceptually uniform (viridis, magma); axes carry units; an axis whose
+data spans decades is logarithmic.
+"""
+import io
+import math
+import statistics
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
+
+plt.rcParams.update({
+    "svg.hashsalt": "qdmr-report",  # stable element ids: the same results give the same page
+    "svg.fonttype": "none",         # text stays text (searchable, small)
+    "font.size": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+})
+
+# Columns the charts know, with their axis labels.
+LABELS = {
+    "draw_ms_median": "draw time, median (ms)",
+    "error_p99": "error p99 (texels)",
+    "error_mean": "error mean (texels)",
+    "missed_fraction": "missed (% of covered pixels)",
+    "iterations_mean": "iterations per pixel, mean",
+    "cache_miss_ratio": "texture cache miss ratio (%)",
+}
+PERCENT = {"missed_fraction", "cache_miss_ratio"}
+
+
+def label(column):
+    return LABELS.get(column, column)
+
+
+def scaled(column, v):
+    return None if v is None else (100.0 * v if column in PERCENT else v)
+
+
+def svg(figure):
+    out = io.StringIO()
+    figure.savefig(out, format="svg", bbox_inches="tight", metadata={"Date": None})
+    plt.close(figure)
+    text = out.getvalue()
+    text = text[text.index("<svg"):]  # inline: no XML prologue or doctype
+    start, end = text.find("<metadata>"), text.find("</metadata>")
+    if 0 <= start < end:  # matplotlib's RDF credits: bytes the page does not need
+        text = text[:start] + text[end + len("</metadata>"):]
+    return text
+
+
+def _spans_decades(values):
+    positive = [v for v in values if v is not None and v > 0]
+    return len(positive) >= 2 and max(positive) / min(positive) >= 30
+
+
+def _scale_axis(ax, which, values, log_hint=False):
+    """Logarithmic where the data spans decades (symmetric-log when zeros are among them)."""
+    values = [v for v in values if v is not None]
+    if not (log_hint or _spans_decades(values)):
+        return
+    positive = [v for v in values if v > 0]
+    if not positive:
+        return
+    setter = ax.set_xscale if which == "x" else ax.set_yscale
+    if min(values) <= 0:
+        setter("symlog", linthresh=min(positive))
+    else:
+        setter("log")
+
+
+def pareto_chart(study, group, rows, front, link):
+    """Time against p99 error for the rows of one group, the front drawn over the faint dominated rows, missed
+    fraction as colour; every point links to link(index)."""
+    fig, ax = plt.subplots(figsize=(5.6, 3.8))
+    times = [study.number(r, "draw_ms_median") for r in rows]
+    errors = [study.number(r, "error_p99") for r in rows]
+    missed = [scaled("missed_fraction", study.number(r, "missed_fraction")) or 0.0 for r in rows]
+    usable = [i for i, r in enumerate(rows) if times[i] is not None and errors[i] is not None]
+    if not usable:
+        plt.close(fig)
+        return None
+    vmax = max(max(missed[i] for i in usable), 1e-9)
+    on_front = [i for i in usable if rows[i]["index"] in front]
+    dominated = [i for i in usable if rows[i]["index"] not in front]
+    scatter_kw = dict(cmap="viridis", vmin=0.0, vmax=vmax, edgecolors="black", linewidths=0.4)
+    if dominated:
+        points = ax.scatter([times[i] for i in dominated], [errors[i] for i in dominated],
+                            c=[missed[i] for i in dominated], s=22, alpha=0.25, **scatter_kw)
+        points.set_urls([link(rows[i]["index"]) for i in dominated])
+    ordered = sorted(on_front, key=lambda i: (times[i], errors[i]))
+    ax.plot([times[i] for i in ordered], [errors[i] for i in ordered], color="0.25", linewidth=1, zorder=2,
+            drawstyle="steps-post")
+    points = ax.scatter([times[i] for i in ordered], [errors[i] for i in ordered],
+                        c=[missed[i] for i in ordered], s=46, zorder=3, **scatter_kw)
+    points.set_urls([link(rows[i]["index"]) for i in ordered])
+    colorbar = fig.colorbar(points, ax=ax)
+    colorbar.set_label(label("missed_fraction"))
+    ax.set_xlabel(label("draw_ms_median"))
+    ax.set_ylabel(label("error_p99"))
+    _scale_axis(ax, "x", [times[i] for i in usable])
+    _scale_axis(ax, "y", [errors[i] for i in usable])
+    ax.set_title(f"{group}: {len(ordered)} on the front, {len(dominated)} dominated (faint)")
+    return svg(fig)
+
+
+def numeric_axes(study):
+    """The axes whose values are numbers, with at least three distinct values: what line plots are drawn along."""
+    found = []
+    for axis in study.axes:
+        values = {study.number(r, axis) for r in study.rows} - {None}
+        if len(values) >= 3 and all(isinstance(r["config"].get(axis), (int, float, type(None)))
+                                    and not isinstance(r["config"].get(axis), bool) for r in study.rows):
+            found.append(axis)
+    return found
+
+
+def line_chart(study, axis, metrics):
+    """One panel per metric along `axis`, one line per group: the median over the other axes' values at each
+    point, the band from their minimum to their maximum."""
+    metrics = [m for m in metrics if any(study.number(r, m) is not None for r in study.rows)]
+    if not metrics:
+        return None
+    columns = min(len(metrics), 2)
+    rows = (len(metrics) + columns - 1) // columns
+    fig, panels = plt.subplots(rows, columns, figsize=(3.6 * columns, 2.9 * rows), squeeze=False)
+    for ax in panels.flat[len(metrics):]:
+        ax.set_visible(False)
+    spec = study.axis_spec(axis)
+    log_x = spec.get("range", {}).get("scale") == "log"
+    unit = " (degrees)" if spec.get("camera") else ""
+    colours = plt.get_cmap("viridis")
+    groups = study.groups()
+    for ax, metric in zip(panels.flat, metrics):
+        all_y = []
+        for g_index, group in enumerate(groups):
+            points = {}
+            for r in study.rows:
+                if study.group_of(r) != group:
+                    continue
+                x, y = study.number(r, axis), scaled(metric, study.number(r, metric))
+                if x is not None and y is not None:
+                    points.setdefault(x, []).append(y)
+            if not points:
+                continue
+            xs = sorted(points)
+            colour = colours(g_index / max(len(groups) - 1, 1) * 0.9)
+            ax.plot(xs, [statistics.median(points[x]) for x in xs], marker="o", markersize=3, color=colour,
+                    label=group)
+            if any(len(points[x]) > 1 for x in xs):
+                ax.fill_between(xs, [min(points[x]) for x in xs], [max(points[x]) for x in xs], color=colour,
+                                alpha=0.15, linewidth=0)
+            all_y += [y for x in xs for y in points[x]]
+        ax.set_xlabel(axis + unit)
+        ax.set_ylabel(label(metric))
+        _scale_axis(ax, "x", [study.number(r, axis) for r in study.rows], log_hint=log_x)
+        _scale_axis(ax, "y", all_y)
+    if len(groups) > 1:
+        panels.flat[0].legend(title=study.group_axis, fontsize=7, title_fontsize=7)
+    fig.tight_layout()
+    return svg(fig)
+
+
+def cache_chart(study, layout_axis):
+    """The cache study: the miss ratio as bars per texture layout, one bar per group."""
+    layouts = []
+    for r in study.rows:
+        v = r["config"].get(layout_axis)
+        if v not in layouts:
+            layouts.append(v)
+    groups = study.groups()
+    fig, ax = plt.subplots(figsize=(max(4.0, 1.1 * len(layouts) * max(len(groups), 1) * 0.5 + 2), 3.2))
+    width = 0.8 / max(len(groups), 1)
+    colours = plt.get_cmap("viridis")
+    for g_index, group in enumerate(groups):
+        heights = []
+        for layout in layouts:
+            values = [study.number(r, "cache_miss_ratio") for r in study.rows
+                      if study.group_of(r) == group and r["config"].get(layout_axis) == layout]
+            values = [v for v in values if v is not None]
+            heights.append(100.0 * statistics.median(values) if values else math.nan)
+        ax.bar([i + g_index * width for i in range(len(layouts))], heights, width, label=group,
+               color=colours(g_index / max(len(groups) - 1, 1) * 0.9))
+    ax.set_xticks([i + width * (len(groups) - 1) / 2 for i in range(len(layouts))],
+                  [str(v) for v in layouts])
+    ax.set_xlabel(layout_axis)
+    ax.set_ylabel(label("cache_miss_ratio"))
+    if len(groups) > 1:
+        ax.legend(title=study.group_axis, fontsize=7, title_fontsize=7)
+    return svg(fig)
+
+
+def colour_scale(cmap, vmax, unit):
+    """A horizontal colour bar from 0 to vmax, the key of the heatmaps."""
+    fig, ax = plt.subplots(figsize=(3.2, 0.5))
+    norm = matplotlib.colors.Normalize(0.0, vmax)
+    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), cax=ax, orientation="horizontal",
+                 label=unit)
+    return svg(fig)
