@@ -112,12 +112,6 @@ for i in 1 2 3 4; do [ -f "$work/results/shard-$i/study.json" ] || fail "shard $
 
 # The merged rows equal an unsharded run's in every deterministic column.
 "$qdmr" study "$spec" -o "$work/unsharded" >/dev/null 2>&1 || fail "the unsharded study failed"
-python3 - "$work/results/merged/results.json" "$work/unsharded/results.json" <<'PY' || fail "merged rows differ"
-import json, sys
-merged, whole = (json.load(open(p)) for p in sys.argv[1:])
-assert len(merged["rows"]) == len(whole["rows"]) == whole["configurations"], "row counts"
-for a, b in zip(merged["rows"], whole["rows"]):
-    assert (a["index"], a["config"], a["deterministic"]) == (b["index"], b["config"], b["deterministic"]), a["index"]
-print(f"{len(merged['rows'])} merged rows equal the unsharded run's (deterministic columns)")
-PY
+python3 "$source/tests/examples/same_study_rows.py" "$work/results/merged/results.json" \
+  "$work/unsharded/results.json" || fail "the merged rows differ from the unsharded run's"
 echo "slurm: ok"
