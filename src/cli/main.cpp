@@ -345,7 +345,9 @@ int main(int argc, char** argv) {
   study_cmd->add_option("--shard", study.shard, "Run shard I of N (I/N), balanced by estimated cost; merge with qdmr study merge");
   study_cmd->add_flag("--resume", study.resume, "Continue an interrupted run of the same spec in the same folder");
   study_cmd->add_flag("--force", study.force, "Run more configurations than the spec's max_configurations");
-  study_cmd->add_option("--threads", study.threads, "Worker threads (default: every core)");
+  study_cmd->add_option("--threads", study.threads, "Worker threads per configuration (default: every core / jobs)");
+  study_cmd->add_option("--jobs", study.jobs, "Configurations drawn at once, each with its own renderers (default 1; "
+                                              "rows are the same, times include the contention)");
   qdmr::cli::StudyMergeArgs merge;
   CLI::App* merge_cmd = study_cmd->add_subcommand("merge", "Merge the folders of every shard of a study");
   merge_cmd->add_option("folders", merge.folders, "The shard folders")->required();

@@ -50,7 +50,9 @@ int run_study(const StudyArgs& args) {
     throw Error("--threads", "must be from 1 to " + std::to_string(limits::kMaxThreads));
   StudyOptions options;
   options.shard = parse_shard(args.shard);
+  if (args.jobs < 1 || args.jobs > 64) throw Error("--jobs", "must be from 1 to 64, got " + std::to_string(args.jobs));
   options.threads = args.threads.value_or(0);
+  options.jobs = args.jobs;
   options.resume = args.resume;
   options.force = args.force;
   const StudySpec spec = read_study_spec(args.spec);

@@ -11,6 +11,7 @@ struct StudyArgs {
   bool resume = false, force = false;
   bool report = false;  // write OUTPUT-report when done
   std::optional<int> threads;
+  int jobs = 1;
 };
 
 struct StudyMergeArgs {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <set>
 #include <thread>
 
@@ -287,9 +289,17 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
   const SceneSource source(spec.scene);
   const std::array<double, 9> camera = base_camera(spec, source);
 
-  Measurer measurer(spec, source, options.threads);
-  const nlohmann::ordered_json header = make_header(spec, configs.size(), options.shard, measurer.renderer().threads(),
-                                                    isa_name(measurer.renderer().isa()));
+  // --jobs: that many configurations at once, each measured by its own renderers with threads / jobs workers
+  // (every core / jobs by default). Rows are the same; the timing columns then include the contention.
+  const int jobs = std::max(1, options.jobs);
+  int threads_per_job = options.threads;
+  if (jobs > 1 && threads_per_job == 0)
+    threads_per_job = std::max(1, int(std::thread::hardware_concurrency()) / jobs);
+  std::vector<std::unique_ptr<Measurer>> measurers;
+  for (int j = 0; j < jobs; ++j) measurers.push_back(std::make_unique<Measurer>(spec, source, threads_per_job));
+  nlohmann::ordered_json header = make_header(spec, configs.size(), options.shard,
+                                              measurers[0]->renderer().threads(), isa_name(measurers[0]->renderer().isa()));
+  header["machine"]["jobs"] = jobs;
 
   std::filesystem::create_directories(out);
   const std::filesystem::path rows_file = out / "rows.jsonl", header_file = out / "study.json";
@@ -338,30 +348,60 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
   };
   auto last_write = Clock::now();
   std::size_t finished = done.size();
-  for (std::size_t index : mine) {
-    if (done.count(index)) continue;
-    if (options.stop_requested && options.stop_requested()) {
-      run.stopped = true;
-      break;
+  // Workers take the next pending configuration in order; everything shared (rows, files, progress) is updated
+  // under the lock, the drawing is not. The first error stops every worker and is thrown after they finish.
+  std::vector<std::size_t> pending;
+  for (std::size_t index : mine)
+    if (!done.count(index)) pending.push_back(index);
+  std::mutex lock;
+  std::size_t next = 0;
+  std::exception_ptr failure;
+  const auto work = [&](Measurer& measurer) {
+    for (;;) {
+      std::size_t index = 0;
+      {
+        const std::lock_guard<std::mutex> guard(lock);
+        if (failure || run.stopped || next == pending.size()) return;
+        if (options.stop_requested && options.stop_requested()) {
+          run.stopped = true;
+          return;
+        }
+        index = pending[next++];
+      }
+      const StudyConfig& config = configs[index];
+      StudyRow row;
+      try {
+        const SceneDesc scene = source.load(study_overrides(spec, config, camera));
+        try {
+          row = measurer.measure(config, scene, out / "images", camera);
+        } catch (const Error& e) {
+          throw Error(study_label(spec, config), e.what());
+        }
+        const std::lock_guard<std::mutex> guard(lock);
+        append_line(rows_file, row.dump());
+        rows.push_back(std::move(row));
+        ++run.rendered;
+        ++finished;
+        if (options.progress) options.progress(finished, mine.size(), study_label(spec, config));
+        if (Clock::now() - last_write > std::chrono::seconds(2)) {
+          write_study_results(results_header(), rows, out);
+          last_write = Clock::now();
+        }
+      } catch (...) {
+        const std::lock_guard<std::mutex> guard(lock);
+        if (!failure) failure = std::current_exception();
+        return;
+      }
     }
-    const StudyConfig& config = configs[index];
-    const SceneDesc scene = source.load(study_overrides(spec, config, camera));
-    StudyRow row;
-    try {
-      row = measurer.measure(config, scene, out / "images", camera);
-    } catch (const Error& e) {
-      throw Error(study_label(spec, config), e.what());
-    }
-    append_line(rows_file, row.dump());
-    rows.push_back(std::move(row));
-    ++run.rendered;
-    ++finished;
-    if (options.progress) options.progress(finished, mine.size(), study_label(spec, config));
-    if (Clock::now() - last_write > std::chrono::seconds(2)) {
-      write_study_results(results_header(), rows, out);
-      last_write = Clock::now();
-    }
+  };
+  if (jobs == 1) {
+    work(*measurers[0]);
+  } else {
+    std::vector<std::thread> workers;
+    for (auto& m : measurers) workers.emplace_back(work, std::ref(*m));
+    for (std::thread& w : workers) w.join();
   }
+  if (failure) std::rethrow_exception(failure);
   write_study_results(results_header(), rows, out);
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return run;

@@ -1,4 +1,4 @@
-// qdmr study through the command: deterministic columns identical across thread counts and shardings, resume
+// qdmr study through the command: deterministic columns identical across thread counts, jobs, ISAs and shardings, resume
 // after a kill equal to an uninterrupted run, merge refusing missing or foreign shards, folders never mixed.
 #include <gtest/gtest.h>
 
@@ -51,6 +51,11 @@ TEST(StudyCommand, RowsAreTheSameForAnyThreadCountAndSharding) {
   const CommandResult one = study(dir, {"-o", (dir / "one").string(), "--threads", "1"});
   ASSERT_EQ(one.exit_code, 0) << one.output;
   ASSERT_EQ(study(dir, {"-o", (dir / "two").string(), "--threads", "2"}).exit_code, 0);
+  ASSERT_EQ(study(dir, {"-o", (dir / "jobs").string(), "--jobs", "2"}).exit_code, 0);
+  ::setenv("QDMR_ISA", "sse4.2", 1);  // the baseline kernel instead of the CPU's best
+  const CommandResult sse = study(dir, {"-o", (dir / "sse").string()});
+  ::unsetenv("QDMR_ISA");
+  ASSERT_EQ(sse.exit_code, 0) << sse.output;
   ASSERT_EQ(study(dir, {"-o", (dir / "a").string(), "--shard", "1/2"}).exit_code, 0);
   ASSERT_EQ(study(dir, {"-o", (dir / "b").string(), "--shard", "2/2"}).exit_code, 0);
   const CommandResult merged = run(cli(), {"study", "merge", (dir / "a").string(), (dir / "b").string(), "-o", (dir / "m").string()});
@@ -59,6 +64,14 @@ TEST(StudyCommand, RowsAreTheSameForAnyThreadCountAndSharding) {
   const auto reference = deterministic_rows(dir / "one");
   ASSERT_EQ(reference.size(), 6u);
   EXPECT_EQ(deterministic_rows(dir / "two"), reference);
+  EXPECT_EQ(deterministic_rows(dir / "jobs"), reference);
+  // Across ISAs every column but lane_utilisation, which measures the kernel's SIMD width (4, 8 or 16 lanes).
+  const auto without_lanes = [](std::vector<nlohmann::json> rows) {
+    for (auto& row : rows) row["deterministic"].erase("lane_utilisation");
+    return rows;
+  };
+  EXPECT_EQ(without_lanes(deterministic_rows(dir / "sse")), without_lanes(reference));
+  EXPECT_EQ(nlohmann::json::parse(read_file(dir / "sse" / "study.json"))["machine"]["isa"], "sse4.2");
   EXPECT_EQ(deterministic_rows(dir / "m"), reference);
   EXPECT_LT(deterministic_rows(dir / "a").size(), 6u);  // each shard has a part
   // The displaced techniques did iterate, QDM is its own baseline, and nothing is NaN.

@@ -22,7 +22,8 @@ struct StudyShard {
 };
 
 struct StudyOptions {
-  int threads = 0;                   // 0: every core
+  int threads = 0;                   // per configuration; 0: every core / jobs
+  int jobs = 1;                      // configurations drawn at once (each by its own renderers)
   StudyShard shard;
   bool resume = false;               // keep the rows of an interrupted run of the same spec and shard
   bool force = false;                // allow more than the spec's max_configurations
