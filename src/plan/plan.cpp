@@ -19,8 +19,12 @@
 namespace qdmr {
 namespace {
 
+// Texture keys print floats exactly (hexfloat): values that differ in the last bit are different textures.
 std::string source_key(const TextureDesc& d) {
   std::ostringstream k;
+  k << std::hexfloat;
+  // The storage: the same source stored as r8 or BC3 is another texture.
+  k << "fmt" << int(d.format) << ":bc" << int(d.compression) << ":";
   switch (d.source) {
     case TextureSource::None: k << "none"; break;
     case TextureSource::File: k << "file:" << d.file.string() << ":ch" << int(d.channel) << ":srgb" << d.srgb; break;
@@ -38,13 +42,13 @@ std::string source_key(const TextureDesc& d) {
 
 std::string height_key(const LayerDesc& layer) {
   std::ostringstream k;
-  k << source_key(layer.height) << ":scale" << layer.height_scale << ":offset" << layer.height_offset;
+  k << std::hexfloat << source_key(layer.height) << ":scale" << layer.height_scale << ":offset" << layer.height_offset;
   return k.str();
 }
 
 std::string request_key(const TextureDesc& d, TexturePurpose purpose, const LayerDesc& layer) {
   std::ostringstream k;
-  k << purpose_name(purpose) << "|" << source_key(d);
+  k << std::hexfloat << purpose_name(purpose) << "|" << source_key(d);
   if (purpose == TexturePurpose::Albedo && d.source == TextureSource::Procedural)
     k << ":low" << d.color_low.x << "," << d.color_low.y << "," << d.color_low.z << ":high" << d.color_high.x << ","
       << d.color_high.y << "," << d.color_high.z << ":var" << d.variation;

@@ -78,6 +78,31 @@ TEST(Renderer, CameraAndSizeChangesRePrepareNothing) {
   EXPECT_EQ(again.items_built + again.items_reused, 0u);
 }
 
+// Whatever changes a texture's content changes its key: a persistent renderer must never re-use the texture of
+// the previous scene for a new storage (BC3, a format) or a float that differs in its last bit. Each new scene's
+// frame is its one-shot render.
+TEST(Renderer, ANewTextureSettingIsANewTexture) {
+  Renderer renderer;
+  const std::vector<std::vector<SceneOverride>> scenes = {
+      {},
+      {{"/materials/bricks/layers/0/height/compression", "bc3"}},
+      {{"/materials/bricks/layers/0/height/format", "r8"}},
+      {{"/materials/bricks/layers/0/albedo/variation", "0.15000002"}},
+  };
+  std::vector<PixelBuffer> frames;
+  for (const auto& overrides : scenes) {
+    const SceneDesc scene = small_scene("plane", overrides);
+    renderer.set_scene(scene);
+    const Frame& frame = renderer.draw();
+    EXPECT_TRUE(same_bits(frame.color, render_frame(scene, {}).color)) << overrides.size();
+    if (!overrides.empty()) {
+      EXPECT_GT(frame.stats.items_built, 0u) << overrides[0].pointer;
+    }
+    frames.push_back(frame.color);
+  }
+  EXPECT_FALSE(same_bits(frames[0], frames[1]));  // BC3 moves heights by up to 3/255
+}
+
 TEST(Renderer, StatsNameTheVariantThePlanPicked) {
   for (const std::string name : {"terrain", "objects", "surface_blend_4layers", "pom_vs_qdm_depth_5.0"}) {
     Renderer renderer;
