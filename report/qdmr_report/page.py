@@ -142,7 +142,7 @@ class Page:
 
     def pareto_section(self):
         s = self.study
-        out = ["<h2 id=pareto>Pareto fronts</h2>",
+        out = ["<section id=pareto><h2>Pareto fronts</h2>",
                "<p>Time against p99 error (distance of the hit from the exact fp64 reference's, in level-0 texels); "
                "colour is the fraction of covered pixels missed by more than a texel. A configuration is on the "
                "front when no other is at least as good in all of time, p99 error and missed fraction and better in "
@@ -167,12 +167,14 @@ class Page:
     def axes_section(self):
         s = self.study
         axes = plots.numeric_axes(s)
-        out = ["<h2 id=axes>Along each numeric axis</h2>"]
+        out = ["<section id=axes><h2>Along each numeric axis</h2>"]
         if not axes:
             out.append("<p class=note>No axis has three or more numeric values.</p>")
             return "\n".join(out)
-        out.append(f"<p>One line per {esc(s.group_axis or 'study')}: the median over the other axes' values at each "
-                   "point, the band from their minimum to their maximum.</p>")
+        series, _ = plots.line_series(s, axes[0])
+        out.append(f"<p>One line per value of {esc(', '.join(series) or 'the study')} (the categorical axes, or the "
+                   "group axis when they make too many lines): the median over the other axes' values at each point, "
+                   "the band from their minimum to their maximum.</p>")
         for axis in axes:
             chart = plots.line_chart(s, axis, ["error_p99", "missed_fraction", "draw_ms_median", "iterations_mean"])
             if chart:
@@ -183,7 +185,7 @@ class Page:
         s = self.study
         ranked = sorted((r for r in s.rows if s.number(r, "error_p99") is not None),
                         key=lambda r: (-s.number(r, "error_p99"), r["index"]))
-        out = ["<h2 id=worst>Worst artifacts</h2>"]
+        out = ["<section id=worst><h2>Worst artifacts</h2>"]
         with_reference = [r for r in ranked if s.kept(r["index"], ".png") and s.kept(r["index"], ".reference.png")]
         if not with_reference:
             out.append("<p class=note>No configuration kept both its image and its exact reference: add "
@@ -214,7 +216,7 @@ class Page:
 
     def cache_section(self):
         s = self.study
-        out = ["<h2 id=cache>Texture cache</h2>"]
+        out = ["<section id=cache><h2>Texture cache</h2>"]
         has_cache = any(s.number(r, "cache_miss_ratio") is not None for r in s.rows)
         layout_axes = [a for a in s.axes if a == "layout" or s.axis_spec(a).get("path", "").endswith("/layout")]
         if not has_cache or not layout_axes:
@@ -229,7 +231,7 @@ class Page:
         s = self.study
         det, timing = s.columns(DETERMINISTIC), s.columns(TIMING)
         on_front = set().union(*s.fronts.values()) if s.fronts else set()
-        out = ["<h2 id=rows>Every configuration</h2>",
+        out = ["<section id=rows><h2>Every configuration</h2>",
                "<p>Click a column to sort. Bold rows are on a Pareto front. Timing columns (last) vary from run to "
                "run; the others are bit-identical across runs, threads, ISAs and shards.</p>",
                "<table class=rows><thead><tr><th>index</th>"
@@ -249,9 +251,9 @@ class Page:
 
     def cards_section(self):
         if not self.cards:
-            return ("<h2 id=configurations>Configurations</h2><p class=note>The spec kept no files per configuration "
+            return ("<section id=configurations><h2>Configurations</h2><p class=note>The spec kept no files per configuration "
                     "(<code>keep</code>).</p>")
-        out = ["<h2 id=configurations>Configurations</h2>",
+        out = ["<section id=configurations><h2>Configurations</h2>",
                f"<p>What each configuration kept. Heatmaps share one scale across the study: error_texels (magma) from "
                f"0 to {self.error_max:.3g} texels, iterations (viridis) from 0 to {self.iterations_max:.0f}.</p>",
                "<div class=charts>", f"<figure>{plots.colour_scale('magma', self.error_max, 'error (texels)')}</figure>",
@@ -270,12 +272,13 @@ class Page:
 
     def render(self):
         self.make_cards()
+        sections = [self.pareto_section(), self.axes_section(), self.worst_section(), self.cache_section(),
+                    self.table_section(), self.cards_section()]
         body = [self.header(),
                 "<nav><a href='#pareto'>Pareto fronts</a><a href='#axes'>Axes</a><a href='#worst'>Worst artifacts</a>"
                 "<a href='#cache'>Cache</a><a href='#rows'>Every configuration</a>"
                 "<a href='#configurations'>Pictures</a></nav>",
-                self.pareto_section(), self.axes_section(), self.worst_section(), self.cache_section(),
-                self.table_section(), self.cards_section()]
+                *(section + "\n</section>" for section in sections)]
         title = esc(os.path.basename(self.study.header.get("spec_file", "study")))
         return ("<!doctype html>\n<html lang=en><head><meta charset=utf-8>"
                 "<meta name=viewport content='width=device-width, initial-scale=1'>"

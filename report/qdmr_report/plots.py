@@ -8,6 +8,8 @@ import io
 import math
 import statistics
 
+from .results import format_value
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -69,6 +71,8 @@ def _scale_axis(ax, which, values, log_hint=False):
     setter = ax.set_xscale if which == "x" else ax.set_yscale
     if min(values) <= 0:
         setter("symlog", linthresh=min(positive))
+        if min(values) == 0:  # no negative decades below the data's zero
+            (ax.set_xlim if which == "x" else ax.set_ylim)(0, None)
     else:
         setter("log")
 
@@ -108,20 +112,50 @@ def pareto_chart(study, group, rows, front, link):
     return svg(fig)
 
 
+def _zipped_followers(study):
+    """Axes zipped to an earlier one (they advance together, so a chart along them repeats the first's)."""
+    followers = set()
+    for group in study.header.get("spec", {}).get("zip", []):
+        followers.update(group[1:])
+    return followers
+
+
 def numeric_axes(study):
-    """The axes whose values are numbers, with at least three distinct values: what line plots are drawn along."""
+    """The axes whose values are numbers, with at least three distinct values: what line plots are drawn along
+    (an axis zipped to an earlier one is left out)."""
     found = []
+    followers = _zipped_followers(study)
     for axis in study.axes:
         values = {study.number(r, axis) for r in study.rows} - {None}
-        if len(values) >= 3 and all(isinstance(r["config"].get(axis), (int, float, type(None)))
-                                    and not isinstance(r["config"].get(axis), bool) for r in study.rows):
+        if axis not in followers and len(values) >= 3 and all(
+                isinstance(r["config"].get(axis), (int, float, type(None)))
+                and not isinstance(r["config"].get(axis), bool) for r in study.rows):
             found.append(axis)
     return found
 
 
+MAX_LINES = 8
+
+
+def line_series(study, along):
+    """What the lines of a chart along an axis are: every combination of the categorical axes (strings,
+    booleans, or fewer than three numbers; zipped followers left out) when there are at most MAX_LINES of them,
+    else the group axis alone. Returns (axis names, a function of a row giving its line's label)."""
+    followers = _zipped_followers(study)
+    numeric = set(numeric_axes(study))
+    categorical = [a for a in study.axes if a != along and a not in numeric and a not in followers
+                   and len({format_value(r["config"].get(a)) for r in study.rows}) > 1]
+    combinations = {tuple(format_value(r["config"].get(a)) for a in categorical) for r in study.rows}
+    if not categorical or len(combinations) > MAX_LINES:
+        categorical = [study.group_axis] if study.group_axis else []
+    if len(categorical) == 1:
+        return categorical, lambda r: format_value(r["config"].get(categorical[0]))
+    return categorical, lambda r: ", ".join(f"{a}={format_value(r['config'].get(a))}" for a in categorical)
+
+
 def line_chart(study, axis, metrics):
-    """One panel per metric along `axis`, one line per group: the median over the other axes' values at each
-    point, the band from their minimum to their maximum."""
+    """One panel per metric along `axis`, one line per value of the categorical axes (line_series): the median
+    over the other axes' values at each point, the band from their minimum to their maximum."""
     metrics = [m for m in metrics if any(study.number(r, m) is not None for r in study.rows)]
     if not metrics:
         return None
@@ -131,16 +165,24 @@ def line_chart(study, axis, metrics):
     for ax in panels.flat[len(metrics):]:
         ax.set_visible(False)
     spec = study.axis_spec(axis)
-    log_x = spec.get("range", {}).get("scale") == "log"
+    xs_all = [study.number(r, axis) for r in study.rows]
+    positive = [x for x in xs_all if x is not None and x > 0]
+    # A log range, or positive values spanning a factor of ten or more (map sizes, caps), get a log axis.
+    log_x = spec.get("range", {}).get("scale") == "log" or (
+        len(positive) == len([x for x in xs_all if x is not None]) and positive and max(positive) / min(positive) >= 10)
     unit = " (degrees)" if spec.get("camera") else ""
     colours = plt.get_cmap("viridis")
-    groups = study.groups()
+    series, line_of = line_series(study, axis)
+    lines = []
+    for r in study.rows:
+        if line_of(r) not in lines:
+            lines.append(line_of(r))
     for ax, metric in zip(panels.flat, metrics):
         all_y = []
-        for g_index, group in enumerate(groups):
+        for l_index, line in enumerate(lines):
             points = {}
             for r in study.rows:
-                if study.group_of(r) != group:
+                if line_of(r) != line:
                     continue
                 x, y = study.number(r, axis), scaled(metric, study.number(r, metric))
                 if x is not None and y is not None:
@@ -148,19 +190,19 @@ def line_chart(study, axis, metrics):
             if not points:
                 continue
             xs = sorted(points)
-            colour = colours(g_index / max(len(groups) - 1, 1) * 0.9)
+            colour = colours(l_index / max(len(lines) - 1, 1) * 0.9)
             ax.plot(xs, [statistics.median(points[x]) for x in xs], marker="o", markersize=3, color=colour,
-                    label=group)
+                    label=line)
             if any(len(points[x]) > 1 for x in xs):
                 ax.fill_between(xs, [min(points[x]) for x in xs], [max(points[x]) for x in xs], color=colour,
                                 alpha=0.15, linewidth=0)
             all_y += [y for x in xs for y in points[x]]
         ax.set_xlabel(axis + unit)
         ax.set_ylabel(label(metric))
-        _scale_axis(ax, "x", [study.number(r, axis) for r in study.rows], log_hint=log_x)
+        _scale_axis(ax, "x", xs_all, log_hint=log_x)
         _scale_axis(ax, "y", all_y)
-    if len(groups) > 1:
-        panels.flat[0].legend(title=study.group_axis, fontsize=7, title_fontsize=7)
+    if len(lines) > 1:
+        panels.flat[0].legend(title=", ".join(series) if len(series) == 1 else None, fontsize=7, title_fontsize=7)
     fig.tight_layout()
     return svg(fig)
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Opens an HTML page from disk in headless Chromium and checks it the way a reader would see it.
 
-  browser_check.py PAGE.html --screenshot OUT.png [--sort-check] [--full-page]
+  browser_check.py PAGE.html --screenshot OUT.png [--sort-check] [--full-page | --element SELECTOR]
 
 Fails (exit 1, one line per problem) when an image did not load, the console or the page reported an error, the
 page asked for anything but local files, or (--sort-check) clicking a column of table.rows does not sort it.
@@ -125,7 +125,7 @@ SORT = """(() => {
 })()"""
 
 
-def check(page, screenshot, sort_check, width, height, full_page):
+def check(page, screenshot, sort_check, width, height, full_page, element=None):
     executable = shutil.which("chromium") or shutil.which("chromium-browser")
     if not executable:
         print("browser_check: SKIP: chromium is not installed (Debian package chromium; scripts/setup installs it)")
@@ -170,7 +170,16 @@ def check(page, screenshot, sort_check, width, height, full_page):
                 if not request_url.startswith(("file:", "data:", "about:")):
                     problems.append(f"the page asked the network for {request_url}")
         capture = {"format": "png"}
-        if full_page:  # the whole page, as tall as its content (capped: a screenshot, not an archive)
+        if element:  # one element of the page (e.g. a section of the report), as tall as it is (capped)
+            box = browser.send("Runtime.evaluate", {"returnByValue": True, "expression":
+                               f"(() => {{ const r = document.querySelector({json.dumps(element)})"
+                               ".getBoundingClientRect(); return [r.x, r.y + window.scrollY, r.width, r.height]; })()"},
+                               session=session)["result"].get("value")
+            if not box:
+                raise RuntimeError(f"no element {element} on the page")
+            capture.update(captureBeyondViewport=True, clip={"x": box[0], "y": box[1], "width": box[2], "scale": 1,
+                                                                "height": min(box[3], 3000)})
+        elif full_page:  # the whole page, as tall as its content (capped: a screenshot, not an archive)
             size = browser.send("Page.getLayoutMetrics", session=session)["cssContentSize"]
             capture.update(captureBeyondViewport=True, clip={"x": 0, "y": 0, "width": width, "scale": 1,
                                                                 "height": min(size["height"], 20000)})
@@ -193,11 +202,13 @@ def main():
     parser.add_argument("--width", type=int, default=1280)
     parser.add_argument("--height", type=int, default=1000)
     parser.add_argument("--full-page", action="store_true", help="screenshot the whole page, not the first screen")
+    parser.add_argument("--element", help="screenshot only the element this CSS selector finds (e.g. #pareto)")
     args = parser.parse_args()
     if not os.path.isfile(args.page):
         print(f"browser_check: {args.page}: no such file", file=sys.stderr)
         return 2
-    return check(args.page, args.screenshot, args.sort_check, args.width, args.height, args.full_page)
+    return check(args.page, args.screenshot, args.sort_check, args.width, args.height, args.full_page,
+                 args.element)
 
 
 if __name__ == "__main__":
