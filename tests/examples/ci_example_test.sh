@@ -20,6 +20,14 @@ cmake --install "$build" --prefix "$work/prefix" >/dev/null
 PATH="$work/prefix/bin:$PATH"
 export PATH
 command -v qdmr | grep -q "^$work/prefix/bin/qdmr$" || fail "the installed qdmr is not the one on PATH"
+# The installed qdmr finds its report generator (share/qdmr/qdmr_report): the generator itself answers a bad folder.
+set +e
+qdmr report "$work/no-such-results" -o "$work/no-report" 2>"$work/report.err"
+code=$?
+set -e
+[ "$code" -eq 2 ] && grep -q "no-such-results: not a folder" "$work/report.err" ||
+  fail "the installed qdmr report did not run its generator (exit $code): $(cat "$work/report.err")"
+test -f "$work/prefix/share/qdmr/qdmr_report/__main__.py" || fail "the report generator is not installed"
 
 cd "$src"
 QDMR_CHECK_OUT="$work/pass" examples/ci/run-checks.sh || fail "examples/ci/checks.json failed (exit $?)"
