@@ -87,9 +87,9 @@ int run_study(const StudyArgs& args) {
   std::signal(SIGTERM, on_interrupt);
   options.stop_requested = [] { return interrupted.load(); };
   const StudyRun run = qdmr::run_study(spec, args.output, options);
-  std::printf("%s: %zu configurations (%zu rendered now, %zu kept from before) in %.1f s; results.csv, results.json, "
-              "pareto.csv\n",
-              args.output.c_str(), run.total, run.rendered, run.resumed, run.seconds);
+  std::printf("%s: %zu configurations (%zu rendered now, %zu kept from before; assets prepared %zu times) in %.1f s; "
+              "results.csv, results.json, pareto.csv\n",
+              args.output.c_str(), run.total, run.rendered, run.resumed, run.asset_builds, run.seconds);
   if (run.stopped) {
     std::fprintf(stderr, "study: interrupted; the results so far are valid, continue with --resume\n");
     return 130;

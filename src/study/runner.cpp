@@ -106,6 +106,7 @@ public:
   }
 
   const Renderer& renderer() const { return timing_; }
+  std::size_t asset_builds() const { return asset_builds_; }  // configurations whose timed scene built anything
 
   StudyRow measure(const StudyConfig& config, const SceneDesc& scene, const std::filesystem::path& images,
                    const std::array<double, 9>& camera) {
@@ -121,7 +122,10 @@ public:
     double prepare_ms = 0;
     for (int f = 0; f < spec_.warmup + spec_.frames; ++f) {
       const Frame& frame = timing_.draw();
-      if (f == 0) prepare_ms = frame.stats.plan_ms + frame.stats.prepare_ms;
+      if (f == 0) {
+        prepare_ms = frame.stats.plan_ms + frame.stats.prepare_ms;
+        if (frame.stats.items_built > 0) ++asset_builds_;
+      }
       if (f >= spec_.warmup) draws.push_back(frame.stats.draw_ms());
     }
     const Frame& frame = timing_.frame();
@@ -222,6 +226,7 @@ private:
   const StudySpec& spec_;
   const SceneSource& source_;
   Renderer timing_, measuring_, baseline_renderer_;
+  std::size_t asset_builds_ = 0;
   std::map<std::string, Image> baselines_;
 };
 
@@ -259,6 +264,30 @@ void append_line(const std::filesystem::path& file, const std::string& line) {
   const ssize_t written = ::write(fd, text.data(), text.size());
   ::close(fd);
   if (written != ssize_t(text.size())) throw Error(file.string(), "short write (disk full?)");
+}
+
+// The configurations in the order that re-prepares least: grouped by what their plan builds (the items of the
+// timed frame's plan: textures, meshes, derived data by content key), groups in the order of their first
+// configuration, indices ascending within a group. A renderer keeps the last scene's items, so each asset set is
+// then built once per renderer instead of at every change of an axis that alters it.
+std::vector<std::size_t> order_for_reuse(const StudySpec& spec, const std::vector<StudyConfig>& configs,
+                                         const std::vector<std::size_t>& pending, const SceneSource& source,
+                                         const std::array<double, 9>& camera) {
+  std::map<std::string, std::size_t> group_of;  // asset set -> its group's rank
+  std::vector<std::pair<std::size_t, std::size_t>> ranked;  // (group, index)
+  for (std::size_t index : pending) {
+    const FramePlan plan = plan_frame(source.load(study_overrides(spec, configs[index], camera)));
+    std::vector<std::string> items = plan.items();
+    std::sort(items.begin(), items.end());
+    std::string set;
+    for (const std::string& item : items) set += item + "\n";
+    const auto found = group_of.emplace(set, group_of.size()).first;
+    ranked.emplace_back(found->second, index);
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::size_t> order;
+  for (const auto& [group, index] : ranked) order.push_back(index);
+  return order;
 }
 
 }  // namespace
@@ -353,6 +382,11 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
   std::vector<std::size_t> pending;
   for (std::size_t index : mine)
     if (!done.count(index)) pending.push_back(index);
+  try {
+    pending = order_for_reuse(spec, configs, pending, source, camera);
+  } catch (const Error&) {
+    // A configuration that cannot be planned keeps the index order: its own error is reported when it is drawn.
+  }
   std::mutex lock;
   std::size_t next = 0;
   std::exception_ptr failure;
@@ -402,6 +436,7 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
     for (std::thread& w : workers) w.join();
   }
   if (failure) std::rethrow_exception(failure);
+  for (const auto& m : measurers) run.asset_builds += m->asset_builds();
   write_study_results(results_header(), rows, out);
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return run;

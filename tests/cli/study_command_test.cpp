@@ -153,3 +153,26 @@ TEST(StudyCommand, MergeRefusesMissingDuplicateAndForeignShards) {
 
 }  // namespace
 }  // namespace qdmr::test
+
+namespace qdmr::test {
+namespace {
+
+// An axis that changes what is built (BC3 heights) toggling fastest: configurations are drawn grouped by what
+// they build, so the heights are prepared twice (once per storage), not at every configuration; the rows are
+// still written by index.
+TEST(StudyCommand, ConfigurationsAreOrderedToPrepareEachAssetSetOnce) {
+  TempDir dir;
+  write_file(dir / "s.json", R"({"scene": ")" + (source_dir() / "scenes" / "plane.json").string() + R"(",
+    "width": 48, "height": 27, "frames": 1, "warmup": 0, "metrics": ["time"],
+    "axes": [{"name": "elevation", "camera": "elevation", "values": [60, 40, 20]},
+             {"name": "compression", "path": "/materials/bricks/layers/0/height/compression", "values": ["none", "bc3"]}]})");
+  const CommandResult result = run(cli(), {"study", (dir / "s.json").string(), "-o", (dir / "out").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("assets prepared 2 times"), std::string::npos) << result.output;
+  const auto results = nlohmann::json::parse(read_file(dir / "out" / "results.json"));
+  ASSERT_EQ(results["rows"].size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(results["rows"][i]["index"], i);
+}
+
+}  // namespace
+}  // namespace qdmr::test

@@ -37,6 +37,8 @@ struct StudyRun {
   std::size_t total = 0;     // configurations of this shard
   std::size_t rendered = 0;  // in this run
   std::size_t resumed = 0;   // kept from an earlier run
+  std::size_t asset_builds = 0;  // configurations whose assets had to be (re)built: configurations are ordered
+                                 // by what they build, so this is near the number of distinct asset sets
   bool stopped = false;
   double seconds = 0;
 };
