@@ -183,17 +183,27 @@ class Page:
 
     def worst_section(self):
         s = self.study
-        ranked = sorted((r for r in s.rows if s.number(r, "error_p99") is not None),
+        # The worst of every group value first (by p99), then the second worst of each, ...: one technique's
+        # near-identical variants do not crowd out the others.
+        ranked = sorted((r for r in s.rows if s.number(r, "error_p99") is not None
+                         and s.kept(r["index"], ".png") and s.kept(r["index"], ".reference.png")),
                         key=lambda r: (-s.number(r, "error_p99"), r["index"]))
+        place, seen = {}, {}
+        for r in ranked:
+            g = s.group_of(r)
+            place[r["index"]] = seen.get(g, 0)
+            seen[g] = place[r["index"]] + 1
+        with_reference = sorted(ranked, key=lambda r: (place[r["index"]], -s.number(r, "error_p99"), r["index"]))
         out = ["<section id=worst><h2>Worst artifacts</h2>"]
-        with_reference = [r for r in ranked if s.kept(r["index"], ".png") and s.kept(r["index"], ".reference.png")]
         if not with_reference:
             out.append("<p class=note>No configuration kept both its image and its exact reference: add "
                        "<code>\"keep\": [\"image\", \"reference\", \"error_texels\"]</code> to the spec to see the worst "
                        "artifacts beside the exact reference.</p>")
             return "\n".join(out)
-        out.append(f"<p>The {min(self.worst_count, len(with_reference))} configurations with the highest p99 error "
-                   f"(of those that kept their image and reference): a {self.crop_size}-pixel crop where the error is "
+        by = f" of each {esc(s.group_axis)}" if s.group_axis else ""
+        out.append(f"<p>The {min(self.worst_count, len(with_reference))} configurations with the highest p99 error, "
+                   f"the worst{by} first (of those that kept their image and reference): a {self.crop_size}-pixel "
+                   "crop where the error is "
                    "largest, the same crop of the configuration rendered at the exact reference's hits "
                    "(<code>exact_hits</code>) and their colour difference (magma, black = equal).</p>")
         for row in with_reference[:self.worst_count]:
