@@ -5,6 +5,7 @@ It opens from disk with no server and no network: no external script, style shee
 import html
 import json
 import os
+import sys
 
 from . import pictures, plots
 from .results import DETERMINISTIC, TIMING, format_value
@@ -80,7 +81,11 @@ class Page:
 
     # The pictures of every configuration that kept any: copies and heatmaps in images/.
     def make_cards(self):
-        for row in self.study.rows:
+        terminal = sys.stderr.isatty()  # a progress line on a terminal; quiet in CI logs
+        for done, row in enumerate(self.study.rows, 1):
+            if terminal:
+                print(f"\rreport: pictures of configuration {done}/{len(self.study.rows)}", end="", file=sys.stderr,
+                      flush=True)
             index = row["index"]
             made = []
             for suffix, what in KEPT:
@@ -100,6 +105,8 @@ class Page:
                 made.append((name, what))
             if made:
                 self.cards[index] = made
+        if terminal:
+            print(file=sys.stderr)
 
     def header(self):
         s, h = self.study, self.study.header
