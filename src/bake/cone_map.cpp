@@ -310,6 +310,24 @@ ConeMap empty_map(const Grid& g, ConeKind kind) {
 
 const char* cone_kind_name(ConeKind kind) { return kind == ConeKind::Relaxed ? "relaxed" : "conservative"; }
 
+std::uint64_t cone_bake_bytes(int width, int height, ConeKind kind, AddressMode address) {
+  // As make_grid, build_hierarchy and empty_map allocate them.
+  const bool mirror = address == AddressMode::Mirror;
+  const std::uint64_t w = std::uint64_t(std::max(width, 0)), h = std::uint64_t(std::max(height, 0));
+  const std::uint64_t gw = mirror ? 2 * w : w, gh = mirror ? 2 * h : h;  // the (unfolded) grid
+  const std::uint64_t channels = kind == ConeKind::Relaxed ? kWallChannels.size() : 1;
+  std::uint64_t bytes = gw * gh * sizeof(double)              // Grid::heights
+                        + gw * gh * channels * sizeof(double)  // Grid::value
+                        + (gw + gh + 2) * sizeof(double)       // Grid::sqx, sqy
+                        + w * h * sizeof(float);               // the map
+  for (std::uint64_t lw = gw, lh = gh; lw > 1 || lh > 1;) {  // the hierarchy's levels 1, 2, ...
+    lw = (lw + 1) / 2;
+    lh = (lh + 1) / 2;
+    bytes += lw * lh * channels * sizeof(float);
+  }
+  return bytes;
+}
+
 ConeMap bake_cone_map(const HeightField& field, ConeKind kind) {
   const Grid g = make_grid(field, kind);
   const std::vector<Level> levels = build_hierarchy(g);

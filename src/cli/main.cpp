@@ -58,6 +58,18 @@ std::int64_t default_max_memory_mib() {
   return std::int64_t(std::uint64_t(pages) * std::uint64_t(page) / 2 >> 20);
 }
 
+// --max-memory in bytes: the flag's value (checked: 1 MiB to 1 PiB) or the default.
+std::uint64_t max_memory_bytes(const std::optional<std::int64_t>& mib) {
+  if (mib && (*mib < 1 || *mib > (std::int64_t(1) << 30)))
+    throw qdmr::Error("--max-memory", "must be from 1 to 1073741824 (MiB), got " + std::to_string(*mib));
+  return std::uint64_t(mib.value_or(default_max_memory_mib())) << 20;
+}
+
+// Which limit refused a job, for the end of its message.
+const char* max_memory_source(const std::optional<std::int64_t>& mib) {
+  return mib ? " (--max-memory)" : " (half the RAM; raise it with --max-memory)";
+}
+
 std::vector<qdmr::SceneOverride> overrides(const SceneArgs& args, const RenderArgs* render) {
   std::vector<qdmr::SceneOverride> result;
   for (const std::string& s : args.sets) result.push_back(qdmr::parse_override(s));
@@ -88,8 +100,7 @@ qdmr::RenderOptions render_options(const RenderArgs& render) {
     throw qdmr::Error("--threads", "must be from 1 to " + std::to_string(qdmr::limits::kMaxThreads) + ", got " +
                                        std::to_string(*render.threads) + " (omit it to use every core)");
   options.threads = render.threads.value_or(0);
-  if (render.max_memory_mib && (*render.max_memory_mib < 1 || *render.max_memory_mib > (std::int64_t(1) << 30)))
-    throw qdmr::Error("--max-memory", "must be from 1 to 1073741824 (MiB), got " + std::to_string(*render.max_memory_mib));
+  options.max_memory_bytes = max_memory_bytes(render.max_memory_mib);
   options.tile_size = render.tile;
   const std::optional<qdmr::Isa> isa = qdmr::parse_isa(render.isa);
   if (!isa) throw qdmr::Error("--isa", "unknown ISA '" + render.isa + "' (valid: auto, sse4.2, avx2, avx512)");
@@ -123,8 +134,8 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   qdmr::check_outputs(outputs);  // the scene, its textures and OBJ files are known inputs now
-  // The plan's estimate (`qdmr plan` prints it part by part) is checked by set_scene before anything is built.
-  options.max_memory_bytes = std::uint64_t(render.max_memory_mib.value_or(default_max_memory_mib())) << 20;
+  // The plan's estimate (`qdmr plan` prints it part by part) is checked by set_scene (against
+  // options.max_memory_bytes) before anything is built.
 
   // Progress only on a terminal: logs and CI stay quiet.
   if (::isatty(STDERR_FILENO))
@@ -140,7 +151,7 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   } catch (const qdmr::Error& e) {
     const std::string what = e.what();
     if (what.find("MiB (see qdmr plan), more than the limit of") == std::string::npos) throw;
-    throw qdmr::Error(what + (render.max_memory_mib ? " (--max-memory)" : " (half the RAM; raise it with --max-memory)"));
+    throw qdmr::Error(what + max_memory_source(render.max_memory_mib));
   }
   qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
@@ -182,7 +193,23 @@ int run_plan(const SceneArgs& args, bool as_json) {
 
 struct ConeArgs {
   std::string height, output, kind = "conservative", channel = "r", address = "wrap";
+  std::optional<std::int64_t> max_memory_mib;  // absent: half the RAM
 };
+
+// The most `qdmr bake cone` holds at once, from the image's header: reading (the image as floats, and its 8- or
+// 16-bit samples while they are converted), copying the channel (the image and the field of doubles), baking
+// (the field and the baker's own, qdmr::cone_bake_bytes; the image is freed by then), writing (the map and its
+// rows in file order; the field is freed by then).
+std::uint64_t cone_command_bytes(const qdmr::ImageHeader& header, qdmr::ConeKind kind, qdmr::AddressMode address) {
+  const std::uint64_t texels = std::uint64_t(header.width) * std::uint64_t(header.height);
+  const std::uint64_t image = texels * std::uint64_t(header.channels) * sizeof(float);
+  const std::uint64_t samples = texels * std::uint64_t(header.channels) * std::uint64_t(header.source_bits == 8    ? 1
+                                                                                         : header.source_bits == 16 ? 2
+                                                                                                                    : 0);
+  const std::uint64_t field = texels * sizeof(double);
+  return std::max({image + samples, image + field,
+                   field + qdmr::cone_bake_bytes(header.width, header.height, kind, address), 2 * texels * sizeof(float)});
+}
 
 // qdmr bake cone: the cone map of one channel of a height image, as a 32-bit float EXR.
 int run_bake_cone(const ConeArgs& args) {
@@ -195,24 +222,38 @@ int run_bake_cone(const ConeArgs& args) {
   const std::string channels = "rgba";
   if (args.channel.size() != 1 || channels.find(args.channel[0]) == std::string::npos)
     throw qdmr::Error("--channel " + args.channel, "unknown channel (valid: r, g, b, a)");
+  const std::uint64_t limit = max_memory_bytes(args.max_memory_mib);
   const std::filesystem::path out = args.output;
   if (out.extension() != ".exr") throw qdmr::Error("-o " + args.output, "the cone map is written as .exr");
   const std::vector<qdmr::OutputPath> outputs{{"-o", out}};
   qdmr::check_outputs(outputs);
-  const qdmr::Image image = qdmr::read_image(args.height, args.height);
+  const qdmr::ConeKind kind = args.kind == "relaxed" ? qdmr::ConeKind::Relaxed : qdmr::ConeKind::Conservative;
+  const qdmr::AddressMode mode = qdmr::AddressMode(address - std::begin(addresses));
+  // Everything that can refuse the job is checked from the header, before any pixel is decoded.
+  const qdmr::ImageHeader header = qdmr::read_image_header(args.height, args.height);
   qdmr::check_outputs(outputs);  // the height image is a known input now
   const int channel = int(channels.find(args.channel[0]));
-  if (channel >= image.channels)
+  if (channel >= header.channels)
     throw qdmr::Error(args.height,
-                      "has " + std::to_string(image.channels) + " channel(s), no channel '" + args.channel + "'");
+                      "has " + std::to_string(header.channels) + " channel(s), no channel '" + args.channel + "'");
+  if (const std::uint64_t needed = cone_command_bytes(header, kind, mode); needed > limit)
+    throw qdmr::Error(args.height, "baking its " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                                       " " + qdmr::cone_kind_name(kind) + " cone map (address " + args.address +
+                                       ") needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +
+                                       " MiB, more than the limit of " + std::to_string(limit >> 20) + " MiB" +
+                                       max_memory_source(args.max_memory_mib));
   qdmr::HeightField field;
-  field.width = image.width;
-  field.height = image.height;
-  field.address = qdmr::AddressMode(address - std::begin(addresses));
-  field.h.resize(std::size_t(image.width) * std::size_t(image.height));
-  for (std::size_t k = 0; k < field.h.size(); ++k)
-    field.h[k] = image.texels[k * std::size_t(image.channels) + std::size_t(channel)];
-  const qdmr::ConeKind kind = args.kind == "relaxed" ? qdmr::ConeKind::Relaxed : qdmr::ConeKind::Conservative;
+  {
+    const qdmr::Image image = qdmr::read_image(args.height, args.height);
+    if (image.width != header.width || image.height != header.height || image.channels != header.channels)
+      throw qdmr::Error(args.height, "changed while it was read");
+    field.width = image.width;
+    field.height = image.height;
+    field.address = mode;
+    field.h.resize(std::size_t(image.width) * std::size_t(image.height));
+    for (std::size_t k = 0; k < field.h.size(); ++k)
+      field.h[k] = image.texels[k * std::size_t(image.channels) + std::size_t(channel)];
+  }  // the image is freed before the bake
   const auto start = std::chrono::steady_clock::now();
   qdmr::ConeMap map;
   try {
@@ -221,6 +262,7 @@ int run_bake_cone(const ConeArgs& args) {
     throw qdmr::Error(args.height, e.what());
   }
   const double bake_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  field = {};  // and the field before the write
   qdmr::write_cone_map_exr(map, out);
   std::printf("%s: %dx%d %s cone map, %.1f ms\n", args.output.c_str(), map.width, map.height,
               qdmr::cone_kind_name(kind), bake_ms);
@@ -305,6 +347,8 @@ int main(int argc, char** argv) {
   cone_cmd->add_option("--kind", cone.kind, "conservative (csm, default) or relaxed (rcsm)");
   cone_cmd->add_option("--channel", cone.channel, "Channel holding the heights: r (default), g, b or a");
   cone_cmd->add_option("--address", cone.address, "Address mode of the map: wrap (default), clamp or mirror");
+  cone_cmd->add_option("--max-memory", cone.max_memory_mib,
+                       "Refuse a bake whose estimated memory exceeds this many MiB (default: half the RAM)");
 
   qdmr::cli::CheckArgs check;
   CLI::App* check_cmd = app.add_subcommand(

@@ -1,10 +1,16 @@
 #pragma once
 // Files are written next to their target under a temporary name and renamed over it only when complete, so a
 // failed write never leaves a partial file behind and never damages an existing one.
+//
+// Temporaries are named ".NAME.tmpPID-N.EXT" (NAME the target's file name, PID the writing process, N a counter
+// of the process, EXT the target's extension) and the writer holds an exclusive flock(2) on the temporary until
+// it is renamed or removed. A process killed while writing (SIGKILL, power loss aside) leaves its temporary
+// behind; the next write to the same target removes every temporary of that target whose process is not
+// running and whose lock is free (the kernel drops the lock of a dead process). A temporary of a live process,
+// or one still locked (a writer in another PID namespace sharing the folder), is left alone.
 #include <filesystem>
 #include <functional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
@@ -36,7 +42,11 @@ public:
 private:
   friend void write_atomically(const std::filesystem::path&, const std::string&,
                                const std::function<std::string(const std::filesystem::path&)>&);
-  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> pending_;  // temporary, target
+  struct Pending {
+    std::filesystem::path temporary, target;
+    int lock;  // the temporary's locked file descriptor, closed after the rename or removal
+  };
+  std::vector<Pending> pending_;
   OutputBatch* previous_;
 };
 

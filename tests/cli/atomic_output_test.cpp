@@ -1,5 +1,6 @@
 // Outputs are written atomically (a temporary in the same folder, then rename): a render killed with SIGKILL
-// while it writes leaves the previous file intact, byte for byte.
+// while it writes leaves the previous file intact, byte for byte; the next render to the same files removes the
+// temporaries it left.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -68,12 +69,11 @@ TEST(CliAtomicOutput, SigkillWhileWritingKeepsThePreviousFile) {
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
   EXPECT_EQ(read_file(image), previous);
   EXPECT_EQ(read_file(depth), previous);
-  // The killed process leaves its hidden temporary behind (nothing can remove it); the targets are untouched.
+  // The killed process leaves its hidden temporary behind (nothing in it can remove it); the targets are untouched.
   EXPECT_FALSE(temporaries_of(image).empty());
 
-  // Finished normally, the same command replaces both files with complete images and leaves no temporary of its own.
-  for (const fs::path& t : temporaries_of(image)) fs::remove(t);
-  for (const fs::path& t : temporaries_of(depth)) fs::remove(t);
+  // Finished normally, the same command replaces both files with complete images, removes the temporaries the
+  // killed one left (its process is gone, its lock released) and leaves none of its own.
   const CommandResult done = run(cli(), {"render", (dir / "scene.json").string(), "-o", image.string(), "--aov",
                                          "depth=" + depth.string()});
   ASSERT_EQ(done.exit_code, 0) << done.output;

@@ -64,6 +64,12 @@ const char* cone_kind_name(ConeKind kind);  // "conservative", "relaxed"
 // thread count. Throws qdmr::Error on empty fields and heights outside [0,1].
 ConeMap bake_cone_map(const HeightField& field, ConeKind kind);
 
+// The most memory bake_cone_map allocates at once for a width x height field (its working grid of doubles, per
+// texel one value per channel: 1 conservative, 4 relaxed; mirror unfolded to 2W x 2H; the max hierarchy; the
+// map), in bytes, not counting the field it is given. For memory limits checked before anything is read
+// (`qdmr bake cone --max-memory`).
+std::uint64_t cone_bake_bytes(int width, int height, ConeKind kind, AddressMode address);
+
 // The brute-force baker (every texel against every texel or wall), for tests on small maps.
 ConeMap bake_cone_map_brute_force(const HeightField& field, ConeKind kind);
 
