@@ -12,7 +12,7 @@ constexpr AovInfo kAovs[kAovCount] = {
     {Aov::Depth, "depth", 1},          {Aov::Normal, "normal", 3},        {Aov::UV, "uv", 2},
     {Aov::Iterations, "iterations", 1}, {Aov::HitUV, "hit_uv", 2},         {Aov::HitDepth, "hit_depth", 1},
     {Aov::ErrorTexels, "error_texels", 1}, {Aov::Missed, "missed", 1},    {Aov::Shadow, "shadow", 1},
-    {Aov::Ao, "ao", 1}};
+    {Aov::Ao, "ao", 1},                {Aov::CacheMisses, "cache_misses", 1}};
 
 }  // namespace
 

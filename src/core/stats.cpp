@@ -25,6 +25,25 @@ nlohmann::json RenderStats::to_json() const {
   if (reference)
     j["reference"] = {{"pixels", reference_pixels}, {"error_texels_mean", error_texels_mean},
                       {"error_texels_max", error_texels_max}, {"missed_fraction", missed_fraction}};
+  if (texture_cache.enabled) {
+    const TextureCacheStats& c = texture_cache;
+    j["texture_cache"] = {{"layout", c.layout},
+                          {"quadtree", c.quadtree},
+                          {"replacement", c.replacement},
+                          {"size_bytes", c.size_bytes},
+                          {"line_bytes", c.line_bytes},
+                          {"ways", c.ways},
+                          {"region", c.region},
+                          {"warp", c.warp},
+                          {"accesses", c.accesses},
+                          {"hits", c.hits},
+                          {"misses", c.misses},
+                          {"miss_ratio", c.miss_ratio},
+                          {"accesses_per_pixel", c.accesses_per_pixel},
+                          {"misses_per_pixel", c.misses_per_pixel},
+                          {"bytes_per_pixel", c.bytes_per_pixel},
+                          {"footprint_bytes", c.footprint_bytes}};
+  }
   j["threads"] = threads;
   j["isa"] = simd_arch;
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes},

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/trigonometric.hpp>
@@ -10,6 +11,7 @@
 
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
+#include "qdmr/texture/cache_model.hpp"
 
 namespace qdmr {
 namespace {
@@ -76,6 +78,57 @@ void summarise_counters(const TileCounters& total, RenderStats& stats) {
   }
   stats.lane_utilisation =
       total.iterations_executed > 0 ? double(total.iterations_useful) / double(total.iterations_executed) : 1.0;
+}
+
+// Every texture the frame's programs read, at its address under the cache's layout, registered in plan order.
+TextureAddressMap cache_address_map(const FramePlan& plan, const Assets& assets) {
+  const TextureCacheDesc& cache = plan.scene.texture_cache;
+  TextureAddressMap map(cache.layout, cache.quadtree);
+  const auto texture = [&](int i, bool quadtree) {
+    if (i < 0) return;
+    const bool bc3 = plan.textures[std::size_t(i)].desc.compression == Compression::Bc3;
+    map.add(*assets.textures[std::size_t(i)], quadtree, bc3);
+  };
+  const auto derived = [&](int i, bool quadtree) {
+    if (i >= 0 && assets.derived[std::size_t(i)].texture) map.add(*assets.derived[std::size_t(i)].texture, quadtree, false);
+  };
+  for (const MaterialPlan& m : plan.materials) {
+    for (const LayerPlan& l : m.layers) {
+      texture(l.albedo, false);
+      texture(l.normal, false);
+      texture(l.height, false);
+      texture(l.height_max, true);
+      derived(l.ao, false);
+    }
+    derived(m.weights, false);
+    derived(m.combined_quadtree, true);
+    derived(m.blend_ao, false);
+    derived(m.bilinear_bound, true);
+  }
+  return map;
+}
+
+void summarise_cache(const TextureCacheDesc& desc, const TextureAddressMap& map, const TileCounters& total,
+                     RenderStats& stats) {
+  TextureCacheStats& c = stats.texture_cache;
+  c.enabled = true;
+  c.layout = texel_layout_name(desc.layout);
+  c.quadtree = quadtree_storage_name(desc.quadtree);
+  c.replacement = cache_replacement_name(desc.replacement);
+  c.size_bytes = desc.size_bytes;
+  c.line_bytes = desc.line_bytes;
+  c.ways = desc.ways;
+  c.region = desc.region;
+  c.warp = desc.warp;
+  c.accesses = total.cache_accesses;
+  c.hits = total.cache_hits;
+  c.misses = total.cache_accesses - total.cache_hits;
+  c.miss_ratio = c.accesses > 0 ? double(c.misses) / double(c.accesses) : 0.0;
+  const double pixels = double(std::max<std::uint64_t>(total.pixels_shaded, 1));
+  c.accesses_per_pixel = double(c.accesses) / pixels;
+  c.misses_per_pixel = double(c.misses) / pixels;
+  c.bytes_per_pixel = double(c.misses) * double(desc.line_bytes) / pixels;
+  c.footprint_bytes = map.footprint_bytes();
 }
 
 }  // namespace
@@ -163,6 +216,12 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   context.setups = &setups;
   context.framebuffer = &fb;
   for (const auto& program : programs) context.programs.push_back(program.get());
+  std::optional<TextureAddressMap> cache_addresses;
+  if (scene.texture_cache.enabled) {
+    cache_addresses.emplace(cache_address_map(plan, assets));
+    context.cache = &scene.texture_cache;
+    context.cache_addresses = &*cache_addresses;
+  }
   std::vector<TileCounters> tile_counters(std::size_t(grid.count()));
   std::atomic<int> tiles_done{0};
   std::mutex progress_mutex;
@@ -181,6 +240,8 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   for (const TileCounters& c : tile_counters) total += c;  // in tile order
   stats.raster_shade_ms = ms_since(start);
   summarise_counters(total, stats);
+  stats.texture_cache = TextureCacheStats{};
+  if (cache_addresses) summarise_cache(scene.texture_cache, *cache_addresses, total, stats);
   stats.reference = false;
   stats.reference_pixels = 0;
   stats.error_texels_mean = stats.error_texels_max = stats.missed_fraction = 0;

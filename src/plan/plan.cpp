@@ -485,6 +485,9 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
   plan.width = scene.output.width;
   plan.height = scene.output.height;
   plan.aovs = options.aovs;
+  // The cache_misses AOV is the emulated cache's output: asking for it turns the cache on (default settings).
+  if (std::find(plan.aovs.begin(), plan.aovs.end(), Aov::CacheMisses) != plan.aovs.end())
+    plan.scene.texture_cache.enabled = true;
   const std::string file = scene.file.string();
   Planner planner(scene, plan);
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
@@ -597,6 +600,11 @@ std::string FramePlan::describe() const {
   if (aovs.empty()) s << " none";
   for (Aov a : aovs) s << " " << aov_name(a);
   s << "\n";
+  if (const TextureCacheDesc& c = scene.texture_cache; c.enabled)
+    s << "texture cache (emulated): " << c.size_bytes << " bytes, " << c.line_bytes << "-byte lines, " << c.ways
+      << "-way " << cache_replacement_name(c.replacement) << "; " << texel_layout_name(c.layout) << " texels, quadtrees as "
+      << quadtree_storage_name(c.quadtree) << "; " << c.warp << "-pixel warps, cold in each " << c.region << "x"
+      << c.region << " region\n";
   s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
     << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
     << ", total " << mib(total_bytes()) << "\n";
@@ -642,6 +650,10 @@ nlohmann::json FramePlan::to_json() const {
   j["items"] = items();
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
+  if (const TextureCacheDesc& c = scene.texture_cache; c.enabled)
+    j["texture_cache"] = {{"size_bytes", c.size_bytes}, {"line_bytes", c.line_bytes}, {"ways", c.ways},
+                          {"replacement", cache_replacement_name(c.replacement)}, {"layout", texel_layout_name(c.layout)},
+                          {"quadtree", quadtree_storage_name(c.quadtree)}, {"region", c.region}, {"warp", c.warp}};
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
                  {"derived_bytes", derived_bytes}, {"total_bytes", total_bytes()}};
   return j;

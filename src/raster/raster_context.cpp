@@ -14,6 +14,8 @@ TileCounters& TileCounters::operator+=(const TileCounters& o) {
   for (std::size_t i = 0; i < iteration_histogram.size(); ++i) iteration_histogram[i] += o.iteration_histogram[i];
   iterations_useful += o.iterations_useful;
   iterations_executed += o.iterations_executed;
+  cache_accesses += o.cache_accesses;
+  cache_hits += o.cache_hits;
   return *this;
 }
 

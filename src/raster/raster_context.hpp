@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "program/program.hpp"
+#include "qdmr/core/texture_cache.hpp"
+#include "qdmr/texture/cache_model.hpp"
 #include "raster/binner.hpp"
 #include "raster/framebuffer.hpp"
 #include "raster/geometry.hpp"
@@ -26,6 +28,8 @@ struct TileCounters {
   static constexpr int kIterationBins = 1024;
   std::array<std::uint64_t, kIterationBins + 1> iteration_histogram{};
   std::uint64_t iterations_useful = 0, iterations_executed = 0;
+  // The emulated texture cache (when on): texel reads replayed through it, and how many hit.
+  std::uint64_t cache_accesses = 0, cache_hits = 0;
 
   TileCounters& operator+=(const TileCounters& o);
 };
@@ -35,6 +39,9 @@ struct RasterContext {
   const TriangleSetups* setups = nullptr;
   std::vector<const Program*> programs;  // indexed by TriangleSetup::material; made by the kernel that rasterizes
   Framebuffer* framebuffer = nullptr;
+  // The emulated texture cache, or null (off): its settings and the address of every texture the programs read.
+  const TextureCacheDesc* cache = nullptr;
+  const TextureAddressMap* cache_addresses = nullptr;
 };
 
 }  // namespace qdmr

@@ -5,6 +5,7 @@
 
 #include "program/batch.hpp"
 #include "qdmr/core/limits.hpp"
+#include "texture/fetch_recorder.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
@@ -53,8 +54,8 @@ int classify_block(const TriangleSetup& s, int bx, int by) {
 
 class TileRasterizer {
 public:
-  TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters)
-      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters) {}
+  TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters, FetchRecorder* recorder)
+      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters), recorder_(recorder) {}
 
   void triangle(const TriangleSetup& s) {
     ++counters_.bin_entries;
@@ -136,7 +137,22 @@ private:
     in.covered = simd::from_bits(pass);
 
     ShadeOutput out;
-    program_->shade(in, out);
+    if (recorder_ != nullptr) {
+      // The texture cache sees the quads a GPU would run: every lane of a quad with a pixel to write.
+      std::uint32_t issuing = 0;
+      for (int q = 0; q < simd::kQuadsPerBatch; ++q)
+        if ((pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
+      int lane_x[kLanes], lane_y[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
+        lane_x[l] = x + lane_dx(l);
+        lane_y[l] = y + lane_dy(l);
+      }
+      recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
+      program_->shade(in, out);
+      recorder_->end_batch();
+    } else {
+      program_->shade(in, out);
+    }
     if (out.writes_depth) {
       const std::uint32_t late = pass & simd::to_bits(out.depth < Float::load_aligned(stored_depth));
       counters_.pixels_depth_failed += std::popcount(pass) - std::popcount(late);
@@ -169,10 +185,11 @@ private:
         {&out.error_texels},
         {&out.missed},
         {&out.shadow},
-        {&out.ao}};
+        {&out.ao},
+        {}};  // cache_misses: added by the texture cache's replay after the tile
     for (int a = 0; a < kAovCount; ++a) {
       PixelBuffer& plane = fb_.aov[std::size_t(a)];
-      if (plane.empty()) continue;
+      if (plane.empty() || sources[a][0] == nullptr) continue;
       const int channels = aov_channels(Aov(a));
       alignas(64) float values[3][kLanes];
       for (int c = 0; c < channels; ++c) sources[a][c]->store_aligned(values[c]);
@@ -206,6 +223,7 @@ private:
   EdgeSteps steps_{};
   const ShadingProgram* program_ = nullptr;
   const ScreenVertex* vertex_[3] = {};
+  FetchRecorder* recorder_;
 };
 
 }  // namespace
@@ -213,9 +231,26 @@ private:
 
 void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters) {
-  context.framebuffer->clear_rect(tile.x0, tile.y0, tile.x1, tile.y1);
-  TileRasterizer rasterizer(context, tile, counters);
-  bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+  Framebuffer& fb = *context.framebuffer;
+  fb.clear_rect(tile.x0, tile.y0, tile.x1, tile.y1);
+  if (context.cache == nullptr) {
+    TileRasterizer rasterizer(context, tile, counters, nullptr);
+    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+    return;
+  }
+  // With the texture cache: record the tile's fetches, then replay them through the cache.
+  FetchRecorder recorder(*context.cache, *context.cache_addresses, tile.x0, tile.y0, tile.x1, tile.y1);
+  {
+    const FetchRecorder::Listening listening(recorder);
+    TileRasterizer rasterizer(context, tile, counters, &recorder);
+    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+  }
+  TextureCache cache(*context.cache);
+  CacheCounters cache_counters;
+  PixelBuffer& misses = fb.aov[std::size_t(Aov::CacheMisses)];
+  recorder.replay(cache, cache_counters, fb.width, fb.height, fb.depth.data(), misses.empty() ? nullptr : misses.data());
+  counters.cache_accesses += cache_counters.accesses;
+  counters.cache_hits += cache_counters.hits;
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -94,6 +94,11 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   auto start = Clock::now();
   FramePlan plan = plan_frame(scene, PlanOptions{aovs});
   s.pending_plan_ms = ms_since(start);
+  if (const TextureCacheDesc& cache = plan.scene.texture_cache; cache.enabled && s.options.tile_size % cache.region != 0)
+    throw Error(scene.file.string() + ": /texture_cache/region",
+                "the texture cache replays regions of " + std::to_string(cache.region) +
+                    " pixels inside each tile: the tile size (--tile " + std::to_string(s.options.tile_size) +
+                    ") must be a multiple of it");
   const std::uint64_t needed = plan.total_bytes(), limit = s.options.max_memory_bytes;
   if (limit > 0 && needed > limit)
     throw Error(scene.file.string(), "the job needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +

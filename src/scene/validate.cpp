@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qdmr/core/limits.hpp"
+#include "qdmr/core/texture_cache.hpp"
 
 namespace qdmr::scene_detail {
 
@@ -96,6 +97,34 @@ CameraDesc read_camera(const Value& value) {
   up.require(glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) > 1e-4f,
              "the up vector must not be parallel to the view direction (target - position)");
   return camera;
+}
+
+// The emulated texture cache: present means on, unless "enabled": false.
+TextureCacheDesc read_texture_cache(const Value& value) {
+  const Object object(value, {"enabled", "size_bytes", "line_bytes", "ways", "replacement", "layout", "quadtree",
+                              "region", "warp"});
+  TextureCacheDesc d;
+  d.enabled = true;
+  if (auto v = object.find("enabled")) d.enabled = v->boolean();
+  if (auto v = object.find("size_bytes")) d.size_bytes = static_cast<int>(v->integer(4, 64 << 20));
+  if (auto v = object.find("line_bytes")) d.line_bytes = static_cast<int>(v->integer(4, 4096));
+  if (auto v = object.find("ways")) d.ways = static_cast<int>(v->integer(1, 1024));
+  if (auto v = object.find("replacement"))
+    d.replacement = v->choice<CacheReplacement>({{"lru", CacheReplacement::Lru}, {"fifo", CacheReplacement::Fifo}});
+  if (auto v = object.find("layout"))
+    d.layout = v->choice<TexelLayout>({{"linear", TexelLayout::Linear},
+                                       {"tiled4", TexelLayout::Tiled4},
+                                       {"tiled8", TexelLayout::Tiled8},
+                                       {"morton", TexelLayout::Morton}});
+  if (auto v = object.find("quadtree"))
+    d.quadtree = v->choice<QuadtreeStorage>({{"mip_chain", QuadtreeStorage::MipChain}, {"volume", QuadtreeStorage::Volume}});
+  if (auto v = object.find("region")) d.region = static_cast<int>(v->integer(8, 1024));
+  if (auto v = object.find("warp")) d.warp = static_cast<int>(v->integer(4, 1024));
+  if (const auto problem = check_texture_cache(d)) {
+    const auto field = object.find(problem->field);
+    (field ? *field : value).fail(problem->what);
+  }
+  return d;
 }
 
 LightsDesc read_lights(const Value& value) {
@@ -624,7 +653,7 @@ void read_mtl_override(const Value& value, MaterialDesc& material, const std::fi
 
 SceneDesc validate_scene(const json& document, const Context& context) {
   const Value root(context, document, "");
-  const Object object(root, {"output", "camera", "lights", "materials", "objects"});
+  const Object object(root, {"output", "camera", "lights", "materials", "objects", "texture_cache"});
   SceneDesc scene;
   scene.file = context.file;
   if (auto v = object.find("output")) scene.output = read_output(*v);
@@ -636,6 +665,7 @@ SceneDesc validate_scene(const json& document, const Context& context) {
     scene.lights.directional.back().direction = glm::normalize(scene.lights.directional.back().direction);
   }
   if (auto v = object.find("materials")) scene.materials = read_materials(*v);
+  if (auto v = object.find("texture_cache")) scene.texture_cache = read_texture_cache(*v);
   const std::vector<Value> objects = object.required("objects").array();
   for (std::size_t i = 0; i < objects.size(); ++i) scene.objects.push_back(read_object(objects[i], i, scene.materials));
   return scene;

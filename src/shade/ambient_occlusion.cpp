@@ -4,6 +4,7 @@
 #include "bake/ao_pattern.hpp"
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
+#include "texture/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -15,6 +16,8 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
   using simd::Int;
   const Float one(1.0f), zero(0.0f);
   if (!xsimd::any(active)) return one;
+  FetchLanes lanes(FetchPhase::Occlusion);
+  lanes.narrow(active);
   const ao::Taps taps = ao::make_taps(desc, surface.width(), surface.height());
   const int n = ao::direction_count(desc);
   const Float u0 = xsimd::select(active, u, zero), v0 = xsimd::select(active, v, zero);

@@ -114,7 +114,7 @@ Float BlendedSurface::combine(const Float* h, const Float* w) const {
 
 Float BlendedSurface::height(const Float& u, const Float& v, const Float& lod) const {
   Float h[kMaxLayers], w[kMaxLayers];
-  for (int i = 0; i < count_; ++i) h[i] = present(i) ? layers_[i].height(u, v, lod) : Float(0.0f);
+  for (int i = 0; i < count_; ++i) h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.height(u, v, lod); }) : Float(0.0f);
   weights_at(u, v, w);
   return combine(h, w);
 }
@@ -135,6 +135,8 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
   const simd::IntMask coarse = level >= Int(1);
   Float result(0.0f);
   if (xsimd::any(coarse)) {
+    FetchLanes lanes;  // the batch reads the tree for every lane; only the coarse ones need it
+    lanes.narrow(simd::float_mask(coarse));
     const Int period = Int(texture_.period) >> level;
     Float texel[4];
     load(*texture_.combined, xsimd::max(level - Int(1), Int(0)), wrap_cell(cx, period), wrap_cell(cy, period),
@@ -142,9 +144,12 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
     result = texel[0];
   }
   if (!xsimd::all(coarse)) {
+    FetchLanes lanes;
+    lanes.narrow(!simd::float_mask(coarse));
     // Level 0: the exact box value, as the combined tree was built from.
     Float h[kMaxLayers], w[kMaxLayers];
-    for (int i = 0; i < count_; ++i) h[i] = present(i) ? layers_[i].cell_max(Int(0), cx, cy) : Float(0.0f);
+    for (int i = 0; i < count_; ++i)
+      h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);
     weights_at((xsimd::to_float(cx) + Float(0.5f)) / Float(float(width())),
                (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height())), w);
     result = xsimd::select(simd::float_mask(coarse), result, combine(h, w));
@@ -155,7 +160,8 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
 Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) const {
   if (texture_.combined) return combined_cell_max(level, cx, cy);
   Float hmax[kMaxLayers];
-  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].cell_max(level, cx, cy) : Float(0.0f);
+  for (int i = 0; i < count_; ++i)
+    hmax[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(level, cx, cy); }) : Float(0.0f);
   if (!texture_.view) return bound(hmax, weights_);
   // Per pixel: the weights' maxima over the cell (from the weight texture's max chain), within those over the
   // batch's query box — "QDM1 * QDM2", each cell bounded by its own maxima.
@@ -170,6 +176,8 @@ Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) c
   Float result = bound(hmax, wmax);
   const simd::IntMask texel = level == Int(0);
   if (xsimd::any(texel)) {
+    FetchLanes lanes;
+    lanes.narrow(simd::float_mask(texel));
     // Level 0: the box value with the weights at the texel centre (unwrapped: the weight map does not repeat
     // with the layers).
     Float w[kMaxLayers];
@@ -182,13 +190,14 @@ Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) c
 
 Float BlendedSurface::max_height() const {
   Float hmax[kMaxLayers];
-  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].max_height() : Float(0.0f);
+  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layer_fetch(i, [](const auto& l) { return l.max_height(); }) : Float(0.0f);
   return bound(hmax, weights_);
 }
 
 Float BlendedSurface::cell_max_filtered(const Float& u, const Float& v, const Float& level) const {
   Float hmax[kMaxLayers];
-  for (int i = 0; i < count_; ++i) hmax[i] = present(i) ? layers_[i].cell_max_filtered(u, v, level) : Float(0.0f);
+  for (int i = 0; i < count_; ++i)
+    hmax[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max_filtered(u, v, level); }) : Float(0.0f);
   return bound(hmax, weights_);
 }
 

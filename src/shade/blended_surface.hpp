@@ -9,6 +9,7 @@
 // max(hmax_i * wmax_i) — "QDM1 * QDM2 = conservative QDM" — with wmax_i the largest weight over the UV box the
 // queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
 #include "shade/height_surface.hpp"
+#include "texture/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -67,6 +68,14 @@ private:
   void find_present();
   simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
   bool present(int i) const { return (present_ >> i) & 1u; }
+  // fetch(layer i), recorded for the texture cache only in the lanes where layer i has weight: on its own, the
+  // batch reads a layer for every lane as soon as one lane needs it.
+  template <class Fetch>
+  simd::Float layer_fetch(int i, const Fetch& fetch) const {
+    FetchLanes lanes;
+    lanes.narrow(weights_[i] > simd::Float(0.0f));
+    return fetch(layers_[i]);
+  }
 
   const SingleLayerSurface* layers_;
   int count_;

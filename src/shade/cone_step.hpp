@@ -48,58 +48,63 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
   Int cx = texel_ahead(x0, dx), cy = texel_ahead(y0, dy);
   Float s(0.0f), s_prev(0.0f);
   Mask search = zero != zero;  // rcsm: the last step entered the surface
-  CappedLoop loop{Int(technique.max_iterations)};
-  while (loop.next(active)) {
+  Float iterations;
+  {  // the loop's fetch lanes end with it (the search below starts from all of them)
+    CappedLoop loop(Int(technique.max_iterations), FetchPhase::Trace);
+    while (loop.next(active)) {
 
-    Float hp, r;
-    texels.at(cx, cy, hp, r);
-    const Float top = ds * (Float(1.0f) - hp);
-    // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
-    // the surface), or a relaxed step that went in.
-    const Mask below = active & (s >= top);
-    if constexpr (relaxed) search = search | (below & (s_prev < s));
-    active = active & !below;
+      Float hp, r;
+      texels.at(cx, cy, hp, r);
+      const Float top = ds * (Float(1.0f) - hp);
+      // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
+      // the surface), or a relaxed step that went in.
+      const Mask below = active & (s >= top);
+      if constexpr (relaxed) search = search | (below & (s_prev < s));
+      active = active & !below;
 
-    // The walls of p ahead, each crossing computed from the integer wall as in QDM.
-    const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx));
-    const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy));
-    const Float sx = xsimd::select(dx != zero, xsimd::max((wall_x - x0) / dx, s), inf);
-    const Float sy = xsimd::select(dy != zero, xsimd::max((wall_y - y0) / dy, s), inf);
-    const Mask x_first = sx <= sy;
-    const Float alpha = xsimd::select(x_first, ax, ay), beta = xsimd::select(x_first, ay, ax);
-    const Mask to_top = active & (top <= xsimd::min(sx, sy));
-    // Finite stand-ins (a wall never crossed lies beyond the top): lanes going to the top ignore the rest.
-    const Float sa = xsimd::min(xsimd::min(sx, sy), top), sb = xsimd::min(xsimd::max(sx, sy), top);
-    // Outside the first wall only: alpha (s - sa) = r (top - s).
-    const Float exit1 =
-        xsimd::max((alpha * sa + r * top) / xsimd::max(alpha + r, Float(1e-30f)), sa);
-    // Outside both: with tau = s - sb, delta = sb - sa, T = top - sb,
-    //   alpha^2 (tau + delta)^2 + beta^2 tau^2 = r^2 (T - tau)^2,
-    // a2 tau^2 + 2 b1 tau + c0 = 0 with c0 <= 0 (the ray is in S_p at sb): the root in [0, T] in the stable form.
-    const Float delta = sb - sa, T = top - sb;
-    const Float a2 = alpha * alpha + beta * beta - r * r;
-    const Float b1 = alpha * alpha * delta + r * r * T;
-    const Float c0 = (alpha * delta - r * T) * (alpha * delta + r * T);
-    const Float disc = xsimd::max(b1 * b1 - a2 * c0, zero);
-    const Float tau = xsimd::min(xsimd::max((zero - c0) / xsimd::max(b1 + xsimd::sqrt(disc), Float(1e-30f)), zero), T);
-    const Float next = xsimd::select(to_top, top, xsimd::min(xsimd::select(exit1 <= sb, exit1, sb + tau), top));
-    active = active & !to_top;  // on p's top while over p: the hit
+      // The walls of p ahead, each crossing computed from the integer wall as in QDM.
+      const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx));
+      const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy));
+      const Float sx = xsimd::select(dx != zero, xsimd::max((wall_x - x0) / dx, s), inf);
+      const Float sy = xsimd::select(dy != zero, xsimd::max((wall_y - y0) / dy, s), inf);
+      const Mask x_first = sx <= sy;
+      const Float alpha = xsimd::select(x_first, ax, ay), beta = xsimd::select(x_first, ay, ax);
+      const Mask to_top = active & (top <= xsimd::min(sx, sy));
+      // Finite stand-ins (a wall never crossed lies beyond the top): lanes going to the top ignore the rest.
+      const Float sa = xsimd::min(xsimd::min(sx, sy), top), sb = xsimd::min(xsimd::max(sx, sy), top);
+      // Outside the first wall only: alpha (s - sa) = r (top - s).
+      const Float exit1 =
+          xsimd::max((alpha * sa + r * top) / xsimd::max(alpha + r, Float(1e-30f)), sa);
+      // Outside both: with tau = s - sb, delta = sb - sa, T = top - sb,
+      //   alpha^2 (tau + delta)^2 + beta^2 tau^2 = r^2 (T - tau)^2,
+      // a2 tau^2 + 2 b1 tau + c0 = 0 with c0 <= 0 (the ray is in S_p at sb): the root in [0, T] in the stable form.
+      const Float delta = sb - sa, T = top - sb;
+      const Float a2 = alpha * alpha + beta * beta - r * r;
+      const Float b1 = alpha * alpha * delta + r * r * T;
+      const Float c0 = (alpha * delta - r * T) * (alpha * delta + r * T);
+      const Float disc = xsimd::max(b1 * b1 - a2 * c0, zero);
+      const Float tau = xsimd::min(xsimd::max((zero - c0) / xsimd::max(b1 + xsimd::sqrt(disc), Float(1e-30f)), zero), T);
+      const Float next = xsimd::select(to_top, top, xsimd::min(xsimd::select(exit1 <= sb, exit1, sb + tau), top));
+      active = active & !to_top;  // on p's top while over p: the hit
 
-    // The texel at the step's end: the one ahead of the position, at least one past each wall crossed.
-    const Mask stepping = active;
-    const Int ahead_x = texel_ahead(x0 + dx * next, dx), ahead_y = texel_ahead(y0 + dy * next, dy);
-    const Int moved_x = xsimd::select(step_x_pos, xsimd::max(ahead_x, cx + step_x), xsimd::min(ahead_x, cx + step_x));
-    const Int moved_y = xsimd::select(step_y_pos, xsimd::max(ahead_y, cy + step_y), xsimd::min(ahead_y, cy + step_y));
-    cx = xsimd::select(int_mask(stepping & (next >= sx)), moved_x, cx);
-    cy = xsimd::select(int_mask(stepping & (next >= sy)), moved_y, cy);
-    s_prev = xsimd::select(stepping, s, s_prev);
-    s = xsimd::select(stepping | to_top, next, s);
+      // The texel at the step's end: the one ahead of the position, at least one past each wall crossed.
+      const Mask stepping = active;
+      const Int ahead_x = texel_ahead(x0 + dx * next, dx), ahead_y = texel_ahead(y0 + dy * next, dy);
+      const Int moved_x = xsimd::select(step_x_pos, xsimd::max(ahead_x, cx + step_x), xsimd::min(ahead_x, cx + step_x));
+      const Int moved_y = xsimd::select(step_y_pos, xsimd::max(ahead_y, cy + step_y), xsimd::min(ahead_y, cy + step_y));
+      cx = xsimd::select(int_mask(stepping & (next >= sx)), moved_x, cx);
+      cy = xsimd::select(int_mask(stepping & (next >= sy)), moved_y, cy);
+      s_prev = xsimd::select(stepping, s, s_prev);
+      s = xsimd::select(stepping | to_top, next, s);
+    }
+    iterations = loop.iterations();
   }
-  Float iterations = loop.iterations();
   if constexpr (relaxed) {
     // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
     Float lo = s_prev, hi = s;
+    FetchLanes lanes(FetchPhase::Refine);
     for (int i = 0; i < technique.binary_steps && xsimd::any(search); ++i) {
+      lanes.narrow(search);
       const Float mid = (lo + hi) * Float(0.5f);
       Float h, unused;
       texels.at(texel_ahead(x0 + dx * mid, zero), texel_ahead(y0 + dy * mid, zero), h, unused);

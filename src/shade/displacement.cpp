@@ -17,6 +17,7 @@
 #include "shade/refine.hpp"
 #include "shade/relief.hpp"
 #include "shade/traversal.hpp"
+#include "texture/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
@@ -267,6 +268,7 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     return a[0];
   };
   Float albedo[4], tangent_normal[3], specular(0.0f), ao(1.0f);
+  FetchLanes surface_lanes(FetchPhase::Surface);
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
     const Layer& l = layers_[0];
     layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, albedo, tangent_normal);
@@ -292,6 +294,8 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     }
     for (int i = 0; i < count; ++i) {
       if (!xsimd::any(f[i] > Float(0.0f))) continue;  // a layer absent from the whole batch costs no fetch
+      FetchLanes layer_lanes(FetchPhase::Surface);     // and within a batch, only its lanes fetch it
+      layer_lanes.narrow(f[i] > Float(0.0f));
       const Layer& l = layers_[std::size_t(i)];
       Float a[4], n[3];
       layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, a, n);

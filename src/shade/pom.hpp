@@ -17,6 +17,8 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
                                Float(0.5f));
   const Float step = ds / n;
   Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
+  FetchLanes lanes(FetchPhase::Trace);
+  lanes.narrow(active);
   // gap = surface depth - ray depth: > 0 while the ray is above the surface.
   {
     const Float gap0 = ds * (Float(1.0f) - surface.height(ray.u0, ray.v0, lod));
@@ -29,6 +31,7 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
   for (int i = 1; i <= technique.max_steps && xsimd::any(active); ++i) {
     const Float fi = Float(static_cast<float>(i));
     const Mask in_range = active & (fi <= n);
+    lanes.narrow(in_range);
     const Float s = step * fi;
     const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
     iterations += count(in_range);

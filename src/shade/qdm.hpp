@@ -27,7 +27,7 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
   Int cx = xsimd::to_int(xsimd::floor(x0)) >> top, cy = xsimd::to_int(xsimd::floor(y0)) >> top;
   Float s(0.0f);
   const Int stop = xsimd::to_int(stop_level);
-  CappedLoop loop{cap};
+  CappedLoop loop(cap, FetchPhase::Trace);
   while (loop.next(active)) {
 
     // The cell's highest point (wrap addressing: power-of-two level sizes), or LinearMipMapLinear at the ray's

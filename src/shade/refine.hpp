@@ -17,6 +17,8 @@ Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Floa
                                   Float& iterations, Mask active,
              const TechniqueDesc& technique, const HeightField* patches) {
   if (technique.refinement == QdmRefinement::None) return s_hit;
+  FetchLanes lanes(FetchPhase::Refine);
+  lanes.narrow(active);
   const Float lod0(0.0f);
   const Float step = texel_step(ray, float(surface.width()), float(surface.height()));
   Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
@@ -35,6 +37,7 @@ Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Floa
   Mask searching = active & (gap_lo > Float(0.0f));
   hi = xsimd::select(gap_lo > Float(0.0f), hi, lo);
   for (int i = 0; i < steps && xsimd::any(searching); ++i) {
+    lanes.narrow(searching);
     const Float mid = (lo + hi) * Float(0.5f);
     const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
     iterations += count(searching);

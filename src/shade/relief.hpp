@@ -13,18 +13,24 @@ Hit relief(const Surface& surface, const Ray& ray, const Float& ds,
   const int steps = technique.linear_steps;
   const Float step = ds / Float(float(steps));
   Float lo(0.0f), hi = ds, iterations(0.0f);
-  for (int i = 0; i <= steps && xsimd::any(active); ++i) {
-    const Float s = step * Float(float(i));
-    const Float h = surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
-    const Mask found = active & (s >= ds * (Float(1.0f) - h));
-    iterations += count(active);
-    hi = xsimd::select(found, s, hi);
-    lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
-    active = active & !found;
+  {  // the linear search's fetch lanes end with it (the search below starts from all of them)
+    FetchLanes lanes(FetchPhase::Trace);
+    for (int i = 0; i <= steps && xsimd::any(active); ++i) {
+      lanes.narrow(active);
+      const Float s = step * Float(float(i));
+      const Float h = surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod);
+      const Mask found = active & (s >= ds * (Float(1.0f) - h));
+      iterations += count(active);
+      hi = xsimd::select(found, s, hi);
+      lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
+      active = active & !found;
+    }
   }
   lo = xsimd::select(active, ds - step, lo);  // never below: the bottom (h >= 0 everywhere) is the hit
   Mask searching = lo < hi;
+  FetchLanes search_lanes(FetchPhase::Refine);
   for (int i = 0; i < technique.binary_steps && xsimd::any(searching); ++i) {
+    search_lanes.narrow(searching);
     const Float mid = (lo + hi) * Float(0.5f);
     const Float h = surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod);
     const Mask below = mid >= ds * (Float(1.0f) - h);

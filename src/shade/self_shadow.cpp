@@ -7,6 +7,7 @@
 #include "shade/blended_surface.hpp"
 #include "shade/height_surface.hpp"
 #include "shade/traversal.hpp"
+#include "texture/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
@@ -102,7 +103,7 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
 
   Mask active = p.active & !along_wall & !(p.s - c <= floor_depth);
   Mask occluded = zero != zero;
-  CappedLoop loop{Int(desc.max_iterations)};
+  CappedLoop loop(Int(desc.max_iterations), FetchPhase::Shadow);
   while (loop.next(active)) {
     const Float top_depth = p.ds * (Float(1.0f) - surface.cell_max(level, origin.x(level, cx), origin.y(level, cy)));
     // A rising ray is lowest where it enters the cell, at c.
@@ -177,6 +178,8 @@ ShadowResult horizon(const Surface& surface, const ShadowDesc& desc, const Prepa
   const Mask taken = p.active & (c_max > Float(0.0f));
   Profile profile(desc.profile);
   const int n = std::max(desc.samples, 1);
+  FetchLanes lanes(FetchPhase::Shadow);
+  lanes.narrow(taken);
   for (int k = 1; k <= n && xsimd::any(taken); ++k) {
     const Float c = c_max * Float(float(k) / float(n));
     const Float h = surface.height(p.u + p.du * c, p.v + p.dv * c, lod);
@@ -197,10 +200,12 @@ ShadowResult qdm_soft(const Surface& surface, const ShadowDesc& desc, const Prep
   const int taps = std::min(int(desc.tap_weights.size()), surface.top_level() + 1);
   const Float bound(kMaxTexelCoordinate);
   Profile profile(desc.profile);
+  FetchLanes lanes(FetchPhase::Shadow);
   for (int k = 0; k < taps; ++k) {
     const Float c = Float(float(1 << k)) / texels_per_climb;
     const Mask taken = p.active & (c <= c_max);
     if (!xsimd::any(taken)) break;  // c grows with k: no later tap is taken either
+    lanes.narrow(taken);
     const Float px = xsimd::min(xsimd::max(xsimd::select(taken, x0 + dx * c, zero), Float(0.0f) - bound), bound);
     const Float py = xsimd::min(xsimd::max(xsimd::select(taken, y0 + dy * c, zero), Float(0.0f) - bound), bound);
     const Int level(k);
@@ -221,6 +226,8 @@ ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const S
   if (desc.mode == ShadowMode::Off) return r;
   const Prepared p = prepare(ray, active);
   if (!xsimd::any(p.active)) return r;
+  FetchLanes lanes(FetchPhase::Shadow);
+  lanes.narrow(p.active);
   switch (desc.mode) {
     case ShadowMode::Off: break;
     case ShadowMode::Hard: r = hard(surface, desc, p); break;

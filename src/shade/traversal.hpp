@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/simd.hpp"
+#include "texture/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -13,20 +14,27 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 inline constexpr float kMaxTexelCoordinate = 4194304.0f;
 
 // The iteration budget of a capped SIMD loop, as a GPU wave runs it: a lane stops when it is done or when
-// its own count reaches the cap; the loop ends when no lane is left.
-struct CappedLoop {
-  simd::Int cap;
-  simd::Int done = simd::Int(0);
+// its own count reaches the cap; the loop ends when no lane is left. Only the running lanes fetch (`phase`: for
+// the texture-cache recorder).
+class CappedLoop {
+public:
+  CappedLoop(const simd::Int& cap, FetchPhase phase) : cap_(cap), lanes_(phase) {}
 
   // Drops the lanes that used up their budget and counts one more iteration for the others.
   bool next(simd::Mask& active) {
-    const simd::IntMask running = simd::int_mask(active) & (done < cap);
+    const simd::IntMask running = simd::int_mask(active) & (done_ < cap_);
     active = simd::float_mask(running);
     if (!xsimd::any(active)) return false;
-    done += xsimd::select(running, simd::Int(1), simd::Int(0));
+    done_ += xsimd::select(running, simd::Int(1), simd::Int(0));
+    lanes_.narrow(active);
     return true;
   }
-  simd::Float iterations() const { return xsimd::to_float(done); }
+  simd::Float iterations() const { return xsimd::to_float(done_); }
+
+private:
+  simd::Int cap_;
+  simd::Int done_ = simd::Int(0);
+  FetchLanes lanes_;
 };
 
 // Where the ray x(t) = origin + dir t crosses the line x = wall, per lane: (wall - origin) / dir in fp32 (two

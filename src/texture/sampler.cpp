@@ -7,6 +7,7 @@
 
 #include "core/det_math.hpp"
 #include "qdmr/core/error.hpp"
+#include "texture/fetch_trace.hpp"
 #include "texture/internal.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -94,6 +95,7 @@ LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) 
                                          FetchPath path, Float* out) {
   const Texture& t = view.texture();
   const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(t.format));
+  trace_fetch(t, level.offset, x, y);
   decode(t, simd::load_bytes4(t.storage.data(), offset, path), path, out);
 }
 

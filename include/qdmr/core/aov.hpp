@@ -15,8 +15,10 @@ namespace qdmr {
 // the polygon; 1 with shadow mode off or no directional light) and `ao`, the ambient occlusion term that
 // multiplies the ambient light (after ao.strength; 1 = open, also with ao mode off). Pixels nothing covers are
 // 0 in every AOV.
-enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed, Shadow, Ao };
-inline constexpr int kAovCount = 10;
+// `cache_misses`: texel reads of that pixel's lanes that missed the emulated texture cache (the scene's
+// texture_cache; docs/texture_cache.md), helper lanes of its quad included.
+enum class Aov { Depth, Normal, UV, Iterations, HitUV, HitDepth, ErrorTexels, Missed, Shadow, Ao, CacheMisses };
+inline constexpr int kAovCount = 11;
 
 std::optional<Aov> parse_aov(const std::string& name);
 std::string aov_name(Aov aov);

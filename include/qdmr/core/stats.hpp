@@ -27,6 +27,17 @@ struct MaterialStat {
   std::string variant;
 };
 
+// The emulated texture cache over the frame (scene key texture_cache): its settings, the texel reads replayed
+// through it and their outcome. Per pixel: divided by the pixels shaded (written).
+struct TextureCacheStats {
+  bool enabled = false;
+  std::string layout, quadtree, replacement;
+  int size_bytes = 0, line_bytes = 0, ways = 0, region = 0, warp = 0;
+  std::uint64_t accesses = 0, hits = 0, misses = 0;
+  double miss_ratio = 0, accesses_per_pixel = 0, misses_per_pixel = 0, bytes_per_pixel = 0;  // bytes: misses x line
+  std::uint64_t footprint_bytes = 0;  // the textures' memory in this layout (padding and 3D slices included)
+};
+
 struct RenderStats {
   // Milliseconds per stage; load and write are filled in by whoever loads and writes. prepare_ms is 0 for a
   // frame that re-used everything.
@@ -48,6 +59,7 @@ struct RenderStats {
   std::uint64_t items_built = 0, items_reused = 0;  // prepare: plan items built, and taken from the previous frame
   std::vector<TextureStat> textures;
   std::vector<MaterialStat> materials;
+  TextureCacheStats texture_cache;
 
   nlohmann::json to_json() const;
 };

@@ -13,6 +13,7 @@
 #include <glm/vec4.hpp>
 
 #include "qdmr/core/sampling.hpp"
+#include "qdmr/core/texture_cache.hpp"
 
 namespace qdmr {
 
@@ -290,6 +291,7 @@ struct SceneDesc {
   LightsDesc lights;
   std::vector<MaterialDesc> materials;  // sorted by name (JSON objects are unordered), then those of MTL files
   std::vector<ObjectDesc> objects;      // submission order
+  TextureCacheDesc texture_cache;       // the emulated texture cache (off unless asked for)
 
   const MaterialDesc* find_material(const std::string& name) const {
     for (const auto& m : materials)
