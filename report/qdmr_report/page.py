@@ -5,6 +5,7 @@ It opens from disk with no server and no network: no external script, style shee
 import html
 import json
 import os
+import statistics
 import sys
 
 from . import pictures, plots
@@ -56,7 +57,8 @@ for (const th of document.querySelectorAll('table.rows th')) {
 """
 
 KEPT = [(".png", "image"), (".reference.png", "exact reference"), (".error_texels.exr", "error_texels"),
-        (".iterations.exr", "iterations")]
+        (".iterations.exr", "iterations"), (".cache_misses.exr", "cache_misses")]
+HEATMAPS = {"error_texels": "magma", "iterations": "viridis", "cache_misses": "cividis"}
 
 
 def esc(v):
@@ -75,6 +77,7 @@ class Page:
         rows = study.rows
         self.error_max = max([study.number(r, "error_p99") or 0.0 for r in rows] + [1.0])
         self.iterations_max = max([study.number(r, "iterations_max") or 0.0 for r in rows] + [1.0])
+        self.cache_max = None  # from the kept cache_misses pictures (make_cards): no column holds a maximum
 
     def anchor(self, index):
         return f"#c{index}" if index in self.cards else f"#row{index}"
@@ -95,18 +98,27 @@ class Page:
                 if suffix.endswith(".png"):
                     name = f"{index}{suffix}"
                     pictures.copy_image(source, os.path.join(self.images, name))
-                elif what == "error_texels":
-                    name = f"{index}.error_texels.png"
-                    pictures.heatmap(pictures.read(source), self.error_max, "magma", os.path.join(self.images, name))
                 else:
-                    name = f"{index}.iterations.png"
-                    pictures.heatmap(pictures.read(source), self.iterations_max, "viridis",
+                    name = f"{index}.{what}.png"
+                    pictures.heatmap(pictures.read(source), self.heatmap_max(what), HEATMAPS[what],
                                      os.path.join(self.images, name))
                 made.append((name, what))
             if made:
                 self.cards[index] = made
         if terminal:
             print(file=sys.stderr)
+
+    def heatmap_max(self, what):
+        if what == "error_texels":
+            return self.error_max
+        if what == "iterations":
+            return self.iterations_max
+        if self.cache_max is None:
+            # The 99th percentile of the covered pixels' misses, the largest over the study: one scale for all.
+            p99 = [pictures.covered_percentile(pictures.read(path), 99.0)
+                   for path in (self.study.kept(r["index"], ".cache_misses.exr") for r in self.study.rows) if path]
+            self.cache_max = max(p99 + [1.0])
+        return self.cache_max
 
     def header(self):
         s, h = self.study, self.study.header
@@ -240,8 +252,40 @@ class Page:
             out.append("<p class=note>This study has no texture-cache columns per layout (a <code>layout</code> axis "
                        "and the <code>cache_miss_ratio</code> column).</p>")
             return "\n".join(out)
-        out.append("<p>The emulated texture cache's miss ratio, the median over the other axes, per layout.</p>")
-        out.append(f"<figure>{plots.cache_chart(s, layout_axes[0])}</figure>")
+        quadtree_axes = [a for a in s.axes if a == "quadtree" or s.axis_spec(a).get("path", "").endswith("/quadtree")]
+        quadtree = quadtree_axes[0] if quadtree_axes else None
+        out.append("<p>The emulated texture cache's miss ratio and the bytes it fetched per pixel (misses times the "
+                   "line size), the median over the other axes, per texel layout"
+                   + (" and quadtree storage" if quadtree else "") + ".</p>")
+        out.append(f"<figure>{plots.cache_chart(s, layout_axes[0], quadtree)}</figure>")
+        if quadtree:
+            out.append(self.quadtree_table(layout_axes[0], quadtree))
+        return "\n".join(out)
+
+    def quadtree_table(self, layout_axis, quadtree_axis):
+        """Per layout: the bytes per pixel of each quadtree storage, and the change from the first."""
+        s = self.study
+        storages = [v for v in s.axis_spec(quadtree_axis).get("values", [])]
+        layouts = []
+        for r in s.rows:
+            if r["config"].get(layout_axis) not in layouts:
+                layouts.append(r["config"].get(layout_axis))
+        out = ["<table><thead><tr><th>" + esc(layout_axis) + "</th>"
+               + "".join(f"<th>{esc(v)}: bytes per pixel</th>" for v in storages)
+               + "".join(f"<th>{esc(v)} vs {esc(storages[0])}</th>" for v in storages[1:]) + "</tr></thead><tbody>"]
+        for layout in layouts:
+            medians = []
+            for storage in storages:
+                values = [s.number(r, "cache_bytes_per_pixel") for r in s.rows
+                          if r["config"].get(layout_axis) == layout and r["config"].get(quadtree_axis) == storage]
+                values = [v for v in values if v is not None]
+                medians.append(statistics.median(values) if values else None)
+            cells = [f"<td>{esc(layout)}</td>"] + [f"<td>{m:.1f}</td>" if m is not None else "<td></td>" for m in medians]
+            for m in medians[1:]:
+                change = (m / medians[0] - 1.0) * 100.0 if m is not None and medians[0] else None
+                cells.append(f"<td>{change:+.1f} %</td>" if change is not None else "<td></td>")
+            out.append("<tr>" + "".join(cells) + "</tr>")
+        out.append("</tbody></table>")
         return "\n".join(out)
 
     def table_section(self):
@@ -270,11 +314,15 @@ class Page:
         if not self.cards:
             return ("<section id=configurations><h2>Configurations</h2><p class=note>The spec kept no files per configuration "
                     "(<code>keep</code>).</p>")
+        cache = f", cache_misses (cividis) from 0 to {self.cache_max:.0f} misses" if self.cache_max is not None else ""
         out = ["<section id=configurations><h2>Configurations</h2>",
                f"<p>What each configuration kept. Heatmaps share one scale across the study: error_texels (magma) from "
-               f"0 to {self.error_max:.3g} texels, iterations (viridis) from 0 to {self.iterations_max:.0f}.</p>",
+               f"0 to {self.error_max:.3g} texels, iterations (viridis) from 0 to {self.iterations_max:.0f}{cache}.</p>",
                "<div class=charts>", f"<figure>{plots.colour_scale('magma', self.error_max, 'error (texels)')}</figure>",
-               f"<figure>{plots.colour_scale('viridis', self.iterations_max, 'iterations')}</figure></div>"]
+               f"<figure>{plots.colour_scale('viridis', self.iterations_max, 'iterations')}</figure>"]
+        if self.cache_max is not None:
+            out.append(f"<figure>{plots.colour_scale('cividis', self.cache_max, 'texture cache misses')}</figure>")
+        out.append("</div>")
         for row in self.study.rows:
             index = row["index"]
             if index not in self.cards:

@@ -41,6 +41,13 @@ def heatmap(values, vmax, cmap, target):
     plt.imsave(target, plane, cmap=cmap, vmin=0.0, vmax=vmax, format="png")
 
 
+def covered_percentile(values, q):
+    """The q-th percentile of a single-channel image over its non-zero pixels (0 where there are none)."""
+    plane = numpy.nan_to_num(values[:, :, 0], nan=0.0, posinf=0.0, neginf=0.0)
+    covered = plane[plane > 0]
+    return float(numpy.percentile(covered, q)) if covered.size else 0.0
+
+
 def worst_window(weights, size):
     """The top-left corner of the size x size window with the largest sum of weights (a summed-area table)."""
     h, w = weights.shape

@@ -31,6 +31,7 @@ LABELS = {
     "missed_fraction": "missed (% of covered pixels)",
     "iterations_mean": "iterations per pixel, mean",
     "cache_miss_ratio": "texture cache miss ratio (%)",
+    "cache_bytes_per_pixel": "texture cache bytes fetched per pixel",
 }
 PERCENT = {"missed_fraction", "cache_miss_ratio"}
 
@@ -207,32 +208,46 @@ def line_chart(study, axis, metrics):
     return svg(fig)
 
 
-def cache_chart(study, layout_axis):
-    """The cache study: the miss ratio as bars per texture layout, one bar per group."""
-    layouts = []
+def cache_series(study, row, quadtree_axis):
+    """The bar series of a row in the cache charts: its group, split by quadtree storage where that axis applies."""
+    group = study.group_of(row)
+    storage = row["config"].get(quadtree_axis) if quadtree_axis else None
+    return group if storage is None else f"{group}, {storage}"
+
+
+def cache_chart(study, layout_axis, quadtree_axis=None):
+    """The cache study: miss ratio and bytes per pixel as bars per texture layout, one bar per group (and quadtree
+    storage), the median over the other axes."""
+    layouts, series = [], []
     for r in study.rows:
-        v = r["config"].get(layout_axis)
-        if v not in layouts:
-            layouts.append(v)
-    groups = study.groups()
-    fig, ax = plt.subplots(figsize=(max(4.0, 1.1 * len(layouts) * max(len(groups), 1) * 0.5 + 2), 3.2))
-    width = 0.8 / max(len(groups), 1)
+        if r["config"].get(layout_axis) not in layouts:
+            layouts.append(r["config"].get(layout_axis))
+        if cache_series(study, r, quadtree_axis) not in series:
+            series.append(cache_series(study, r, quadtree_axis))
+    metrics = [m for m in ("cache_miss_ratio", "cache_bytes_per_pixel")
+               if any(study.number(r, m) is not None for r in study.rows)]
+    fig, axes = plt.subplots(len(metrics), 1, squeeze=False,
+                             figsize=(min(12.0, max(5.0, 0.3 * len(layouts) * max(len(series), 1) + 2.0)),
+                                      2.8 * len(metrics)))
+    width = 0.8 / max(len(series), 1)
     colours = plt.get_cmap("viridis")
-    for g_index, group in enumerate(groups):
-        heights = []
-        for layout in layouts:
-            values = [study.number(r, "cache_miss_ratio") for r in study.rows
-                      if study.group_of(r) == group and r["config"].get(layout_axis) == layout]
-            values = [v for v in values if v is not None]
-            heights.append(100.0 * statistics.median(values) if values else math.nan)
-        ax.bar([i + g_index * width for i in range(len(layouts))], heights, width, label=group,
-               color=colours(g_index / max(len(groups) - 1, 1) * 0.9))
-    ax.set_xticks([i + width * (len(groups) - 1) / 2 for i in range(len(layouts))],
-                  [str(v) for v in layouts])
-    ax.set_xlabel(layout_axis)
-    ax.set_ylabel(label("cache_miss_ratio"))
-    if len(groups) > 1:
-        ax.legend(title=study.group_axis, fontsize=7, title_fontsize=7)
+    for ax, metric in zip(axes.flat, metrics):
+        scale = 100.0 if metric in PERCENT else 1.0
+        for s_index, name in enumerate(series):
+            heights = []
+            for layout in layouts:
+                values = [study.number(r, metric) for r in study.rows
+                          if cache_series(study, r, quadtree_axis) == name and r["config"].get(layout_axis) == layout]
+                values = [v for v in values if v is not None]
+                heights.append(scale * statistics.median(values) if values else math.nan)
+            ax.bar([i + s_index * width for i in range(len(layouts))], heights, width, label=name,
+                   color=colours(s_index / max(len(series) - 1, 1) * 0.9))
+        ax.set_xticks([i + width * (len(series) - 1) / 2 for i in range(len(layouts))], [str(v) for v in layouts])
+        ax.set_ylabel(label(metric), fontsize=8)
+    axes.flat[-1].set_xlabel(layout_axis)
+    if len(series) > 1:
+        axes.flat[0].legend(title=study.group_axis, fontsize=7, title_fontsize=7, ncol=2)
+    fig.tight_layout()
     return svg(fig)
 
 

@@ -117,7 +117,10 @@ public:
     row["config"] = values;
     nlohmann::ordered_json det = nlohmann::ordered_json::object(), timing = nlohmann::ordered_json::object();
 
-    timing_.set_scene(scene, {});
+    // Timed frames never record texture fetches: the cache is measured on its own frame below.
+    SceneDesc timed = scene;
+    timed.texture_cache.enabled = false;
+    timing_.set_scene(timed, {});
     std::vector<double> draws;
     double prepare_ms = 0;
     for (int f = 0; f < spec_.warmup + spec_.frames; ++f) {
@@ -160,7 +163,8 @@ public:
       timing["prepare_ms"] = prepare_ms;
     }
 
-    if (spec_.wants(StudyMetric::Error) || !keep_aovs().empty()) measure_error(config, scene, images, det);
+    const bool cache = spec_.wants(StudyMetric::Cache) || scene.texture_cache.enabled || keeps("cache_misses");
+    if (spec_.wants(StudyMetric::Error) || !keep_aovs().empty() || cache) measure_frame(config, scene, cache, images, det);
     if (keeps("reference")) write_reference(config, scene, images);
     row["deterministic"] = det;
     row["timing"] = timing;
@@ -184,14 +188,25 @@ private:
     write_frame(measuring_.draw(), images / (std::to_string(config.index) + ".reference.png"));
   }
 
-  void measure_error(const StudyConfig& config, const SceneDesc& scene, const std::filesystem::path& images,
+  // One untimed frame for what is not time: the error AOVs, the kept AOVs and the texture cache.
+  void measure_frame(const StudyConfig& config, SceneDesc scene, bool cache, const std::filesystem::path& images,
                      nlohmann::ordered_json& det) {
-    std::vector<Aov> aovs{Aov::Depth, Aov::ErrorTexels, Aov::Missed};
+    std::vector<Aov> aovs;
+    if (spec_.wants(StudyMetric::Error)) aovs = {Aov::Depth, Aov::ErrorTexels, Aov::Missed};
     for (Aov a : keep_aovs())
       if (std::find(aovs.begin(), aovs.end(), a) == aovs.end()) aovs.push_back(a);
+    scene.texture_cache.enabled = cache;
     measuring_.set_scene(scene, aovs);
     const Frame& frame = measuring_.draw();
     for (Aov a : keep_aovs()) write_aov(frame, a, images / (std::to_string(config.index) + "." + aov_name(a) + ".exr"));
+    if (cache) {
+      const TextureCacheStats& c = frame.stats.texture_cache;
+      det["cache_accesses_per_pixel"] = c.accesses_per_pixel;
+      det["cache_miss_ratio"] = c.miss_ratio;
+      det["cache_misses_per_pixel"] = c.misses_per_pixel;
+      det["cache_bytes_per_pixel"] = c.bytes_per_pixel;
+      det["cache_footprint_bytes"] = c.footprint_bytes;
+    }
     if (!spec_.wants(StudyMetric::Error)) return;
     const auto plane = [&](Aov a) -> const PixelBuffer& {
       for (const AovImage& image : frame.aovs)

@@ -202,7 +202,8 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
       spec.metrics.push_back(item.choice<StudyMetric>({{"time", StudyMetric::Time},
                                                         {"iterations", StudyMetric::Iterations},
                                                         {"error", StudyMetric::Error},
-                                                        {"image_diff", StudyMetric::ImageDiff}}));
+                                                        {"image_diff", StudyMetric::ImageDiff},
+                                                        {"cache", StudyMetric::Cache}}));
     v->require(!spec.metrics.empty(), "expected at least one metric");
   }
   if (auto v = object.find("baseline")) {
@@ -220,6 +221,7 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
     for (const Value& item : v->array()) {
       const std::string kind = item.choice<std::string>({{"image", "image"}, {"error_texels", "error_texels"},
                                                          {"iterations", "iterations"},
+                                                         {"cache_misses", "cache_misses"},
                                                          {"reference", "reference"}});
       spec.keep.push_back(kind);
     }

@@ -32,7 +32,8 @@ struct StudyRule {
   std::map<std::string, std::vector<nlohmann::json>> when;      // axis name -> values that match
 };
 
-enum class StudyMetric { Time, Iterations, Error, ImageDiff };
+// cache: the emulated texture cache's columns (also when the scene turns texture_cache on); never timed.
+enum class StudyMetric { Time, Iterations, Error, ImageDiff, Cache };
 
 struct StudySpec {
   std::filesystem::path file;
