@@ -1,0 +1,143 @@
+// The emulated texture cache in a frame: off by default, the same statistics and cache_misses AOV for every ISA,
+// thread count and tile size, the image untouched by it, and settings the frame cannot honour refused.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <numeric>
+
+#include "cli/cli_test_util.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/load/load.hpp"
+#include "qdmr/render/render.hpp"
+
+namespace qdmr::test {
+namespace {
+
+SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
+  overrides.push_back({"/output/width", "160"});
+  overrides.push_back({"/output/height", "96"});
+  return load_scene(source_dir() / "scenes" / (name + ".json"), overrides);
+}
+
+bool same_bits(const PixelBuffer& a, const PixelBuffer& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) {
+           return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y);
+         });
+}
+
+const PixelBuffer& misses_plane(const Frame& frame) {
+  for (const AovImage& a : frame.aovs)
+    if (a.aov == Aov::CacheMisses) return a.pixels;
+  throw Error("test", "no cache_misses AOV");
+}
+
+TEST(TextureCache, IsOffUnlessAsked) {
+  const Frame frame = render_frame(small_scene("plane"), RenderOptions{});
+  EXPECT_FALSE(frame.stats.texture_cache.enabled);
+  EXPECT_FALSE(frame.stats.to_json().contains("texture_cache"));
+}
+
+TEST(TextureCache, AskingForTheMissesAovTurnsItOn) {
+  RenderOptions options;
+  options.aovs = {Aov::CacheMisses};
+  const Frame frame = render_frame(small_scene("plane"), options);
+  const TextureCacheStats& c = frame.stats.texture_cache;
+  ASSERT_TRUE(c.enabled);
+  EXPECT_EQ(c.layout, "linear");
+  EXPECT_EQ(c.size_bytes, 8192);
+  // Normal mapping reads albedo and normal trilinearly: 2 x 8 texels per shaded pixel, plus the helper lanes of
+  // partly covered quads (a few per cent on this plane).
+  EXPECT_GE(c.accesses_per_pixel, 16.0);
+  EXPECT_LT(c.accesses_per_pixel, 17.0);
+  EXPECT_GT(c.misses, 0u);
+  EXPECT_EQ(c.hits + c.misses, c.accesses);
+  // The AOV holds the misses of covered pixels' own lanes: at most all misses, and most of them (the helper
+  // lanes outside the plane are few).
+  const PixelBuffer& misses = misses_plane(frame);
+  const double sum = std::accumulate(misses.begin(), misses.end(), 0.0);
+  EXPECT_LE(sum, double(c.misses));
+  EXPECT_GT(sum, 0.9 * double(c.misses));
+}
+
+// Every ISA this machine runs, 1 and 2 threads, tiles of 32, 64 and 96 pixels: bit-identical statistics and
+// AOV. The scenes cover every fetch path: QDM over a per-pixel 4-layer blend with qdm_soft shadows and baked AO
+// (terrain), and POM, relief and QDM on meshes (objects_displaced).
+TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
+  for (const char* name : {"terrain", "objects_displaced"}) {
+    SCOPED_TRACE(name);
+    const SceneDesc scene = small_scene(name, {{"/texture_cache/layout", "\"tiled4\""}});
+    struct Setting {
+      Isa isa;
+      int threads, tile;
+    };
+    std::vector<Setting> settings;
+    for (Isa isa : usable_isas()) settings.push_back({isa, 2, 64});
+    settings.push_back({Isa::Sse42, 1, 32});
+    settings.push_back({usable_isas().front(), 2, 96});
+    std::optional<Frame> first;
+    for (const Setting& s : settings) {
+      RenderOptions options;
+      options.isa = s.isa;
+      options.threads = s.threads;
+      options.tile_size = s.tile;
+      options.aovs = {Aov::CacheMisses};
+      Frame frame = render_frame(scene, options);
+      SCOPED_TRACE(std::string(isa_name(s.isa)) + ", " + std::to_string(s.threads) + " threads, tile " +
+                   std::to_string(s.tile));
+      if (!first) {
+        first = std::move(frame);
+        EXPECT_GT(first->stats.texture_cache.accesses, 0u);
+        continue;
+      }
+      EXPECT_EQ(frame.stats.texture_cache.accesses, first->stats.texture_cache.accesses);
+      EXPECT_EQ(frame.stats.texture_cache.hits, first->stats.texture_cache.hits);
+      EXPECT_TRUE(same_bits(misses_plane(frame), misses_plane(*first)));
+    }
+  }
+}
+
+TEST(TextureCache, LeavesTheImageAsItIs) {
+  const SceneDesc off = small_scene("objects_displaced");
+  const SceneDesc on = small_scene("objects_displaced", {{"/texture_cache/layout", "\"morton\""}});
+  ASSERT_TRUE(on.texture_cache.enabled);
+  EXPECT_TRUE(same_bits(render_frame(off, RenderOptions{}).color, render_frame(on, RenderOptions{}).color));
+}
+
+TEST(TextureCache, LayoutsChangeTheMissesNotTheReads) {
+  const auto stats = [](const char* layout) {
+    return render_frame(small_scene("plane", {{"/texture_cache/layout", std::string("\"") + layout + "\""}}),
+                        RenderOptions{})
+        .stats.texture_cache;
+  };
+  const TextureCacheStats linear = stats("linear"), morton = stats("morton");
+  EXPECT_EQ(linear.accesses, morton.accesses);
+  // A trilinear footprint is 2x2 texels: in rows it spans two lines, in Morton order usually one.
+  EXPECT_LT(morton.misses, linear.misses);
+}
+
+TEST(TextureCache, RefusesATileThatIsNotAWholeNumberOfRegions) {
+  RenderOptions options;
+  options.tile_size = 40;
+  EXPECT_THROW(render_frame(small_scene("plane", {{"/texture_cache/region", "32"}}), options), Error);
+  options.tile_size = 48;
+  EXPECT_NO_THROW(render_frame(small_scene("plane", {{"/texture_cache/region", "16"}}), options));
+}
+
+TEST(TextureCache, SceneSettingsAreChecked) {
+  const auto message = [](const std::string& pointer, const std::string& value) {
+    try {
+      small_scene("plane", {{pointer, value}});
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("/texture_cache/line_bytes", "48").find("/texture_cache/line_bytes"), std::string::npos);
+  EXPECT_NE(message("/texture_cache/size_bytes", "1000").find("whole number of sets"), std::string::npos);
+  EXPECT_NE(message("/texture_cache/layout", "\"swizzled\"").find("/texture_cache/layout"), std::string::npos);
+  EXPECT_NE(message("/texture_cache/colour", "1").find("colour"), std::string::npos);
+  EXPECT_EQ(message("/texture_cache/enabled", "false"), "accepted");
+}
+
+}  // namespace
+}  // namespace qdmr::test
