@@ -288,6 +288,68 @@ class Page:
         out.append("</tbody></table>")
         return "\n".join(out)
 
+    def budget_section(self):
+        """The spec's budget: per group value (and per value of the `per` axes), the fastest configuration whose
+        missed fraction is below the budget, and its time over the `relative_to` configuration's."""
+        s = self.study
+        budget = s.header.get("spec", {}).get("budget")
+        if not budget:
+            return ""
+        limit = float(budget["missed_fraction"])
+        per = list(budget.get("per", []))
+        relative_to = budget.get("relative_to", {})
+        fixed = set(per) | {s.group_axis} | set(relative_to)
+
+        def key(row):
+            return tuple(format_value(row["config"].get(a)) for a in per)
+
+        def is_reference(row):
+            return all(row["config"].get(a) == v for a, v in relative_to.items())
+
+        def time(row):
+            return s.number(row, "draw_ms_median")
+
+        references = {}
+        for r in s.rows:
+            if is_reference(r) and time(r) is not None:
+                k = key(r)
+                references[k] = min(references.get(k, time(r)), time(r))
+        keys = sorted({key(r) for r in s.rows})
+        groups = [g for g in s.groups() if not (relative_to and all(
+            format_value(v) == g for a, v in relative_to.items() if a == s.group_axis))]
+        out = ["<section id=budget><h2>Within budget</h2>",
+               f"<p>Per {esc(s.group_axis)}{' and ' + esc(', '.join(per)) if per else ''}: the fastest configuration "
+               f"with fewer than {100 * limit:.3g} % of its covered pixels missed (and no NaN or Inf), its time"
+               + (" over " + esc(", ".join(f"{a}={format_value(v)}" for a, v in relative_to.items()))
+                  + " at the same " + esc(", ".join(per)) if relative_to else "")
+               + ", and the knobs that got it there. Where no configuration is within the budget, the one that "
+                 "missed least.</p>",
+               "<table><thead><tr><th>" + esc(s.group_axis) + "</th>"
+               + "".join(f"<th>{esc(', '.join(f'{a}={v}' for a, v in zip(per, k)))}</th>" for k in keys)
+               + "</tr></thead><tbody>"]
+        for g in groups:
+            cells = [f"<td>{esc(g)}</td>"]
+            for k in keys:
+                rows = [r for r in s.rows if s.group_of(r) == g and key(r) == k and time(r) is not None
+                        and s.number(r, "missed_fraction") is not None]
+                if not rows:
+                    cells.append("<td></td>")
+                    continue
+                within = [r for r in rows if s.number(r, "missed_fraction") < limit and not s.number(r, "nonfinite")]
+                best = min(within, key=time) if within else min(rows, key=lambda r: s.number(r, "missed_fraction"))
+                knobs = ", ".join(f"{a}={format_value(v)}" for a, v in best["config"].items()
+                                  if a not in fixed and v is not None)
+                ratio = f"{time(best) / references[k]:.2f}x" if k in references and references[k] > 0 else \
+                    f"{time(best):.3g} ms"
+                missed = 100 * s.number(best, "missed_fraction")
+                text = (f"<b>{ratio}</b>" if within else f"not reached ({ratio})") + \
+                    f"<br><small>{esc(knobs)}{'; ' if knobs else ''}{missed:.3g} % missed, p99 " \
+                    f"{format_value(s.number(best, 'error_p99'))}</small>"
+                cells.append(f"<td><a href='{self.anchor(best['index'])}'>{text}</a></td>")
+            out.append("<tr>" + "".join(cells) + "</tr>")
+        out.append("</tbody></table>")
+        return "\n".join(out)
+
     def table_section(self):
         s = self.study
         det, timing = s.columns(DETERMINISTIC), s.columns(TIMING)
@@ -337,10 +399,12 @@ class Page:
 
     def render(self):
         self.make_cards()
-        sections = [self.pareto_section(), self.axes_section(), self.worst_section(), self.cache_section(),
-                    self.table_section(), self.cards_section()]
+        budget = self.budget_section()
+        sections = [self.pareto_section(), *([budget] if budget else []), self.axes_section(), self.worst_section(),
+                    self.cache_section(), self.table_section(), self.cards_section()]
         body = [self.header(),
-                "<nav><a href='#pareto'>Pareto fronts</a><a href='#axes'>Axes</a><a href='#worst'>Worst artifacts</a>"
+                "<nav><a href='#pareto'>Pareto fronts</a>" + ("<a href='#budget'>Within budget</a>" if budget else "")
+                + "<a href='#axes'>Axes</a><a href='#worst'>Worst artifacts</a>"
                 "<a href='#cache'>Cache</a><a href='#rows'>Every configuration</a>"
                 "<a href='#configurations'>Pictures</a></nav>",
                 *(section + "\n</section>" for section in sections)]

@@ -139,7 +139,8 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
   const scene_detail::Context context{file.string(), std::filesystem::absolute(file).parent_path()};
   const Value root(context, spec.document, "");
   const Object object(root, {"scene", "set", "width", "height", "frames", "warmup", "axes", "zip", "rules",
-                             "metrics", "baseline", "diff_threshold", "keep", "group_by", "max_configurations"});
+                             "metrics", "baseline", "diff_threshold", "keep", "group_by", "max_configurations",
+                             "budget"});
   spec.scene = object.required("scene").existing_file();
   if (auto v = object.find("set")) {
     v->expect_type(nlohmann::json::value_t::object, "an object of JSON pointers and values");
@@ -232,6 +233,24 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
       if (a.name == "technique") spec.group_axis = a.name;
   }
   if (auto v = object.find("max_configurations")) spec.max_configurations = std::size_t(v->integer(1, 1000000));
+  // The report's "within budget" table (docs/studies.md); nothing here depends on it but its validity.
+  if (auto v = object.find("budget")) {
+    const Object budget(*v, {"missed_fraction", "per", "relative_to"});
+    budget.required("missed_fraction").number_in(0.0, 1.0);
+    if (auto per = budget.find("per"))
+      for (const Value& name : per->array()) axis_index(spec, name, name.string());
+    if (auto to = budget.find("relative_to")) {
+      to->expect_type(nlohmann::json::value_t::object, "an object of axis names and values");
+      for (const auto& item : to->json().items()) {
+        const Value entry = *to->member(item.key());
+        const StudyAxis& axis = spec.axes[axis_index(spec, entry, item.key())];
+        entry.require(std::find(axis.values.begin(), axis.values.end(), item.value()) != axis.values.end(),
+                      "not one of the axis's values");
+      }
+    }
+    v->require(spec.wants(StudyMetric::Time) && spec.wants(StudyMetric::Error),
+               "a budget compares time at a missed fraction: it needs the time and error metrics");
+  }
 
   // The hash of what decides the rows: the canonical JSON (sorted keys) of the document.
   const std::string canonical = spec.document.dump();

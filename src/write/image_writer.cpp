@@ -113,7 +113,7 @@ struct AovPixels {
 
 // An AOV's values as a file of `container` holds them: as they are in float files; mapped into [0, 1] for an
 // 8-bit PNG so the picture is readable (normals to 0.5 + 0.5 n, UVs to their fractional part, depth,
-// iterations, hit depth and errors divided by their maximum; two channels into red and green).
+// iterations, hit depth, errors and cache misses divided by their maximum; two channels into red and green).
 AovPixels aov_pixels(const Frame& frame, Aov aov, Container container, const std::filesystem::path& file) {
   const AovImage* image = nullptr;
   for (const AovImage& a : frame.aovs)
@@ -126,7 +126,8 @@ AovPixels aov_pixels(const Frame& frame, Aov aov, Container container, const std
     for (float& v : mapped) v = 0.5f + 0.5f * v;
   if (aov == Aov::UV || aov == Aov::HitUV)
     for (float& v : mapped) v -= std::floor(v);
-  if (aov == Aov::Depth || aov == Aov::Iterations || aov == Aov::HitDepth || aov == Aov::ErrorTexels) {
+  if (aov == Aov::Depth || aov == Aov::Iterations || aov == Aov::HitDepth || aov == Aov::ErrorTexels ||
+      aov == Aov::CacheMisses) {
     float max_depth = 0.0f;
     for (float v : mapped) max_depth = std::max(max_depth, v);
     if (max_depth > 0.0f)

@@ -175,7 +175,7 @@ TEST_F(CliBadInput, Tile) {
 TEST_F(CliBadInput, UnknownAov) {
   expect_refused(render_args({"--aov", "albedo=" + (out_ / "albedo.exr").string()}),
                  {"--aov: unknown AOV 'albedo' (valid: depth, normal, uv, iterations, hit_uv, hit_depth, error_texels, missed, "
-                  "shadow, ao)"});
+                  "shadow, ao, cache_misses)"});
   expect_refused(render_args({"--aov", "depth"}), {"--aov depth: expected NAME=FILE"});
 }
 

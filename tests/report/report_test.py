@@ -145,6 +145,31 @@ class Report(unittest.TestCase):
         self.assertTrue("crop at (4, 0), 16 x 16" in page, "crop at (4, 0), 16 x 16")
         self.assertEqual(checksums(self.results), before)  # the results are never written
 
+    def test_budget_table(self):
+        # missed = 0.01 (3 - t)(4 - e): under 2.5 % only relief at elevation 90 and QDM at 20.1 and 90; pom, the time
+        # base, is fastest at elevation 1 (1.00 ms with linear, 1.01 ms with morton).
+        make_results(self.results, cache=True)
+        for name in ("study.json", "results.json"):
+            with open(os.path.join(self.results, name)) as f:
+                content = json.load(f)
+            content["spec"]["budget"] = {"missed_fraction": 0.025, "per": ["layout"],
+                                         "relative_to": {"technique": "pom"}}
+            with open(os.path.join(self.results, name), "w") as f:
+                json.dump(content, f)
+        code, _, err = run(self.results, "-o", self.report)
+        self.assertEqual(code, 0, err)
+        with open(os.path.join(self.report, "index.html")) as f:
+            page = f.read()
+        budget = page[page.index("<section id=budget>"):page.index("</section>", page.index("<section id=budget>"))]
+        # relief, linear: row 14 (elevation 90), 4.64 ms over 1.00; QDM, linear: row 20 (elevation 20.1), 6.20 ms.
+        self.assertIn("<b>4.64x</b>", budget)
+        self.assertIn("<b>6.20x</b>", budget)
+        self.assertIn("elevation=20.1", budget)
+        self.assertIn("#row20", budget)
+        self.assertNotIn("<td>pom</td>", budget)  # the time base is not a row of its own
+        # Morton: same rows one index later, over pom's 1.01 ms.
+        self.assertIn(f"<b>{4.65 / 1.01:.2f}x</b>", budget)
+
     def test_a_second_report_replaces_the_first(self):
         make_results(self.results)
         self.assertEqual(run(self.results, "-o", self.report)[0], 0)
