@@ -298,7 +298,7 @@ class Page:
         limit = float(budget["missed_fraction"])
         per = list(budget.get("per", []))
         relative_to = budget.get("relative_to", {})
-        fixed = set(per) | {s.group_axis} | set(relative_to)
+        fixed = set(per) | {s.group_axis} | set(relative_to) | plots.zipped_followers(s)
 
         def key(row):
             return tuple(format_value(row["config"].get(a)) for a in per)
@@ -321,7 +321,7 @@ class Page:
                f"<p>Per {esc(s.group_axis)}{' and ' + esc(', '.join(per)) if per else ''}: the fastest configuration "
                f"with fewer than {100 * limit:.3g} % of its covered pixels missed (and no NaN or Inf), its time"
                + (" over " + esc(", ".join(f"{a}={format_value(v)}" for a, v in relative_to.items()))
-                  + " at the same " + esc(", ".join(per)) if relative_to else "")
+                  + (" at the same " + esc(", ".join(per)) if per else "") if relative_to else "")
                + ", and the knobs that got it there. Where no configuration is within the budget, the one that "
                  "missed least.</p>",
                "<table><thead><tr><th>" + esc(s.group_axis) + "</th>"

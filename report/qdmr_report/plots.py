@@ -113,7 +113,7 @@ def pareto_chart(study, group, rows, front, link):
     return svg(fig)
 
 
-def _zipped_followers(study):
+def zipped_followers(study):
     """Axes zipped to an earlier one (they advance together, so a chart along them repeats the first's)."""
     followers = set()
     for group in study.header.get("spec", {}).get("zip", []):
@@ -125,7 +125,7 @@ def numeric_axes(study):
     """The axes whose values are numbers, with at least three distinct values: what line plots are drawn along
     (an axis zipped to an earlier one is left out)."""
     found = []
-    followers = _zipped_followers(study)
+    followers = zipped_followers(study)
     for axis in study.axes:
         values = {study.number(r, axis) for r in study.rows} - {None}
         if axis not in followers and len(values) >= 3 and all(
@@ -142,7 +142,7 @@ def line_series(study, along):
     """What the lines of a chart along an axis are: every combination of the categorical axes (strings,
     booleans, or fewer than three numbers; zipped followers left out) when there are at most MAX_LINES of them,
     else the group axis alone. Returns (axis names, a function of a row giving its line's label)."""
-    followers = _zipped_followers(study)
+    followers = zipped_followers(study)
     numeric = set(numeric_axes(study))
     categorical = [a for a in study.axes if a != along and a not in numeric and a not in followers
                    and len({format_value(r["config"].get(a)) for r in study.rows}) > 1]

@@ -75,6 +75,11 @@ TEST(StudySpec, BadSpecsAreRefusedBeforeAnythingRuns) {
       {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "baseline": {"t": 2})", "s.json: /baseline/t: not one of the axis's values"},
       {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "metrics": ["speed"])", "s.json: /metrics/0: unknown value 'speed'"},
       {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "keep": ["depth"])", "s.json: /keep/0: unknown value 'depth'"},
+      {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "budget": {"per": ["t"]})", "s.json: /budget: missing key 'missed_fraction'"},
+      {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "budget": {"missed_fraction": 2})", "s.json: /budget/missed_fraction: "},
+      {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "budget": {"missed_fraction": 0.1, "per": ["u"]})", "s.json: /budget/per/0: no axis named 'u'"},
+      {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "budget": {"missed_fraction": 0.1, "relative_to": {"t": 3}})", "s.json: /budget/relative_to/t: not one of the axis's values"},
+      {R"("axes": [{"name": "t", "path": "/t", "values": [1]}], "metrics": ["time"], "budget": {"missed_fraction": 0.1})", "s.json: /budget: a budget compares time at a missed fraction"},
   };
   for (const auto& [rest, expected] : cases) {
     TempDir dir;
