@@ -12,20 +12,13 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
+#include "support/frames.hpp"
 
 namespace qdmr::test {
 namespace {
 
 SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
-  overrides.push_back({"/output/width", "96"});
-  overrides.push_back({"/output/height", "54"});
-  return load_scene(source_dir() / "scenes" / (name + ".json"), overrides);
-}
-
-bool same_bits(const PixelBuffer& a, const PixelBuffer& b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) {
-           return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y);
-         });
+  return test::small_scene(name, std::move(overrides), 96, 54);
 }
 
 // Resident set size now (not the peak), from /proc/self/statm.

@@ -2,27 +2,19 @@
 // thread count and tile size, the image untouched by it, and settings the frame cannot honour refused.
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <numeric>
 
 #include "cli/cli_test_util.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/render/render.hpp"
+#include "support/frames.hpp"
 
 namespace qdmr::test {
 namespace {
 
 SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
-  overrides.push_back({"/output/width", "160"});
-  overrides.push_back({"/output/height", "96"});
-  return load_scene(source_dir() / "scenes" / (name + ".json"), overrides);
-}
-
-bool same_bits(const PixelBuffer& a, const PixelBuffer& b) {
-  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) {
-           return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y);
-         });
+  return test::small_scene(name, std::move(overrides), 160, 96);
 }
 
 const PixelBuffer& misses_plane(const Frame& frame) {
