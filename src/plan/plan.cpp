@@ -341,10 +341,16 @@ public:
       const int field = field_of(0);
       const TextureRequest& h = plan_.textures[std::size_t(m.layers[0].height)];
       const std::string& field_key = plan_.derived[std::size_t(field)].key;
-      if (m.cone_map)
+      if (m.cone_map) {
+        const std::uint64_t map = std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float);
         m.cones = add(DerivedKind::ConeMap, "cones|" + std::to_string(int(m.cone_kind)) + "|" + field_key,
-                      where + "/technique", {field}, index,
-                      std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float));
+                      where + "/technique", {field}, index, map);
+        // Baked (unless the cache has it; the plan cannot count on that): the baker's grid of doubles (mirror
+        // unfolded to 2W x 2H; 4 wall channels for relaxed) and its max hierarchy, held while it bakes. Its
+        // field is item `field`, its map `map`.
+        plan_.derived[std::size_t(m.cones)].working_bytes =
+            cone_bake_bytes(h.width, h.height, m.cone_kind, desc.sampling.address) - map;
+      }
       if (bilinear_patch)
         m.bilinear_bound = add(DerivedKind::BilinearBound, "bilinear_bound|" + field_key, where + "/technique/refinement",
                                {field}, index, chain_bytes(h.width, h.height, TexelFormat::R32F));
@@ -523,7 +529,10 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
 
   for (const MeshPlan& m : plan.meshes) plan.mesh_bytes += m.bytes;
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
-  for (const DerivedPlan& d : plan.derived) plan.derived_bytes += d.bytes;
+  for (const DerivedPlan& d : plan.derived) {
+    plan.derived_bytes += d.bytes;
+    plan.working_bytes = std::max(plan.working_bytes, d.working_bytes);
+  }
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
@@ -583,7 +592,9 @@ std::string FramePlan::describe() const {
       for (int in : d.inputs) s << " [" << in << "]";
     }
     if (d.texture >= 0) s << " from texture " << d.texture;
-    s << ", " << mib(d.bytes) << "  <- " << d.where << "\n";
+    s << ", " << mib(d.bytes);
+    if (d.working_bytes > 0) s << " (" << mib(d.working_bytes) << " more while it is baked)";
+    s << "  <- " << d.where << "\n";
   }
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes) {
@@ -606,8 +617,9 @@ std::string FramePlan::describe() const {
       << quadtree_storage_name(c.quadtree) << "; " << c.warp << "-pixel warps, cold in each " << c.region << "x"
       << c.region << " region\n";
   s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
-    << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes)
-    << ", total " << mib(total_bytes()) << "\n";
+    << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes);
+  if (working_bytes > 0) s << ", working " << mib(working_bytes) << " (while a cone map is baked)";
+  s << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
 
@@ -638,7 +650,7 @@ nlohmann::json FramePlan::to_json() const {
   j["derived"] = nlohmann::json::array();
   for (const DerivedPlan& d : derived)
     j["derived"].push_back({{"kind", derived_kind_name(d.kind)}, {"inputs", d.inputs}, {"texture", d.texture},
-                            {"bytes", d.bytes}, {"where", d.where}});
+                            {"bytes", d.bytes}, {"working_bytes", d.working_bytes}, {"where", d.where}});
   j["meshes"] = nlohmann::json::array();
   for (const MeshPlan& m : meshes) {
     nlohmann::json mtl = nlohmann::json::array();
@@ -655,7 +667,7 @@ nlohmann::json FramePlan::to_json() const {
                           {"replacement", cache_replacement_name(c.replacement)}, {"layout", texel_layout_name(c.layout)},
                           {"quadtree", quadtree_storage_name(c.quadtree)}, {"region", c.region}, {"warp", c.warp}};
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
-                 {"derived_bytes", derived_bytes}, {"total_bytes", total_bytes()}};
+                 {"derived_bytes", derived_bytes}, {"working_bytes", working_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

@@ -57,7 +57,10 @@ struct DerivedPlan {
   int texture = -1;     // the height texture it is made from (HeightField), else -1
   int material = -1;    // the first material that asked for it
   int side = 0;         // ao maps: the map's width
-  std::uint64_t bytes = 0;
+  std::uint64_t bytes = 0;  // what it keeps
+  // What its build allocates on top of `bytes` and frees again (a cone bake: the baker's grid of doubles and max
+  // hierarchy, qdmr::cone_bake_bytes less the map). 0 for the other kinds.
+  std::uint64_t working_bytes = 0;
 };
 
 // Indices into FramePlan::textures and FramePlan::derived of one layer (-1: not needed).
@@ -107,7 +110,13 @@ struct FramePlan {
   std::vector<MeshPlan> meshes;          // one per scene object
   std::vector<Aov> aovs;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, derived_bytes = 0;
-  std::uint64_t total_bytes() const { return framebuffer_bytes + texture_bytes + mesh_bytes + derived_bytes; }
+  // The largest DerivedPlan::working_bytes: derived data is built one item at a time, so at most one build's
+  // working memory is held at once, on top of everything built before it.
+  std::uint64_t working_bytes = 0;
+  // The estimate --max-memory is checked against: everything kept, plus the largest build's working memory.
+  std::uint64_t total_bytes() const {
+    return framebuffer_bytes + texture_bytes + mesh_bytes + derived_bytes + working_bytes;
+  }
 
   // Everything prepare() builds, one line per item ("texture <key>", "mesh <key>", "<derived kind> <key>"),
   // in build order; Assets::built lists the same lines as they are made.
