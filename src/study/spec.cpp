@@ -94,6 +94,20 @@ std::size_t axis_index(const StudySpec& spec, const Value& where, const std::str
   where.fail("no axis named '" + scene_detail::shorten(name) + "'" + scene_detail::suggestion(name, names, "axes are"));
 }
 
+// An object of axis names and one value of each (a baseline, a budget's reference configuration).
+std::map<std::string, nlohmann::json> axis_values(const StudySpec& spec, const Value& value) {
+  value.expect_type(nlohmann::json::value_t::object, "an object of axis names and values");
+  std::map<std::string, nlohmann::json> values;
+  for (const auto& item : value.json().items()) {
+    const Value entry = *value.member(item.key());
+    const StudyAxis& axis = spec.axes[axis_index(spec, entry, item.key())];
+    entry.require(std::find(axis.values.begin(), axis.values.end(), item.value()) != axis.values.end(),
+                  "not one of the axis's values");
+    values[item.key()] = item.value();
+  }
+  return values;
+}
+
 std::map<std::string, std::vector<nlohmann::json>> read_conditions(const StudySpec& spec, const Value& value) {
   value.expect_type(nlohmann::json::value_t::object, "an object of axis names and values, e.g. {\"technique\": [\"pom\"]}");
   std::map<std::string, std::vector<nlohmann::json>> when;
@@ -208,14 +222,7 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
     v->require(!spec.metrics.empty(), "expected at least one metric");
   }
   if (auto v = object.find("baseline")) {
-    v->expect_type(nlohmann::json::value_t::object, "an object of axis names and values");
-    for (const auto& item : v->json().items()) {
-      const Value entry = *v->member(item.key());
-      const StudyAxis& axis = spec.axes[axis_index(spec, entry, item.key())];
-      entry.require(std::find(axis.values.begin(), axis.values.end(), item.value()) != axis.values.end(),
-                    "not one of the axis's values");
-      spec.baseline[item.key()] = item.value();
-    }
+    spec.baseline = axis_values(spec, *v);
   }
   if (auto v = object.find("diff_threshold")) spec.diff_threshold = v->non_negative();
   if (auto v = object.find("keep"))
@@ -239,15 +246,7 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
     budget.required("missed_fraction").number_in(0.0, 1.0);
     if (auto per = budget.find("per"))
       for (const Value& name : per->array()) axis_index(spec, name, name.string());
-    if (auto to = budget.find("relative_to")) {
-      to->expect_type(nlohmann::json::value_t::object, "an object of axis names and values");
-      for (const auto& item : to->json().items()) {
-        const Value entry = *to->member(item.key());
-        const StudyAxis& axis = spec.axes[axis_index(spec, entry, item.key())];
-        entry.require(std::find(axis.values.begin(), axis.values.end(), item.value()) != axis.values.end(),
-                      "not one of the axis's values");
-      }
-    }
+    if (auto to = budget.find("relative_to")) axis_values(spec, *to);
     v->require(spec.wants(StudyMetric::Time) && spec.wants(StudyMetric::Error),
                "a budget compares time at a missed fraction: it needs the time and error metrics");
   }
