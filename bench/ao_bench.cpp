@@ -65,8 +65,8 @@ int main(int argc, char** argv) {
   const qdmr::Image heights = qdmr::generate_procedural(noise);
   const qdmr::Texture height = qdmr::make_mip_texture(heights, qdmr::TexelFormat::R16, false, qdmr::MipReduce::Box);
   const qdmr::Texture tree = qdmr::make_mip_texture(heights, qdmr::TexelFormat::R16, false, qdmr::MipReduce::Max);
-  const qdmr::TextureView height_view(height), tree_view(tree);
-  const qdmr::SingleLayerSurface surface(height_view, &tree_view, qdmr::SamplerState{}, qdmr::HeightFetch::Bilinear);
+  const qdmr::HeightLayerTextures textures(height, &tree, qdmr::SamplerState{}, qdmr::HeightFetch::Bilinear);
+  const qdmr::SingleLayerSurface surface(textures);
   const float ds = 0.05f;
 
   // The points, batch by batch: u, v, s per lane, with the lanes of a batch on one row.

@@ -43,8 +43,8 @@ const Maps& maps() {
 
 void shadow(benchmark::State& state, ShadowMode mode) {
   const Maps& m = maps();
-  const TextureView height(m.height), tree(m.tree);
-  const SingleLayerSurface surface(height, &tree, SamplerState{}, HeightFetch::Bilinear);
+  const HeightLayerTextures textures(m.height, &m.tree, SamplerState{}, HeightFetch::Bilinear);
+  const SingleLayerSurface surface(textures);
   ShadowDesc desc;
   desc.mode = mode;
   const double elevation = double(state.range(0)) * std::numbers::pi / 180.0;

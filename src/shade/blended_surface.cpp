@@ -12,14 +12,6 @@ Int floor_index(const Float& x) {
   return xsimd::to_int(xsimd::floor(xsimd::max(xsimd::min(x, Float(kMaxTexelCoordinate)), Float(-kMaxTexelCoordinate))));
 }
 
-SamplerState weight_sampler(const SamplerState& layer) {
-  SamplerState s;
-  s.filter = Filter::Bilinear;
-  s.address = AddressMode::Wrap;
-  s.fetch = layer.fetch;
-  return s;
-}
-
 // Cell index i of a level whose period is p cells, wrapped into [0, p) (|i| < 2^24, as in the traversals).
 Int wrap_cell(const Int& i, const Int& p) {
   const Int q = xsimd::to_int(xsimd::floor(xsimd::to_float(i) / xsimd::to_float(p)));
@@ -29,6 +21,14 @@ Int wrap_cell(const Int& i, const Int& p) {
 }
 
 }  // namespace
+
+SamplerState weight_sampler_state(const SamplerState& material) {
+  SamplerState s;
+  s.filter = Filter::Bilinear;
+  s.address = AddressMode::Wrap;
+  s.fetch = material.fetch;
+  return s;
+}
 
 BlendedSurface::BlendedSurface(const SingleLayerSurface* layers, int count, BlendOperator op, const Float* w)
     : layers_(layers), count_(count), op_(op) {
@@ -57,7 +57,7 @@ void BlendedSurface::find_present() {
 // centre reads that texel alone), read from the max chain at the first level where they fit in 2x2 texels.
 void BlendedSurface::bound_weights(const Float& u_lo, const Float& u_hi, const Float& v_lo, const Float& v_hi,
                                    Float* w) const {
-  const TextureView& view = *texture_.view;
+  const TextureView& view = texture_.view->view();
   const float texels_per_uv_x = float(view.texture().width()) / texture_.scale;
   const float texels_per_uv_y = float(view.texture().height()) / texture_.scale;
   Int x0 = floor_index(u_lo * Float(texels_per_uv_x) - Float(0.5f));
@@ -75,14 +75,10 @@ void BlendedSurface::bound_weights(const Float& u_lo, const Float& u_hi, const F
     y0 = xsimd::select(wide, y0 >> 1, y0);
     y1 = xsimd::select(wide, y1 >> 1, y1);
   }
-  const Int size_x = simd::load_i32(view.widths(), level, sampler().fetch);
-  const Int size_y = simd::load_i32(view.heights(), level, sampler().fetch);
-  const Int mask_x = size_x - Int(1), mask_y = size_y - Int(1);
   for (int i = 0; i < kMaxLayers; ++i) w[i] = Float(0.0f);
   for (int corner = 0; corner < 4; ++corner) {
-    const Int x = ((corner & 1) ? x1 : x0) & mask_x, y = ((corner & 2) ? y1 : y0) & mask_y;
     Float texel[4];
-    load(view, level, x, y, sampler().fetch, texel);
+    texture_.view->load_wrapped(level, (corner & 1) ? x1 : x0, (corner & 2) ? y1 : y0, texel);
     for (int i = 0; i < count_; ++i) w[i] = xsimd::max(w[i], texel[i]);
   }
 }
@@ -94,7 +90,7 @@ void BlendedSurface::weights_at(const Float& u, const Float& v, Float* w) const 
   }
   const Float inv(1.0f / texture_.scale);
   Float texel[4];
-  sample(*texture_.view, weight_sampler(sampler()), u * inv, v * inv, Float(0.0f), texel);
+  texture_.view->sample(u * inv, v * inv, Float(0.0f), texel);
   for (int i = 0; i < count_; ++i) w[i] = texel[i];
 }
 
@@ -139,8 +135,7 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
     lanes.narrow(simd::float_mask(coarse));
     const Int period = Int(texture_.period) >> level;
     Float texel[4];
-    load(*texture_.combined, xsimd::max(level - Int(1), Int(0)), wrap_cell(cx, period), wrap_cell(cy, period),
-         sampler().fetch, texel);
+    texture_.combined->load(xsimd::max(level - Int(1), Int(0)), wrap_cell(cx, period), wrap_cell(cy, period), texel);
     result = texel[0];
   }
   if (!xsimd::all(coarse)) {

@@ -14,14 +14,18 @@
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
 struct WeightTexture {
-  const TextureView* view = nullptr;  // RGBA8 linear, power-of-two, max chain; level 0 sampled bilinearly (wrap)
+  // RGBA8 linear, power-of-two, max chain; level 0 sampled bilinearly with wrap (weight_sampler_state)
+  const TextureSampler* view = nullptr;
   float scale = 1.0f;                 // weight-map UV = layer UV / scale
   // Optional precomputed combined quadtree: level k holds the maxima of the blended box surface over cells of
   // level k + 1, over one period of `period` level-0 texels per side (the layers' size times the whole number
   // of repeats the weights span); values rounded up, so it stays conservative.
-  const TextureView* combined = nullptr;
+  const TextureSampler* combined = nullptr;
   int period = 0;
 };
+
+// The state weight textures are sampled with, from the material's.
+SamplerState weight_sampler_state(const SamplerState& material);
 
 class BlendedSurface {
 public:

@@ -12,7 +12,7 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 // The level-0 texels cone stepping reads: a height and a cone ratio each, addressed like the height map.
 struct ConeTexels {
   const ConeMap* cones;
-  const TextureView* height;
+  const TextureSampler* height;
   AddressMode address;
   simd::FetchPath fetch;
 
@@ -20,7 +20,7 @@ struct ConeTexels {
     const Int ax = address_texel(x, cones->width, address);
     const Int ay = address_texel(y, cones->height, address);
     Float texel[4];
-    load(*height, Int(0), ax, ay, fetch, texel);
+    height->load(Int(0), ax, ay, texel);
     h = texel[0];
     ratio = simd::load_f32(cones->ratio.data(), ay * Int(cones->width) + ax, fetch);
   }

@@ -45,25 +45,26 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
+  SamplerState ao_sampler = sampler_;
+  ao_sampler.filter = Filter::Bilinear;
   for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
     const LayerInputs& l = inputs.layers[i];
-    Layer layer{TextureView(*l.albedo), TextureView(*l.normal), std::nullopt, std::nullopt, std::nullopt,
+    Layer layer{TextureSampler(*l.albedo, sampler_), TextureSampler(*l.normal, sampler_), std::nullopt, std::nullopt,
                 i < material.layers.size() ? material.layers[i].specular : SpecularFromAlbedo{}};
-    if (l.height) layer.height.emplace(*l.height);
-    if (l.height_max) layer.height_max.emplace(*l.height_max);
-    if (l.ao) layer.ao.emplace(*l.ao);
+    if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, technique_.height_fetch);
+    if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);
     layers_.push_back(std::move(layer));
   }
   if (inputs.blend_ao) {
-    blend_ao_.emplace(*inputs.blend_ao);
+    blend_ao_.emplace(*inputs.blend_ao, ao_sampler);
     blend_ao_scale_ = inputs.blend_ao_scale;
   }
   if (ao_.mode == AoMode::Baked && !blend_ao_ &&
       std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
     throw Error("displacement program", "baked AO needs an AO map per layer or one of the blend");
-  if (inputs.weights) weights_.emplace(*inputs.weights);
+  if (inputs.weights) weights_.emplace(*inputs.weights, weight_sampler_state(sampler_));
   if (inputs.combined) {
-    combined_.emplace(*inputs.combined);
+    combined_.emplace(*inputs.combined, sampler_);
     combined_period_ = inputs.combined_period;
   }
   if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
@@ -75,7 +76,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
 
 SingleLayerSurface DisplacementProgram::layer_surface(int i) const {
   const Layer& l = layers_[std::size_t(i)];
-  return SingleLayerSurface(*l.height, l.height_max ? &*l.height_max : nullptr, sampler_, technique_.height_fetch);
+  return SingleLayerSurface(*l.height);
 }
 
 // The hit in world space: the UV offset through dP/du and dP/dv (from the quad derivatives of the world
@@ -190,14 +191,14 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
     hit = trace::pom(surface, ray, ds, lod, setup.view_tangent.z, active, technique_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
-    const trace::ConeTexels texels{cones_, &*layers_[0].height, sampler_.address, sampler_.fetch};
+    const trace::ConeTexels texels{cones_, &layers_[0].height->height, sampler_.address, sampler_.fetch};
     hit = trace::cone_step<V::technique == TechniqueKind::Rcsm>(texels, ray, ds, active, technique_);
     hit.box_s = hit.s;
     hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {
     Float stop(0.0f);
     if (technique_.lod_stop)
-      stop = xsimd::max(xsimd::floor(lod_from_derivatives(*layers_[0].height_max, d.dudx, d.dvdx, d.dudy, d.dvdy)),
+      stop = xsimd::max(xsimd::floor(layers_[0].height->tree.lod(d.dudx, d.dvdx, d.dudy, d.dvdy)),
                         Float(0.0f));
     Int cap(technique_.max_iterations);
     if (technique_.min_iterations > 0) {
@@ -215,11 +216,11 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
 namespace {
 
 // Albedo and tangent-space normal (unnormalised) of one layer at the hit.
-void layer_colour(const TextureView& albedo_view, const TextureView& normal_view, const SamplerState& sampler,
-                  const UvDerivatives& d, const Float& u, const Float& v, Float* albedo, Float* normal) {
-  sample(albedo_view, sampler, u, v, lod_from_derivatives(albedo_view, d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+void layer_colour(const TextureSampler& albedo_texture, const TextureSampler& normal_texture, const UvDerivatives& d,
+                  const Float& u, const Float& v, Float* albedo, Float* normal) {
+  albedo_texture.sample(u, v, albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
   Float n[4];
-  sample(normal_view, sampler, u, v, lod_from_derivatives(normal_view, d.dudx, d.dvdx, d.dudy, d.dvdy), n);
+  normal_texture.sample(u, v, normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), n);
   for (int c = 0; c < 3; ++c) normal[c] = n[c] * Float(2.0f) - Float(1.0f);
 }
 
@@ -260,18 +261,16 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   // Baked AO is read per layer and blended like the colours.
-  SamplerState ao_sampler = sampler_;
-  ao_sampler.filter = Filter::Bilinear;
   const auto baked_ao = [&](const Layer& l) {
     Float a[4];
-    sample(*l.ao, ao_sampler, hu, hv, Float(0.0f), a);
+    l.ao->sample(hu, hv, Float(0.0f), a);
     return a[0];
   };
   Float albedo[4], tangent_normal[3], specular(0.0f), ao(1.0f);
   FetchLanes surface_lanes(FetchPhase::Surface);
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
     const Layer& l = layers_[0];
-    layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, albedo, tangent_normal);
+    layer_colour(l.albedo, l.normal, d, hu, hv, albedo, tangent_normal);
     specular = specular_from_albedo(albedo, l.specular, lighting_.specular);
     if (l.ao) ao = baked_ao(l);
   } else {
@@ -287,7 +286,7 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
     if (blend_ao_) {
       const Float inv(1.0f / float(blend_ao_scale_));
       Float a[4];
-      sample(*blend_ao_, ao_sampler, hu * inv, hv * inv, Float(0.0f), a);
+      blend_ao_->sample(hu * inv, hv * inv, Float(0.0f), a);
       ao = a[0];
     } else if (ao_.mode == AoMode::Baked) {
       ao = Float(0.0f);
@@ -298,7 +297,7 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
       layer_lanes.narrow(f[i] > Float(0.0f));
       const Layer& l = layers_[std::size_t(i)];
       Float a[4], n[3];
-      layer_colour(l.albedo, l.normal, sampler_, d, hu, hv, a, n);
+      layer_colour(l.albedo, l.normal, d, hu, hv, a, n);
       for (int c = 0; c < 4; ++c) albedo[c] += f[i] * a[c];
       for (int c = 0; c < 3; ++c) tangent_normal[c] += f[i] * n[c];
       specular += f[i] * specular_from_albedo(a, l.specular, lighting_.specular);
@@ -390,7 +389,7 @@ void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) c
   setup.ray = Ray{u, v, (Float(0.0f) - setup.view_tangent.x) / vz, (Float(0.0f) - setup.view_tangent.y) / vz};
   setup.active = in.covered;
   if (layers_[0].height)
-    setup.height_lod = lod_from_derivatives(*layers_[0].height, setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
+    setup.height_lod = layers_[0].height->height.lod(setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
 
   const int count = int(layers_.size());
   if (count == 1) {

@@ -42,8 +42,9 @@ public:
 
 private:
   struct Layer {
-    TextureView albedo, normal;
-    std::optional<TextureView> height, height_max, ao;
+    TextureSampler albedo, normal;
+    std::optional<HeightLayerTextures> height;  // and its max chain
+    std::optional<TextureSampler> ao;          // bilinear
     SpecularFromAlbedo specular;
   };
   // What shade() computes before the surface is known: the frame, the ray and the depth scale.
@@ -81,10 +82,10 @@ private:
 
   ShadeFn shade_;
   std::vector<Layer> layers_;
-  std::optional<TextureView> weights_;
-  std::optional<TextureView> combined_;
+  std::optional<TextureSampler> weights_;
+  std::optional<TextureSampler> combined_;
   int combined_period_ = 0;
-  std::optional<TextureView> blend_ao_;
+  std::optional<TextureSampler> blend_ao_;
   int blend_ao_scale_ = 1;
   const ConeMap* cones_;
   const HeightField* reference_;

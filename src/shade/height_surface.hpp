@@ -15,42 +15,46 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
+// The textures of one height layer, bound once per program to the samplers its material fixes.
+struct HeightLayerTextures {
+  // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material needs
+  // no hierarchy (then cell_max is only valid at level 0).
+  HeightLayerTextures(const Texture& height, const Texture* quadtree, const SamplerState& sampler, HeightFetch fetch);
+
+  TextureSampler height;  // sampled as the height fetch says: point, bilinear or the material's filter
+  TextureSampler tree;    // the max chain (or the heights, without one), trilinear with wrap (cell_max_filtered)
+  bool has_tree;
+  SamplerState sampler;   // the material's
+  HeightFetch fetch;
+};
+
 class SingleLayerSurface {
 public:
-  // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material
-  // needs no hierarchy (then cell_max is only valid at level 0).
-  SingleLayerSurface(const TextureView& height, const TextureView* quadtree, const SamplerState& sampler,
-                     HeightFetch fetch)
-      : height_(&height), quadtree_(quadtree), sampler_(sampler), fetch_(fetch) {}
+  explicit SingleLayerSurface(const HeightLayerTextures& textures) : textures_(&textures) {}
 
-  int width() const { return height_->texture().width(); }
-  int height() const { return height_->texture().height(); }
+  int width() const { return textures_->height.texture().width(); }
+  int height() const { return textures_->height.texture().height(); }
   // The surface for queries within a UV box (blended surfaces bound their weights over it; one layer has none).
   SingleLayerSurface around(const simd::Float&, const simd::Float&, const simd::Float&, const simd::Float&) const {
     return *this;
   }
-  bool has_hierarchy() const { return quadtree_ != nullptr; }
-  int top_level() const { return quadtree_ ? quadtree_->levels() - 1 : 0; }
-  const SamplerState& sampler() const { return sampler_; }
-  HeightFetch fetch() const { return fetch_; }
+  bool has_hierarchy() const { return textures_->has_tree; }
+  int top_level() const { return textures_->has_tree ? textures_->tree.view().levels() - 1 : 0; }
+  const SamplerState& sampler() const { return textures_->sampler; }
+  HeightFetch fetch() const { return textures_->fetch; }
 
   // The filtered surface: the nearest or bilinear level-0 texel (the surfaces the exact reference knows), or
   // trilinear with `lod` (the talk's POM), which smooths heights with distance.
   simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const {
-    SamplerState state = sampler_;
-    if (fetch_ != HeightFetch::Trilinear) state.filter = fetch_ == HeightFetch::Point ? Filter::Point : Filter::Bilinear;
     simd::Float h[4];
-    sample(*height_, state, u, v, lod, h);
+    textures_->height.sample(u, v, lod, h);
     return h[0];
   }
 
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes).
   simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
-    const TextureView& tree = quadtree_ ? *quadtree_ : *height_;
-    const simd::Int size_x = simd::load_i32(tree.widths(), level, sampler_.fetch);
-    const simd::Int size_y = simd::load_i32(tree.heights(), level, sampler_.fetch);
     simd::Float texel[4];
-    load(tree, level, cx & (size_x - simd::Int(1)), cy & (size_y - simd::Int(1)), sampler_.fetch, texel);
+    textures_->tree.load_wrapped(level, cx, cy, texel);
     return texel[0];
   }
 
@@ -60,22 +64,13 @@ public:
   // LinearMipMapLinear over the max chain at (u, v) on `level` (the talk: "possible but may introduce some
   // artifacts"): smooths the maxima, so it is not conservative.
   simd::Float cell_max_filtered(const simd::Float& u, const simd::Float& v, const simd::Float& level) const {
-    SamplerState trilinear = sampler_;
-    trilinear.filter = Filter::Trilinear;
-    trilinear.address = AddressMode::Wrap;
-    trilinear.lod_bias = 0.0f;
-    trilinear.min_lod = 0.0f;
-    trilinear.max_lod = 16.0f;
     simd::Float texel[4];
-    sample(quadtree_ ? *quadtree_ : *height_, trilinear, u, v, level, texel);
+    textures_->tree.sample(u, v, level, texel);
     return texel[0];
   }
 
 private:
-  const TextureView* height_;
-  const TextureView* quadtree_;
-  SamplerState sampler_;
-  HeightFetch fetch_;
+  const HeightLayerTextures* textures_;
 };
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -12,9 +12,9 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const Float& v = in.varyings[kV];
   const UvDerivatives d = UvDerivatives::from(u, v, lod_mode_);
   Float albedo[4];
-  sample(albedo_, sampler_, u, v, lod_from_derivatives(albedo_, d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+  albedo_.sample(u, v, albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
   Float tangent_normal[4];
-  sample(normal_, sampler_, u, v, lod_from_derivatives(normal_, d.dudx, d.dvdx, d.dudy, d.dvdy), tangent_normal);
+  normal_.sample(u, v, normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), tangent_normal);
 
   const TangentFrame frame = TangentFrame::from(in);
   const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),

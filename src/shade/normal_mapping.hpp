@@ -12,13 +12,12 @@ public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
                        const LightingDesc& lighting, const SpecularFromAlbedo& specular, const LightRig& lights)
-      : ShadingProgram(variant, kBaseVaryingCount), albedo_(albedo), normal_(normal), sampler_(SamplerState::from(sampling)), lod_mode_(sampling.lod),
+      : ShadingProgram(variant, kBaseVaryingCount), albedo_(albedo, SamplerState::from(sampling)), normal_(normal, SamplerState::from(sampling)), lod_mode_(sampling.lod),
         lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
 
 private:
-  TextureView albedo_, normal_;
-  SamplerState sampler_;
+  TextureSampler albedo_, normal_;
   LodMode lod_mode_;
   LightingDesc lighting_;
   SpecularFromAlbedo specular_;

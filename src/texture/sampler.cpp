@@ -4,6 +4,8 @@
 #include "texture/sampler.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <utility>
 
 #include "core/det_math.hpp"
 #include "qdmr/core/error.hpp"
@@ -34,8 +36,12 @@ const float* srgb_table() {
 
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
+// Every helper below is inlined into sample_with/load_with, so where the key is a constant (an instantiation)
+// its branches fold away and where it is not (the generic sampler) they run per call.
+#define QDMR_INLINE [[gnu::always_inline]] inline
+
 // u reduced to one period of the address mode; exact (no rounding) for finite u.
-Float reduce(const Float& u, AddressMode mode) {
+QDMR_INLINE Float reduce(const Float& u, AddressMode mode) {
   switch (mode) {
     case AddressMode::Wrap: return u - xsimd::floor(u);
     case AddressMode::Mirror: return u - Float(2.0f) * xsimd::floor(u * Float(0.5f));
@@ -45,7 +51,7 @@ Float reduce(const Float& u, AddressMode mode) {
 }
 
 // Texel index i (within a period or two of the reduced coordinate) to a texel of [0, n).
-Int address(Int i, const Int& n, AddressMode mode) {
+QDMR_INLINE Int address(Int i, const Int& n, AddressMode mode) {
   switch (mode) {
     case AddressMode::Wrap:
       i = xsimd::select(i < Int(0), i + n, i);
@@ -66,42 +72,46 @@ struct LevelInfo {
   Int width, height, offset;
 };
 
-LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) {
+QDMR_INLINE LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) {
   return {simd::load_i32(view.widths(), level, path), simd::load_i32(view.heights(), level, path),
           simd::load_i32(view.offsets(), level, path)};
 }
 
-// Inlined into the filters: the format switch and fetch are uniform per call and cheap to specialise.
-[[gnu::always_inline]] inline void decode(const Texture& t, const Int& raw, FetchPath path, Float* out) {
+// Level 0 for every lane (the point and bilinear filters): no table lookups.
+QDMR_INLINE LevelInfo level_zero(const TextureView& view) {
+  return {Int(view.widths()[0]), Int(view.heights()[0]), Int(view.offsets()[0])};
+}
+
+QDMR_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
   const Float inv255(255.0f);
   const auto unorm8 = [&](const Int& byte, bool srgb) {
-    return srgb ? simd::load_f32(srgb_table(), byte, path) : xsimd::to_float(byte) / inv255;
+    return srgb ? simd::load_f32(srgb_table(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
   };
-  switch (t.format) {
-    case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), t.srgb); return;
+  switch (k.format) {
+    case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), k.srgb); return;
     case TexelFormat::RG8:
-      out[0] = unorm8(raw & Int(0xFF), t.srgb);
-      out[1] = unorm8((raw >> 8) & Int(0xFF), t.srgb);
+      out[0] = unorm8(raw & Int(0xFF), k.srgb);
+      out[1] = unorm8((raw >> 8) & Int(0xFF), k.srgb);
       return;
     case TexelFormat::RGBA8:
-      for (int c = 0; c < 4; ++c) out[c] = unorm8((raw >> (8 * c)) & Int(0xFF), t.srgb && c < 3);
+      for (int c = 0; c < 4; ++c) out[c] = unorm8((raw >> (8 * c)) & Int(0xFF), k.srgb && c < 3);
       return;
     case TexelFormat::R16: out[0] = xsimd::to_float(raw & Int(0xFFFF)) / Float(65535.0f); return;
     case TexelFormat::R32F: out[0] = xsimd::bitwise_cast<Float>(raw); return;
   }
 }
 
-[[gnu::always_inline]] inline void fetch(const TextureView& view, const LevelInfo& level, const Int& x, const Int& y,
-                                         FetchPath path, Float* out) {
+QDMR_INLINE void fetch(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& x, const Int& y,
+                       Float* out) {
   const Texture& t = view.texture();
-  const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(t.format));
+  const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(k.format));
   trace_fetch(t, level.offset, x, y);
-  decode(t, simd::load_bytes4(t.storage.data(), offset, path), path, out);
+  decode(k, simd::load_bytes4(t.storage.data(), offset, k.fetch), out);
 }
 
 // u * n split into the fp32 product p and its rounding error e, exactly: p + e = u * n (Dekker's product, with
 // -ffp-contract=off; |u| <= 2 and n <= 16384 keep every partial product far from overflow and underflow).
-void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
+QDMR_INLINE void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
   p = u * n;
   const Float split(4097.0f);  // 2^12 + 1: halves of 12 bits
   const Float uc = u * split, nc = n * split;
@@ -117,7 +127,7 @@ void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
 // 2^-bits (for the coordinates the address modes leave: u * n in [-n, 2n]), so q's floor is right unless q * 2^bits
 // is an integer that the exact x lies just below (docs/sampling.md, "Math modes"). The weight is q minus the
 // index in fixed point or in fp32 (1 when the exact index is the one below q).
-void split(const Float& u, const Float& n, float offset, int bits, bool exact, Int& index, Float& weight) {
+QDMR_INLINE void split(const Float& u, const Float& n, float offset, int bits, bool exact, Int& index, Float& weight) {
   Float p, e;
   if (exact)
     exact_product(u, n, p, e);
@@ -140,38 +150,169 @@ void split(const Float& u, const Float& n, float offset, int bits, bool exact, I
   weight = xsimd::to_float(f & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
 }
 
-void sample_level(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Int& level,
-                  bool linear, Float* out) {
-  const LevelInfo info = level_info(view, level, s.fetch);
+QDMR_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
+                              const LevelInfo& info, bool linear, Float* out) {
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
-  const int bits = fraction_bits(s.precision);
-  const int channels = view.texture().channels();
-  // Power-of-two sizes make fl(u * n) exact and fp32 floors right without fixed point: every mode agrees there.
-  const bool exact = s.math != MathMode::Sm3 && (bits > 0 || !view.power_of_two());
   if (!linear) {
     Int x, y;
     Float unused;
-    split(u, w, 0.0f, bits, exact, x, unused);
-    split(v, h, 0.0f, bits, exact, y, unused);
-    fetch(view, info, address(x, info.width, s.address), address(y, info.height, s.address), s.fetch, out);
+    split(u, w, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
+    split(v, h, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
+    fetch(view, k, info, address(x, info.width, k.address), address(y, info.height, k.address), out);
     return;
   }
   Int x0, y0;
   Float wx, wy;
-  split(u, w, 0.5f, bits, exact, x0, wx);
-  split(v, h, 0.5f, bits, exact, y0, wy);
-  const Int xa = address(x0, info.width, s.address), xb = address(x0 + Int(1), info.width, s.address);
-  const Int ya = address(y0, info.height, s.address), yb = address(y0 + Int(1), info.height, s.address);
+  split(u, w, 0.5f, k.fraction_bits, k.exact_texel, x0, wx);
+  split(v, h, 0.5f, k.fraction_bits, k.exact_texel, y0, wy);
+  const Int xa = address(x0, info.width, k.address), xb = address(x0 + Int(1), info.width, k.address);
+  const Int ya = address(y0, info.height, k.address), yb = address(y0 + Int(1), info.height, k.address);
   Float t00[4], t10[4], t01[4], t11[4];
-  fetch(view, info, xa, ya, s.fetch, t00);
-  fetch(view, info, xb, ya, s.fetch, t10);
-  fetch(view, info, xa, yb, s.fetch, t01);
-  fetch(view, info, xb, yb, s.fetch, t11);
-  for (int c = 0; c < channels; ++c) {
+  fetch(view, k, info, xa, ya, t00);
+  fetch(view, k, info, xb, ya, t10);
+  fetch(view, k, info, xa, yb, t01);
+  fetch(view, k, info, xb, yb, t11);
+  for (int c = 0; c < channel_count(k.format); ++c) {
     const Float top = t00[c] + (t10[c] - t00[c]) * wx;
     const Float bottom = t01[c] + (t11[c] - t01[c]) * wx;
     out[c] = top + (bottom - top) * wy;
   }
+}
+
+QDMR_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const SamplerState& s, const Float& u,
+                             const Float& v, const Float& lod, Float* out) {
+  const Mask finite = is_finite(u) & is_finite(v);
+  const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), k.address);
+  const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), k.address);
+  const bool linear = k.filter == Filter::Bilinear || k.filter == Filter::Trilinear || k.filter == Filter::LinearMipPoint;
+  const int channels = channel_count(k.format);
+  if (k.filter == Filter::Point || k.filter == Filter::Bilinear) {
+    sample_level(view, k, ru, rv, level_zero(view), linear, out);
+  } else {
+    const Float last(float(view.levels() - 1));
+    Float l = lod + Float(s.lod_bias);
+    l = xsimd::select(l == l, l, last);  // NaN: the coarsest level, as for non-finite derivatives
+    l = xsimd::min(xsimd::max(l, Float(s.min_lod)), Float(s.max_lod));
+    l = xsimd::min(xsimd::max(l, Float(0.0f)), last);
+    const int bits = k.fraction_bits;
+    if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
+    if (k.filter == Filter::PointMipPoint || k.filter == Filter::LinearMipPoint) {
+      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f))), k.fetch), linear, out);
+    } else {  // trilinear, point-mip-linear
+      const Float l0 = xsimd::floor(l), f = l - l0;
+      const Int i0 = xsimd::to_int(l0);
+      Float fine[4], coarse[4];
+      sample_level(view, k, ru, rv, level_info(view, i0, k.fetch), linear, fine);
+      sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1)), k.fetch), linear,
+                   coarse);
+      for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
+    }
+  }
+  for (int c = 0; c < channels; ++c) out[c] = xsimd::select(finite, out[c], Float(view.first_texel()[std::size_t(c)]));
+}
+
+// wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.
+QDMR_INLINE void load_with(const SamplerKey& k, bool wrap, const TextureView& view, const Int& level, const Int& x,
+                           const Int& y, Float* out) {
+  const Int l = xsimd::min(xsimd::max(level, Int(0)), Int(view.levels() - 1));
+  const LevelInfo info = level_info(view, l, k.fetch);
+  if (wrap) {
+    fetch(view, k, info, x & (info.width - Int(1)), y & (info.height - Int(1)), out);
+    return;
+  }
+  const Int cx = xsimd::min(xsimd::max(x, Int(0)), info.width - Int(1));
+  const Int cy = xsimd::min(xsimd::max(y, Int(0)), info.height - Int(1));
+  fetch(view, k, info, cx, cy, out);
+}
+
+template <SamplerKey K>
+void sample_fixed(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Float& lod,
+                  Float* out) {
+  sample_with(K, view, s, u, v, lod, out);
+}
+
+template <SamplerKey K, bool Wrap>
+void load_fixed(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath, Float* out) {
+  load_with(K, Wrap, view, level, x, y, out);
+}
+
+void load_generic_wrapped(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path,
+                          Float* out) {
+  SamplerKey k = sampler_key(view, SamplerState{});
+  k.fetch = path;
+  load_with(k, true, view, level, x, y, out);
+}
+
+#undef QDMR_INLINE
+
+// The common keys, instantiated: the filters programs use for colour and height (point, bilinear, trilinear) with
+// wrap addressing, exact or 8-bit weights, either texel-coordinate rounding, the formats textures and height maps
+// come in, and this build's default fetch path. Everything else (clamp, mirror, 6-bit weights, the mip-point
+// filters, fp32 heights, the portable fetch path on a gather build) runs the generic sampler.
+constexpr Filter kCommonFilters[] = {Filter::Point, Filter::Bilinear, Filter::Trilinear};
+constexpr int kCommonBits[] = {0, 8};
+constexpr std::pair<TexelFormat, bool> kCommonFormats[] = {
+    {TexelFormat::R8, false}, {TexelFormat::RG8, false}, {TexelFormat::RGBA8, false}, {TexelFormat::RGBA8, true},
+    {TexelFormat::R16, false}};
+constexpr FetchPath kDefaultFetch = simd::kHasHardwareGather ? FetchPath::Gather : FetchPath::Portable;
+constexpr std::size_t kFormatCount = std::size(kCommonFormats);
+constexpr std::size_t kCommonKeys = std::size(kCommonFilters) * std::size(kCommonBits) * 2 * kFormatCount;
+
+constexpr SamplerKey common_key(std::size_t i) {
+  SamplerKey k;
+  k.format = kCommonFormats[i % kFormatCount].first;
+  k.srgb = kCommonFormats[i % kFormatCount].second;
+  i /= kFormatCount;
+  k.exact_texel = i % 2 == 1;
+  i /= 2;
+  k.fraction_bits = kCommonBits[i % std::size(kCommonBits)];
+  i /= std::size(kCommonBits);
+  k.filter = kCommonFilters[i];
+  k.address = AddressMode::Wrap;
+  k.fetch = kDefaultFetch;
+  return k;
+}
+
+struct SampleEntry {
+  SamplerKey key;
+  SampleFunction function;
+};
+
+template <std::size_t... I>
+constexpr std::array<SampleEntry, sizeof...(I)> common_samplers(std::index_sequence<I...>) {
+  return {{{common_key(I), &sample_fixed<common_key(I)>}...}};
+}
+constexpr std::array<SampleEntry, kCommonKeys> kCommonSamplers = common_samplers(std::make_index_sequence<kCommonKeys>());
+
+// Loads depend on the format only.
+constexpr SamplerKey load_key(TexelFormat format, bool srgb) {
+  SamplerKey k;
+  k.format = format;
+  k.srgb = srgb;
+  k.fetch = kDefaultFetch;
+  return k;
+}
+
+struct LoadEntry {
+  SamplerKey key;
+  LoadFunction clamped, wrapped;
+};
+
+template <std::size_t... I>
+constexpr std::array<LoadEntry, sizeof...(I) + 1> format_loaders(std::index_sequence<I...>) {
+  return {{{load_key(kCommonFormats[I].first, kCommonFormats[I].second),
+            &load_fixed<load_key(kCommonFormats[I].first, kCommonFormats[I].second), false>,
+            &load_fixed<load_key(kCommonFormats[I].first, kCommonFormats[I].second), true>}...,
+           {load_key(TexelFormat::R32F, false), &load_fixed<load_key(TexelFormat::R32F, false), false>,
+            &load_fixed<load_key(TexelFormat::R32F, false), true>}}};
+}
+constexpr auto kLoaders = format_loaders(std::make_index_sequence<kFormatCount>());
+
+const LoadEntry* loader_for(const TextureView& view, FetchPath path) {
+  if (path != kDefaultFetch) return nullptr;
+  for (const LoadEntry& e : kLoaders)
+    if (e.key.format == view.texture().format && e.key.srgb == view.texture().srgb) return &e;
+  return nullptr;
 }
 
 }  // namespace
@@ -202,47 +343,43 @@ Float lod_from_derivatives(const TextureView& view, const Float& dudx, const Flo
   return xsimd::select(is_finite(px) & is_finite(py), xsimd::select(tiny, Float(kMinLod), lod), last);
 }
 
+SamplerKey sampler_key(const TextureView& view, const SamplerState& s) {
+  SamplerKey k;
+  k.filter = s.filter;
+  k.address = s.address;
+  k.fraction_bits = fraction_bits(s.precision);
+  // Power-of-two sizes make fl(u * n) exact and fp32 floors right without fixed point: every mode agrees there.
+  k.exact_texel = s.math != MathMode::Sm3 && (k.fraction_bits > 0 || !view.power_of_two());
+  k.format = view.texture().format;
+  k.srgb = view.texture().srgb;
+  k.fetch = s.fetch;
+  return k;
+}
+
 void sample(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Float& lod,
             Float* out) {
-  const Mask finite = is_finite(u) & is_finite(v);
-  const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), s.address);
-  const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), s.address);
-  const Float last(float(view.levels() - 1));
-  Float l = lod + Float(s.lod_bias);
-  l = xsimd::select(l == l, l, last);  // NaN: the coarsest level, as for non-finite derivatives
-  l = xsimd::min(xsimd::max(l, Float(s.min_lod)), Float(s.max_lod));
-  l = xsimd::min(xsimd::max(l, Float(0.0f)), last);
-  const int bits = fraction_bits(s.precision);
-  if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
-  const bool linear = s.filter == Filter::Bilinear || s.filter == Filter::Trilinear || s.filter == Filter::LinearMipPoint;
-  switch (s.filter) {
-    case Filter::Point:
-    case Filter::Bilinear: sample_level(view, s, ru, rv, Int(0), linear, out); break;
-    case Filter::PointMipPoint:
-    case Filter::LinearMipPoint:
-      sample_level(view, s, ru, rv, xsimd::to_int(xsimd::floor(l + Float(0.5f))), linear, out);
-      break;
-    case Filter::Trilinear:
-    case Filter::PointMipLinear: {
-      const Float l0 = xsimd::floor(l), f = l - l0;
-      const Int i0 = xsimd::to_int(l0);
-      Float fine[4], coarse[4];
-      sample_level(view, s, ru, rv, i0, linear, fine);
-      sample_level(view, s, ru, rv, xsimd::min(i0 + Int(1), Int(view.levels() - 1)), linear, coarse);
-      for (int c = 0; c < view.texture().channels(); ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
-      break;
-    }
-  }
-  for (int c = 0; c < view.texture().channels(); ++c)
-    out[c] = xsimd::select(finite, out[c], Float(view.first_texel()[std::size_t(c)]));
+  sample_with(sampler_key(view, s), view, s, u, v, lod, out);
 }
 
 void load(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path, Float* out) {
-  const Int l = xsimd::min(xsimd::max(level, Int(0)), Int(view.levels() - 1));
-  const LevelInfo info = level_info(view, l, path);
-  const Int cx = xsimd::min(xsimd::max(x, Int(0)), info.width - Int(1));
-  const Int cy = xsimd::min(xsimd::max(y, Int(0)), info.height - Int(1));
-  fetch(view, info, cx, cy, path, out);
+  SamplerKey k = sampler_key(view, SamplerState{});
+  k.fetch = path;
+  load_with(k, false, view, level, x, y, out);
+}
+
+SampleFunction sample_function(const SamplerKey& key) {
+  for (const SampleEntry& e : kCommonSamplers)
+    if (e.key == key) return e.function;
+  return &sample;
+}
+
+bool is_specialised(const SamplerKey& key) { return sample_function(key) != &sample; }
+
+TextureSampler::TextureSampler(const Texture& texture, const SamplerState& state)
+    : view_(texture), state_(state), sample_(sample_function(sampler_key(view_, state_))) {
+  const LoadEntry* e = loader_for(view_, state_.fetch);
+  load_ = e ? e->clamped : static_cast<LoadFunction>(&qdmr::QDMR_ISA::load);
+  load_wrapped_ = e ? e->wrapped : &load_generic_wrapped;
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -59,6 +59,20 @@ struct SamplerState {
   }
 };
 
+// What the sampling code branches on, from a texture and a sampler state; fixed per material, so a program binds
+// it once (TextureSampler) and its inner loops run code specialised for it.
+struct SamplerKey {
+  Filter filter = Filter::Trilinear;
+  AddressMode address = AddressMode::Wrap;
+  int fraction_bits = 0;     // of texel coordinates, weights and LOD: 0 (exact floats), 8 or 6 (SamplePrecision)
+  bool exact_texel = false;  // floor the exact texel coordinate, not the fp32 one (split() in sampler.cpp)
+  TexelFormat format = TexelFormat::RGBA8;
+  bool srgb = false;
+  simd::FetchPath fetch = simd::FetchPath::Portable;
+  constexpr bool operator==(const SamplerKey&) const = default;
+};
+SamplerKey sampler_key(const TextureView& texture, const SamplerState& state);
+
 // LOD in level-0 texels from UV derivatives, GL formula: log2(max(|d(uv*size)/dx|, |d(uv*size)/dy|)).
 // A zero footprint gives -64; non-finite derivatives give the last level.
 simd::Float lod_from_derivatives(const TextureView& texture, const simd::Float& dudx, const simd::Float& dvdx,
@@ -66,12 +80,55 @@ simd::Float lod_from_derivatives(const TextureView& texture, const simd::Float& 
 
 // Samples every channel (1..4) at (u, v) with one LOD per lane (bias and clamps applied here; ignored by the
 // level-0 filters point and bilinear); out[c] receives channel c. Lanes with non-finite u or v return
-// level-0 texel (0, 0).
+// level-0 texel (0, 0). The generic sampler: it branches on the options per call (TextureSampler does not).
 void sample(const TextureView& texture, const SamplerState& state, const simd::Float& u, const simd::Float& v,
             const simd::Float& lod, simd::Float* out);
 
 // Texel fetch without filtering (SM4 Load): level, x, y per lane, clamped into range.
 void load(const TextureView& texture, const simd::Int& level, const simd::Int& x, const simd::Int& y,
           simd::FetchPath fetch, simd::Float* out);
+
+using SampleFunction = void (*)(const TextureView&, const SamplerState&, const simd::Float& u, const simd::Float& v,
+                                const simd::Float& lod, simd::Float* out);
+using LoadFunction = void (*)(const TextureView&, const simd::Int& level, const simd::Int& x, const simd::Int& y,
+                              simd::FetchPath fetch, simd::Float* out);
+
+// The sampling code for a key: an instantiation where sampler.cpp lists the key as common (docs/architecture.md,
+// "Specialised samplers"), the generic sampler otherwise. Both give the same bits.
+SampleFunction sample_function(const SamplerKey& key);
+bool is_specialised(const SamplerKey& key);
+
+// A texture bound to the sampler state a material fixes for it, with sampling and loading specialised for both:
+// what shading programs hold, built once per program, so no per-pixel code tests a per-material option.
+class TextureSampler {
+public:
+  TextureSampler(const Texture& texture, const SamplerState& state);
+
+  const TextureView& view() const { return view_; }
+  const Texture& texture() const { return view_.texture(); }
+  const SamplerState& state() const { return state_; }
+  bool specialised() const { return is_specialised(sampler_key(view_, state_)); }
+
+  void sample(const simd::Float& u, const simd::Float& v, const simd::Float& lod, simd::Float* out) const {
+    sample_(view_, state_, u, v, lod, out);
+  }
+  simd::Float lod(const simd::Float& dudx, const simd::Float& dvdx, const simd::Float& dudy, const simd::Float& dvdy) const {
+    return lod_from_derivatives(view_, dudx, dvdx, dudy, dvdy);
+  }
+  // load() above, with this texture's format fixed.
+  void load(const simd::Int& level, const simd::Int& x, const simd::Int& y, simd::Float* out) const {
+    load_(view_, level, x, y, state_.fetch, out);
+  }
+  // load() of cell (x, y) of `level` with the indices wrapped into the level (power-of-two sizes only).
+  void load_wrapped(const simd::Int& level, const simd::Int& x, const simd::Int& y, simd::Float* out) const {
+    load_wrapped_(view_, level, x, y, state_.fetch, out);
+  }
+
+private:
+  TextureView view_;
+  SamplerState state_;
+  SampleFunction sample_;
+  LoadFunction load_, load_wrapped_;
+};
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -32,9 +32,8 @@ public:
   AoHarness(const Image& heights, HeightFetch fetch)
       : height_(make_mip_texture(heights, TexelFormat::R32F, false, MipReduce::Box)),
         quadtree_(make_mip_texture(heights, TexelFormat::R32F, false, MipReduce::Max)),
-        height_view_(height_),
-        quadtree_view_(quadtree_),
-        surface_(height_view_, &quadtree_view_, SamplerState{}, fetch) {}
+        textures_(height_, &quadtree_, SamplerState{}, fetch),
+        surface_(textures_) {}
   AoHarness(const AoHarness&) = delete;
   AoHarness& operator=(const AoHarness&) = delete;
 
@@ -61,7 +60,7 @@ public:
 
 private:
   Texture height_, quadtree_;
-  TextureView height_view_, quadtree_view_;
+  HeightLayerTextures textures_;
   SingleLayerSurface surface_;
 };
 

@@ -298,20 +298,17 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
     box.push_back(make_mip_texture(h, TexelFormat::R32F, false, MipReduce::Box));
     maxima.push_back(make_mip_texture(h, TexelFormat::R32F, false, MipReduce::Max));
   }
-  std::vector<TextureView> box_views, max_views;
-  for (int i = 0; i < kLayers; ++i) {
-    box_views.emplace_back(box[std::size_t(i)]);
-    max_views.emplace_back(maxima[std::size_t(i)]);
-  }
   SamplerState sampler;
   sampler.filter = Filter::Point;
-  std::vector<SingleLayerSurface> layers;
-  for (int i = 0; i < kLayers; ++i) layers.emplace_back(box_views[std::size_t(i)], &max_views[std::size_t(i)], sampler, HeightFetch::Point);
-  const TextureView weight_view(weights);
+  std::vector<HeightLayerTextures> layer_textures;
+  for (int i = 0; i < kLayers; ++i)
+    layer_textures.emplace_back(box[std::size_t(i)], &maxima[std::size_t(i)], sampler, HeightFetch::Point);
+  std::vector<SingleLayerSurface> layers(layer_textures.begin(), layer_textures.end());
+  const TextureSampler weight_view(weights, weight_sampler_state(sampler));
   std::vector<const Texture*> box_pointers;
   for (const Texture& t : box) box_pointers.push_back(&t);
   const Texture combined = combined_quadtree(combined_surface(box_pointers, weights, 2, BlendOperator::Height));
-  const TextureView combined_view(combined);
+  const TextureSampler combined_view(combined, sampler);
 
   HeightField field;  // the two repeats, as one map
   field.width = field.height = 2 * n;

@@ -43,8 +43,8 @@ class ShadowHarness {
 public:
   ShadowHarness(const HeightField& field, HeightFetch fetch = HeightFetch::Point)
       : height_(make_mip_texture(to_image(field), TexelFormat::R32F, false, MipReduce::Box)),
-        tree_(make_mip_texture(to_image(field), TexelFormat::R32F, false, MipReduce::Max)), height_view_(height_),
-        tree_view_(tree_), fetch_(fetch), field_(field) {
+        tree_(make_mip_texture(to_image(field), TexelFormat::R32F, false, MipReduce::Max)), fetch_(fetch),
+        field_(field) {
     for (double& h : field_.h) h = double(float(h));
   }
   ShadowHarness(const ShadowHarness&) = delete;
@@ -55,7 +55,8 @@ public:
   std::vector<Lane> run(const ShadowDesc& desc, float ds, const std::vector<Start>& starts, bool hierarchy = true) const {
     SamplerState sampler;
     sampler.address = AddressMode::Wrap;
-    const SingleLayerSurface surface(height_view_, hierarchy ? &tree_view_ : nullptr, sampler, fetch_);
+    const HeightLayerTextures textures(height_, hierarchy ? &tree_ : nullptr, sampler, fetch_);
+    const SingleLayerSurface surface(textures);
     std::vector<Lane> out;
     for (std::size_t first = 0; first < starts.size(); first += simd::kLanes) {
       alignas(64) float u[simd::kLanes], v[simd::kLanes], s[simd::kLanes], du[simd::kLanes], dv[simd::kLanes];
@@ -78,7 +79,6 @@ public:
 
 private:
   Texture height_, tree_;
-  TextureView height_view_, tree_view_;
   HeightFetch fetch_;
   HeightField field_;
 };

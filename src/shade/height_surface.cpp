@@ -1,0 +1,30 @@
+#include "shade/height_surface.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+namespace {
+
+SamplerState height_fetch_state(SamplerState state, HeightFetch fetch) {
+  if (fetch != HeightFetch::Trilinear) state.filter = fetch == HeightFetch::Point ? Filter::Point : Filter::Bilinear;
+  return state;
+}
+
+SamplerState max_chain_state(SamplerState state) {
+  state.filter = Filter::Trilinear;
+  state.address = AddressMode::Wrap;
+  state.lod_bias = 0.0f;
+  state.min_lod = 0.0f;
+  state.max_lod = 16.0f;
+  return state;
+}
+
+}  // namespace
+
+HeightLayerTextures::HeightLayerTextures(const Texture& height_texture, const Texture* quadtree,
+                                         const SamplerState& material_sampler, HeightFetch height_fetch)
+    : height(height_texture, height_fetch_state(material_sampler, height_fetch)),
+      tree(quadtree ? *quadtree : height_texture, max_chain_state(material_sampler)),
+      has_tree(quadtree != nullptr),
+      sampler(material_sampler),
+      fetch(height_fetch) {}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE
