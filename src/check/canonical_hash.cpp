@@ -1,17 +1,16 @@
 #include "qdmr/check/canonical_hash.hpp"
 
-#include <cctype>
 #include <bit>
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
-#include <OpenImageIO/hash.h>
+#include "core/sha1.hpp"
 
 namespace qdmr {
 
 std::string canonical_hash(int width, int height, int channels, std::span<const float> pixels) {
-  OIIO::SHA1 sha;
+  Sha1 sha;
   const std::string header = "qdmr-canonical-1 " + std::to_string(width) + " " + std::to_string(height) + " " +
                              std::to_string(channels) + "\n";
   sha.append(header.data(), header.size());
@@ -27,9 +26,7 @@ std::string canonical_hash(int width, int height, int channels, std::span<const 
     }
     sha.append(bytes.data(), count * 4);
   }
-  std::string digest = sha.digest();  // OpenImageIO writes upper case
-  for (char& c : digest) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return "sha1:" + digest;
+  return "sha1:" + sha.hex_digest();
 }
 
 }  // namespace qdmr

@@ -5,8 +5,7 @@
 #include <set>
 #include <sstream>
 
-#include <OpenImageIO/hash.h>
-
+#include "core/sha1.hpp"
 #include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
@@ -253,7 +252,7 @@ StudySpec read_study_spec(const std::filesystem::path& file) {
 
   // The hash of what decides the rows: the canonical JSON (sorted keys) of the document.
   const std::string canonical = spec.document.dump();
-  spec.hash = "sha1:" + OIIO::SHA1::digest(canonical.data(), canonical.size());
+  spec.hash = "sha1:" + sha1_hex(canonical.data(), canonical.size());
   for (char& c : spec.hash) c = char(std::tolower(static_cast<unsigned char>(c)));
   return spec;
 }
