@@ -36,3 +36,9 @@ def render(qdmr, scene, sets, width, height, tmp, env=None, extra=()):
     # processes share the cores.
     result["cpu_ms"] = (usage.ru_utime + usage.ru_stime) * 1000.0
     return result
+
+
+def bits_version(qdmr):
+    """The bits version of a qdmr build ("qdmr 0.1.0 (bits version 2)"), for the manifests a benchmark writes."""
+    out = subprocess.run([qdmr, "--version"], check=True, capture_output=True, text=True).stdout
+    return int(out.rsplit("bits version", 1)[1].strip(" )\n"))

@@ -45,7 +45,7 @@ def main():
                                "set": {"/camera/fov_deg": fov}})
         manifest = os.path.join(tmp, "m.json")
         with open(manifest, "w") as f:
-            json.dump({"bits_version": 1, "defaults": {"width": 320, "height": 180}, "checks": checks}, f)
+            json.dump({"bits_version": bench_util.bits_version(qdmr), "defaults": {"width": 320, "height": 180}, "checks": checks}, f)
         subprocess.run([qdmr, "check", manifest, "--update"], check=True, stdout=subprocess.DEVNULL)
 
         results = os.path.join(tmp, "r.json")

@@ -53,6 +53,14 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s);
     const Mask to_plane = above & (top_depth <= t_wall);
     s = xsimd::select(to_plane, top_depth, s);
+    if constexpr (!V::filtered_max) {
+      // On the cell's top plane the ray is at its highest point: the hit at the last level, else descend now, as
+      // the next iteration would after reading the same cell again (a filtered max moves with the ray: it reads).
+      const Mask plane_hit = to_plane & float_mask(at_stop);
+      active = active & !plane_hit;
+      const IntMask plane_descend = int_mask(to_plane & !plane_hit);
+      if (xsimd::any(plane_descend)) descend_to_child<fp64>(plane_descend, s, x0, y0, dx, dy, level, cx, cy);
+    }
     const Mask cross = above & !to_plane;
     s = xsimd::select(cross, t_wall, s);
     const IntMask cross_i = int_mask(cross);

@@ -132,14 +132,14 @@ TEST(CheckCommand, AnotherBitsVersionFailsWithOneClearLineNotPixelDifferences) {
 
 TEST(CheckCommand, SkipIfMissingSkipsAndBadManifestsExitTwo) {
   TempDir dir;
-  write_file(dir / "m.json", R"({"bits_version": 1, "checks": [
+  write_file(dir / "m.json", R"({"bits_version": )" + std::to_string(kBitsVersion) + R"(, "checks": [
     {"name": "big", "scene": ")" + plane() + R"(", "skip_if_missing": ["no/such/asset.png"]}]})");
   const CommandResult skipped = check(dir, {"--junit", (dir / "j.xml").string()});
   EXPECT_EQ(skipped.exit_code, 0) << skipped.output;
   EXPECT_NE(skipped.output.find("SKIP    big"), std::string::npos);
   EXPECT_NE(read_file(dir / "j.xml").find("<skipped message=\"skipped: "), std::string::npos);
 
-  write_file(dir / "m.json", R"({"bits_version": 1, "checks": [{"name": "x", "scene": ")" + plane() + R"(", "outptus": []}]})");
+  write_file(dir / "m.json", R"({"bits_version": )" + std::to_string(kBitsVersion) + R"(, "checks": [{"name": "x", "scene": ")" + plane() + R"(", "outptus": []}]})");
   const CommandResult bad = check(dir, {});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.output.find("m.json: /checks/0: unknown key 'outptus'; did you mean 'outputs'?"), std::string::npos) << bad.output;

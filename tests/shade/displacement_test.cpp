@@ -1,6 +1,7 @@
 // Displacement techniques against the exact reference, and their termination at the extremes.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstring>
 
 #include <nlohmann/json.hpp>
@@ -39,6 +40,26 @@ TEST(Qdm, HitsTheBoxSurfaceExactlyWithEveryLevelUpPolicy) {
       // The bound. The fp32 ray itself (direction from a normalised fp32 view vector, positions
       // uv0 + d * s) is good to ~1e-5 texel here, so 1e-3 leaves room without hiding a wrong cell.
       EXPECT_LE(worst, 1e-3) << field.name << " level_up " << int(policy);
+    }
+  }
+}
+
+// One read per cell visited: a ray that reaches a cell's top plane descends in the same iteration (it does not
+// read the cell again to find itself at its top). Straight down into a flat surface of a 2^k map the ray meets
+// one top plane per level: k + 1 iterations (k + 2 when each plane cost a second read), the hit at its depth.
+TEST(Qdm, ReadsEachLevelOnceOnTheWayDown) {
+  TechniqueDesc t;
+  t.kind = TechniqueKind::Qdm;
+  t.refinement = QdmRefinement::None;
+  t.depth_scale = 0.1f;
+  t.max_iterations = 1000;
+  for (int size : {1, 2, 64, 256}) {
+    const int levels = std::countr_zero(unsigned(size)) + 1;
+    const TechniqueHarness harness(filled(size, 0.5f), t);
+    const std::vector<TechniqueResult> results = harness.run({{0.3, 0.6, 0.0, 0.0}, {0.71, 0.2, 0.0, 0.0}});
+    for (const TechniqueResult& r : results) {
+      EXPECT_EQ(r.iterations, levels) << size;
+      EXPECT_NEAR(r.hit_depth, 0.05, 1e-7) << size;  // ds (1 - h)
     }
   }
 }
