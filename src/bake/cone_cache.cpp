@@ -1,5 +1,4 @@
 // Cone maps on disk: the content-hash cache of baked maps and the EXR the `qdmr bake cone` command writes.
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
@@ -66,9 +65,8 @@ void write_cone_map_exr(const ConeMap& map, const std::filesystem::path& file) {
   for (int y = 0; y < map.height; ++y)
     std::copy_n(map.ratio.begin() + std::ptrdiff_t(y) * map.width, map.width,
                 rows.begin() + std::ptrdiff_t(map.height - 1 - y) * map.width);
-  OIIO::ImageSpec spec(map.width, map.height, 1, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"R"};
-  write_image_file(file, spec, OIIO::TypeDesc::FLOAT, rows.data(), "cone map");
+  const imageio::WriteSpec spec{map.width, map.height, 1, imageio::PixelType::Float, {"R"}, {}, {}};
+  write_image_file(file, spec, rows.data(), "cone map");
 }
 
 }  // namespace qdmr

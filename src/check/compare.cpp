@@ -7,9 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imageio.h>
-#include <OpenImageIO/imagebufalgo.h>
+#include "imageio/backend.hpp"
 
 namespace qdmr {
 namespace {
@@ -160,9 +158,10 @@ Image read_comparable_image(const std::filesystem::path& file, int* bits_version
                      image.texels.begin() + std::ptrdiff_t(std::size_t(image.height - 1 - y) * row));
   if (bits_version) {
     *bits_version = 0;
-    if (auto in = OIIO::ImageInput::open(file.string())) {
-      const std::string text = in->spec().get_string_attribute("qdmr:bits_version");
-      const std::string software = in->spec().get_string_attribute("Software");  // TIFF: "qdmr 0.1.0 (bits version 1)"
+    std::string error;
+    if (const imageio::ReadFile in(file.string(), error); in) {
+      const std::string& text = in.spec().bits_version;
+      const std::string& software = in.spec().software;  // TIFF: "qdmr 0.1.0 (bits version 1)"
       const auto at = software.find("(bits version ");
       if (!text.empty())
         *bits_version = std::atoi(text.c_str());
@@ -174,8 +173,6 @@ Image read_comparable_image(const std::filesystem::path& file, int* bits_version
 }
 
 Image difference_heatmap(const Image& rendered, const Image& golden, double scale) {
-  const OIIO::ImageSpec spec(rendered.width, rendered.height, 1, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf delta(spec);
   std::vector<float> values(std::size_t(rendered.width) * std::size_t(rendered.height));
   std::vector<bool> nonfinite(values.size());
   for (std::size_t p = 0; p < values.size(); ++p) {
@@ -187,11 +184,8 @@ Image difference_heatmap(const Image& rendered, const Image& golden, double scal
     nonfinite[p] = std::isinf(pixel_max);
     values[p] = scale > 0 ? float(std::min(1.0, pixel_max / scale)) : 0.0f;
   }
-  delta.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values.data());
-  const OIIO::ImageBuf colored = OIIO::ImageBufAlgo::color_map(delta, 0, "magma");
   Image heatmap(rendered.width, rendered.height, 3);
-  colored.get_pixels(OIIO::ROI(0, rendered.width, 0, rendered.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT,
-                     heatmap.texels.data());
+  imageio::backend().color_map(values.data(), rendered.width, rendered.height, "magma", heatmap.texels.data());
   for (std::size_t p = 0; p < values.size(); ++p)
     if (nonfinite[p]) std::fill_n(heatmap.texels.begin() + std::ptrdiff_t(3 * p), 3, 1.0f);
   return heatmap;

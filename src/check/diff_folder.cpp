@@ -57,9 +57,8 @@ void write_display_png(const Image& image, const std::filesystem::path& file) {
     const float v = std::isfinite(image.texels[i]) ? std::clamp(image.texels[i], 0.0f, 1.0f) : 0.0f;
     bytes[i] = std::uint8_t(std::floor(v * 255.0f + 0.5f));
   }
-  OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  write_image_file(file, spec, OIIO::TypeDesc::UINT8, bytes.data(), "image");
+  const imageio::WriteSpec spec{image.width, image.height, image.channels, imageio::PixelType::UInt8, {}, {{"oiio:ColorSpace", "sRGB"}}, {}};
+  write_image_file(file, spec, bytes.data(), "image");
 }
 
 std::string delta_histogram_svg(const std::vector<std::int64_t>& bins, const std::string& title) {

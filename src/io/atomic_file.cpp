@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <charconv>
@@ -169,19 +170,18 @@ void write_atomically(const std::filesystem::path& file, const std::string& what
   throw Error(file.string(), "cannot write " + what + ": " + message);
 }
 
-void write_image_file(const std::filesystem::path& file, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
-                      const void* data, const std::string& what) {
+void write_image_file(const std::filesystem::path& file, const imageio::WriteSpec& spec, const void* data,
+                      const std::string& what) {
   // Same pixels, same bytes: OpenImageIO 2.4 stamps EXR (capDate) and TIFF (tag 306) files with the current time
   // when the spec has no DateTime; an empty DateTime is written as an empty string instead. A caller that wants a
   // time in the file sets DateTime itself (write_frame's WriteOptions::timestamp).
-  OIIO::ImageSpec stamped = spec;
-  if (!spec.find_attribute("DateTime")) stamped.attribute("DateTime", "");
+  imageio::WriteSpec stamped = spec;
+  if (std::none_of(spec.strings.begin(), spec.strings.end(), [](const auto& s) { return s.first == "DateTime"; }))
+    stamped.strings.emplace_back("DateTime", "");
+  const imageio::Backend& backend = imageio::backend();  // loaded before the temporary exists
   write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
-    auto output = OIIO::ImageOutput::create(temporary.string());
-    if (!output) return OIIO::geterror();
-    if (output->open(temporary.string(), stamped) && output->write_image(format, data) && output->close()) return "";
-    const std::string message = output->geterror();
-    return message.empty() ? "unknown error" : message;
+    std::string error;
+    return backend.write(temporary.string(), stamped, data, error) ? "" : error;
   });
 }
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
+#include "imageio/backend.hpp"
 
 namespace qdmr {
 
@@ -22,9 +22,10 @@ namespace qdmr {
 void write_atomically(const std::filesystem::path& file, const std::string& what,
                       const std::function<std::string(const std::filesystem::path& temporary)>& write);
 
-// Writes no wall-clock time unless `spec` carries a DateTime attribute (see atomic_file.cpp).
-void write_image_file(const std::filesystem::path& file, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
-                      const void* data, const std::string& what);
+// Writes no wall-clock time unless `spec` carries a DateTime attribute (see atomic_file.cpp). `data` holds
+// spec.width x spec.height pixels of spec.channels values of spec.type, top row first.
+void write_image_file(const std::filesystem::path& file, const imageio::WriteSpec& spec, const void* data,
+                      const std::string& what);
 
 void write_text_file(const std::filesystem::path& file, const std::string& text);
 

@@ -7,7 +7,6 @@
 #include <memory>
 #include <sstream>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "program/variant.hpp"

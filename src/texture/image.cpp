@@ -1,7 +1,5 @@
 #include "qdmr/texture/image.hpp"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
@@ -10,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "imageio/backend.hpp"
 #include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
@@ -83,12 +82,14 @@ Error read_error(const std::string& where, const std::filesystem::path& file, st
 
 // The file checked (kind, size), opened, and its header checked (format, size, channels, PNM fields, a
 // JPEG's end marker): nothing decoded yet.
-std::unique_ptr<OIIO::ImageInput> open_checked(const std::filesystem::path& file, const std::string& where) {
+std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& file, const std::string& where) {
   const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const std::uint64_t size = check_input_file(file, where, InputKind::Image);
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw fail(OIIO::geterror());
-  const std::string format = in->format_name();
+  std::string error;
+  auto in = std::make_unique<imageio::ReadFile>(file.string(), error);
+  if (!*in) throw fail(error);
+  const imageio::ReadSpec& spec = in->spec();
+  const std::string& format = spec.format;
   if (std::find(std::begin(kFormats), std::end(kFormats), format) == std::end(kFormats))
     throw fail("unsupported image format '" + format + "' (textures are PNG, JPEG, OpenEXR, TIFF or PGM/PPM)");
   if (format == "pnm")
@@ -103,63 +104,59 @@ std::unique_ptr<OIIO::ImageInput> open_checked(const std::filesystem::path& file
   if (format == "png" && bytes_of(file, -std::int64_t(std::min<std::uint64_t>(size, 12)), 12) !=
                              std::string("\0\0\0\0IEND\xAE\x42\x60\x82", 12))
     throw fail("truncated PNG (it does not end with an IEND chunk)");
-  const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.width > limits::kMaxTextureSide ||
       spec.height > limits::kMaxTextureSide)
     throw fail("size " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " is outside 1.." +
                std::to_string(limits::kMaxTextureSide));
   if (spec.depth > 1) throw fail("volume images are not supported");
-  if (spec.nchannels < 1 || spec.nchannels > 4)
-    throw fail(std::to_string(spec.nchannels) + " channels (textures take 1 to 4)");
+  if (spec.channels < 1 || spec.channels > 4)
+    throw fail(std::to_string(spec.channels) + " channels (textures take 1 to 4)");
   return in;
 }
 
-int source_bits(const OIIO::ImageSpec& spec) {
-  const bool uniform = spec.channelformats.empty();
-  return uniform && spec.format == OIIO::TypeDesc::UINT8 ? 8 : uniform && spec.format == OIIO::TypeDesc::UINT16 ? 16 : 32;
+int source_bits(const imageio::ReadSpec& spec) {
+  return spec.uniform && spec.type == imageio::PixelType::UInt8 ? 8 : spec.uniform && spec.type == imageio::PixelType::UInt16 ? 16 : 32;
 }
 
 }  // namespace
 
 ImageHeader read_image_header(const std::filesystem::path& file, const std::string& where) {
   const auto in = open_checked(file, where);
-  const OIIO::ImageSpec& spec = in->spec();
-  return {spec.width, spec.height, spec.nchannels, source_bits(spec)};
+  const imageio::ReadSpec& spec = in->spec();
+  return {spec.width, spec.height, spec.channels, source_bits(spec)};
 }
 
 Image read_image(const std::filesystem::path& file, const std::string& where) {
   const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const auto in = open_checked(file, where);
-  const OIIO::ImageSpec& spec = in->spec();
-  Image image(spec.width, spec.height, spec.nchannels);
+  const imageio::ReadSpec& spec = in->spec();
+  Image image(spec.width, spec.height, spec.channels);
   // Rows are stored bottom-up: the file's last row becomes row 0 (v = 0), the OpenGL/OBJ convention, so
   // UVs from OBJ files and +Y-up (GL) normal maps need no flipping.
-  const auto read = [&](OIIO::TypeDesc type, void* data) {
-    const OIIO::stride_t row = OIIO::stride_t(type.size()) * spec.nchannels * spec.width;
+  const auto read = [&](imageio::PixelType type, std::size_t type_size, void* data) {
+    const std::ptrdiff_t row = std::ptrdiff_t(type_size) * spec.channels * spec.width;
     char* last_row = static_cast<char*>(data) + row * (spec.height - 1);
     // A decoder that reports an error but returns true (a warning about damaged data) fails too.
-    if (!in->read_image(0, 0, 0, spec.nchannels, type, last_row, OIIO::AutoStride, -row) || in->has_error()) {
-      const std::string message = in->geterror();
-      throw fail(message.empty() ? OIIO::geterror() : message);
-    }
+    std::string error;
+    if (!in->read(type, last_row, -row, error)) throw fail(error);
   };
   // 8- and 16-bit integers are converted here as k / (2^bits - 1), correctly rounded, so values are exact
   // (OIIO multiplies by a rounded reciprocal).
   const auto convert = [&](auto integer, float max) {
     std::vector<decltype(integer)> raw(image.texels.size());
-    read(OIIO::TypeDesc(OIIO::BaseTypeFromC<decltype(integer)>::value), raw.data());
+    read(sizeof(integer) == 1 ? imageio::PixelType::UInt8 : imageio::PixelType::UInt16, sizeof(integer), raw.data());
     for (std::size_t i = 0; i < raw.size(); ++i) image.texels[i] = float(raw[i]) / max;
   };
-  const bool uniform = spec.channelformats.empty();
-  if (uniform && spec.format == OIIO::TypeDesc::UINT8) {
+  const int bits = source_bits(spec);
+  if (bits == 8) {
     convert(std::uint8_t{}, 255.0f);
     image.source_bits = 8;
-  } else if (uniform && spec.format == OIIO::TypeDesc::UINT16) {
+  } else if (bits == 16) {
     convert(std::uint16_t{}, 65535.0f);
     image.source_bits = 16;
   }
   else
-    read(OIIO::TypeDesc::FLOAT, image.texels.data());
+    read(imageio::PixelType::Float, sizeof(float), image.texels.data());
   return image;
 }
 

@@ -8,7 +8,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "core/det_math.hpp"
@@ -65,13 +64,13 @@ std::string local_time_now() {
 // Pixels as a file of `container` stores them: 8-bit sRGB codes for PNG, 16-bit sRGB codes for a colour TIFF,
 // floats otherwise.
 struct Encoded {
-  OIIO::TypeDesc format = OIIO::TypeDesc::FLOAT;
+  imageio::PixelType format = imageio::PixelType::Float;
   std::vector<std::uint8_t> bytes8;
   std::vector<std::uint16_t> bytes16;
   std::vector<float> floats;
   const void* data() const {
-    if (format == OIIO::TypeDesc::UINT8) return bytes8.data();
-    if (format == OIIO::TypeDesc::UINT16) return bytes16.data();
+    if (format == imageio::PixelType::UInt8) return bytes8.data();
+    if (format == imageio::PixelType::UInt16) return bytes16.data();
     return floats.data();
   }
 };
@@ -79,10 +78,10 @@ struct Encoded {
 Encoded encode(Container container, std::span<const float> pixels, bool srgb) {
   Encoded encoded;
   if (container == Container::Png) {
-    encoded.format = OIIO::TypeDesc::UINT8;
+    encoded.format = imageio::PixelType::UInt8;
     encoded.bytes8 = quantize<std::uint8_t>(pixels, 255.0f, srgb);
   } else if (container == Container::Tiff && srgb) {
-    encoded.format = OIIO::TypeDesc::UINT16;
+    encoded.format = imageio::PixelType::UInt16;
     encoded.bytes16 = quantize<std::uint16_t>(pixels, 65535.0f, true);
   } else {
     encoded.floats.assign(pixels.begin(), pixels.end());  // EXR keeps full float precision
@@ -95,15 +94,15 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
                   bool srgb, const WriteOptions& write) {
   const Container container = container_of(file);
   const Encoded encoded = encode(container, pixels, srgb);
-  OIIO::ImageSpec spec(width, height, channels, encoded.format);
-  if (encoded.format != OIIO::TypeDesc::FLOAT) spec.attribute("oiio:ColorSpace", "sRGB");
+  imageio::WriteSpec spec{width, height, channels, encoded.format, {}, {}, {}};
+  if (encoded.format != imageio::PixelType::Float) spec.strings.emplace_back("oiio:ColorSpace", "sRGB");
   // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
-  if (container == Container::Png) spec.attribute("png:compressionLevel", 3);
+  if (container == Container::Png) spec.ints.emplace_back("png:compressionLevel", 3);
   // TIFF keeps only its own tags: there the bits version is in Software (tag 305) alone.
-  spec.attribute("qdmr:bits_version", std::to_string(kBitsVersion));
-  spec.attribute("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");
-  if (write.timestamp) spec.attribute("DateTime", local_time_now());
-  write_image_file(file, spec, encoded.format, encoded.data(), "image");
+  spec.strings.emplace_back("qdmr:bits_version", std::to_string(kBitsVersion));
+  spec.strings.emplace_back("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");
+  if (write.timestamp) spec.strings.emplace_back("DateTime", local_time_now());
+  write_image_file(file, spec, encoded.data(), "image");
 }
 
 struct AovPixels {
@@ -168,13 +167,16 @@ Image stored_pixels(const Frame& frame, std::optional<Aov> aov, const std::files
                                : AovPixels{3, std::vector<float>(frame.color.begin(), frame.color.end())};
   const Encoded encoded = encode(container, source.values, !aov);
   Image image(frame.width, frame.height, source.channels);
-  if (encoded.format == OIIO::TypeDesc::UINT8)
+  if (encoded.format == imageio::PixelType::UInt8) {
     for (std::size_t i = 0; i < image.texels.size(); ++i) image.texels[i] = float(encoded.bytes8[i]) / 255.0f;
-  else if (encoded.format == OIIO::TypeDesc::UINT16)
+    image.source_bits = 8;
+  } else if (encoded.format == imageio::PixelType::UInt16) {
     for (std::size_t i = 0; i < image.texels.size(); ++i) image.texels[i] = float(encoded.bytes16[i]) / 65535.0f;
-  else
+    image.source_bits = 16;
+  } else {
     image.texels = encoded.floats;
-  image.source_bits = int(encoded.format.size()) * 8;
+    image.source_bits = 32;
+  }
   return image;
 }
 

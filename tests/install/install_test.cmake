@@ -62,3 +62,12 @@ if(NOT header STREQUAL "000000a00000005a")
   message(FATAL_ERROR "${image}: expected a 160x90 PNG, header size bytes are ${header}")
 endif()
 message(STATUS "installed qdmr works: ${image}")
+
+# The installed command loads its image module from lib/qdmr/ relative to itself (src/imageio/lazy.cpp).
+set(command_image "${WORK_DIR}/command.png")
+run("${prefix}/bin/qdmr" render "${SOURCE_DIR}/scenes/plane.json" -o "${command_image}" --width 48 --height 32)
+file(READ "${command_image}" header OFFSET 16 LIMIT 8 HEX)
+if(NOT header STREQUAL "0000003000000020")
+  message(FATAL_ERROR "${command_image}: expected a 48x32 PNG from the installed qdmr, header size bytes are ${header}")
+endif()
+message(STATUS "installed qdmr command writes images: ${command_image}")

@@ -1,0 +1,76 @@
+#pragma once
+// Image files go through one narrow interface to OpenImageIO, so that the `qdmr` command can load OpenImageIO
+// (and the ~260 shared libraries it pulls in, about 0.3 s of dynamic linking) only when a job reads or writes an
+// image. The library and the tests link the backend directly (imageio/direct.cpp); the command loads it from
+// libqdmr_imageio.so on first use (imageio/lazy.cpp). Both run the same code (imageio/oiio_backend.cpp).
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace qdmr::imageio {
+
+enum class PixelType : int { UInt8, UInt16, Float };
+
+// What a reader found in a file's header.
+struct ReadSpec {
+  int width = 0, height = 0, depth = 1, channels = 0;
+  std::string format;          // OpenImageIO's format name: "png", "jpeg", "openexr", "tiff", "pnm", ...
+  bool uniform = true;         // one pixel type for every channel
+  PixelType type = PixelType::Float;  // the file's type when uniform and 8- or 16-bit unsigned, else Float
+  std::string bits_version;    // metadata "qdmr:bits_version", or empty
+  std::string software;        // metadata "Software", or empty
+};
+
+struct WriteSpec {
+  int width = 0, height = 0, channels = 0;
+  PixelType type = PixelType::Float;  // of the data and of the file
+  std::vector<std::string> channel_names;  // empty: the defaults (R, G, B, A)
+  std::vector<std::pair<std::string, std::string>> strings;  // metadata
+  std::vector<std::pair<std::string, int>> ints;
+};
+
+struct Reader;  // an open file (the backend's)
+
+// Errors come back as messages (possibly several lines); nothing throws across the interface.
+struct Backend {
+  Reader* (*open)(const std::string& path, ReadSpec& spec, std::string& error);
+  // Every pixel as `type`, the file's first row at `first_row` and each next row `row_stride` bytes further
+  // (negative: bottom-up). A decoder error or warning is a failure.
+  bool (*read)(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error);
+  void (*close)(Reader* reader);
+  bool (*write)(const std::string& path, const WriteSpec& spec, const void* data, std::string& error);
+  // One channel of `values` in [0, 1] (width x height) through a named colour map ("magma") to RGB.
+  void (*color_map)(const float* values, int width, int height, const char* map, float* rgb);
+};
+
+// The backend of this program: linked in, or loaded on first use (throws qdmr::Error when it cannot be loaded).
+const Backend& backend();
+
+// The OpenImageIO implementation, which backend() returns or the module exports.
+const Backend& oiio_backend();
+
+// An open file, closed when it goes.
+class ReadFile {
+public:
+  // Null reader (and `error` set) when the file cannot be opened.
+  ReadFile(const std::string& path, std::string& error) : backend_(&backend()), reader_(backend_->open(path, spec_, error)) {}
+  ~ReadFile() {
+    if (reader_) backend_->close(reader_);
+  }
+  ReadFile(const ReadFile&) = delete;
+  ReadFile& operator=(const ReadFile&) = delete;
+
+  explicit operator bool() const { return reader_ != nullptr; }
+  const ReadSpec& spec() const { return spec_; }
+  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {
+    return backend_->read(reader_, type, first_row, row_stride, error);
+  }
+
+private:
+  const Backend* backend_;
+  ReadSpec spec_;
+  Reader* reader_;
+};
+
+}  // namespace qdmr::imageio
