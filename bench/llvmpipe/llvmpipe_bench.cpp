@@ -14,7 +14,8 @@
 // Colour target: RGBA32F (qdmr keeps float colour), depth: 32F. Prints, as one JSON line, the median of --runs
 // frames (glClear + draw + glFinish) after one warm-up frame that compiles the shaders, and the pixels covered
 // (a check that the work matches qdmr's pixels_shaded). --hit-uv FILE renders one frame of the canonical scene
-// writing the UV of the hit per pixel and the loop iterations (bench/llvmpipe/README.md: the file format).
+// writing the UV of the hit and the loop iterations per pixel (a PFM: write_hit_uv below), for the texel check
+// of bench/llvmpipe_compare.py; --image FILE writes the last timed frame's colour (PFM) to look at.
 //
 //   LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe LP_NUM_THREADS=2 llvmpipe_bench --mesh grid --runs 7
 //   LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe LP_NUM_THREADS=2 llvmpipe_bench --technique qdm --depth 0.3
@@ -42,10 +43,11 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: llvmpipe_bench [--mesh grid|plane] [--technique normal|pom|relief|qdm] [--depth D] [--width W]\n"
-    "                      [--height H] [--runs N] [--hit-uv FILE]\n"
+    "                      [--height H] [--runs N] [--hit-uv FILE] [--image FILE]\n"
     "  --mesh: plane.json's normal-mapped plane or 710x710 grid (the default: grid; only with --technique normal)\n"
     "  --technique: the canonical scene (bench/llvmpipe/canonical.json) with that technique, depth scale --depth\n"
-    "  --hit-uv FILE: one frame of the canonical scene, hit UV and iterations per pixel to FILE (PFM)";
+    "  --hit-uv FILE: one frame of the canonical scene, hit UV and iterations per pixel to FILE (PFM)\n"
+    "  --image FILE: the last timed frame's linear colour to FILE (PFM)";
 
 struct Options {
   std::string mesh;       // set: the plane.json scene
@@ -53,6 +55,7 @@ struct Options {
   float depth = 0.1f;
   int width = 1920, height = 1080, runs = 7;
   std::string hit_uv;
+  std::string image;  // the last timed frame's colour (linear), PFM
 };
 
 float to_float(const std::string& s, const char* what) {
@@ -94,6 +97,8 @@ Options parse(int argc, char** argv) {
       o.runs = to_int(argv[++i], "--runs", 1, 100000);
     } else if (arg == "--hit-uv") {
       o.hit_uv = argv[++i];
+    } else if (arg == "--image") {
+      o.image = argv[++i];
     } else {
       fail("unknown option " + arg + "\n" + kUsage);
     }
@@ -197,9 +202,10 @@ GLuint link_program(const std::string& fragment_source) {
   return program;
 }
 
-// A 2D texture with the given levels (level i: side >> i), wrap addressing and the filters.
-GLuint make_texture(GLenum internal_format, GLenum format, GLenum type, const std::vector<const void*>& levels, int side,
-                    GLenum min_filter, GLenum mag_filter, bool generate_mips) {
+// A 2D texture with the given levels (level i: side >> i), wrap addressing and the filters, created on the
+// active texture unit (and left bound to it).
+void make_texture(GLenum internal_format, GLenum format, GLenum type, const std::vector<const void*>& levels, int side,
+                  GLenum min_filter, GLenum mag_filter, bool generate_mips) {
   GLuint tex = 0;
   glGenTextures(1, &tex);
   glBindTexture(GL_TEXTURE_2D, tex);
@@ -214,12 +220,11 @@ GLuint make_texture(GLenum internal_format, GLenum format, GLenum type, const st
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GLint(mag_filter));
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  return tex;
 }
 
-void bind_texture(GLuint program, const char* name, int unit, GLuint texture) {
+// Makes `unit` the active texture unit and points the sampler `name` at it: the next make_texture lands there.
+void use_unit(GLuint program, const char* name, int unit) {
   glActiveTexture(GLenum(GL_TEXTURE0 + unit));
-  glBindTexture(GL_TEXTURE_2D, texture);
   glUniform1i(glGetUniformLocation(program, name), unit);
 }
 
@@ -228,18 +233,18 @@ void bind_texture(GLuint program, const char* name, int unit, GLuint texture) {
 // (R32F, every level, read with texelFetch).
 void bind_textures(GLuint program, const SceneTextures& t, bool displaced) {
   const GLenum trilinear = GL_LINEAR_MIPMAP_LINEAR;
-  bind_texture(program, "albedo_map", 0,
-               make_texture(t.albedo_srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.albedo.data()},
-                            t.side, trilinear, GL_LINEAR, true));
-  bind_texture(program, "normal_map", 1,
-               make_texture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.normal.data()}, t.side, trilinear, GL_LINEAR, true));
+  use_unit(program, "albedo_map", 0);
+  make_texture(t.albedo_srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.albedo.data()}, t.side,
+               trilinear, GL_LINEAR, true);
+  use_unit(program, "normal_map", 1);
+  make_texture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.normal.data()}, t.side, trilinear, GL_LINEAR, true);
   if (!displaced) return;
-  bind_texture(program, "height_map", 2,
-               make_texture(GL_R32F, GL_RED, GL_FLOAT, {t.max_chain[0].data()}, t.side, GL_LINEAR, GL_LINEAR, false));
+  use_unit(program, "height_map", 2);
+  make_texture(GL_R32F, GL_RED, GL_FLOAT, {t.max_chain[0].data()}, t.side, GL_LINEAR, GL_LINEAR, false);
   std::vector<const void*> levels;
   for (const auto& level : t.max_chain) levels.push_back(level.data());
-  bind_texture(program, "max_tree", 3,
-               make_texture(GL_R32F, GL_RED, GL_FLOAT, levels, t.side, GL_NEAREST_MIPMAP_NEAREST, GL_NEAREST, false));
+  use_unit(program, "max_tree", 3);
+  make_texture(GL_R32F, GL_RED, GL_FLOAT, levels, t.side, GL_NEAREST_MIPMAP_NEAREST, GL_NEAREST, false);
 }
 
 void draw(GLsizei index_count, const float clear[4]) {
@@ -250,12 +255,11 @@ void draw(GLsizei index_count, const float clear[4]) {
 }
 
 // Frame 0 is the warm-up (the shader is compiled on the first draw); the others are timed.
-std::vector<double> time_frames(GLsizei index_count, int runs) {
-  const float black[4] = {0, 0, 0, 1};
+std::vector<double> time_frames(GLsizei index_count, int runs, const float background[4]) {
   std::vector<double> ms;
   for (int i = 0; i <= runs; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    draw(index_count, black);
+    draw(index_count, background);
     if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
   if (glGetError() != GL_NO_ERROR) fail("a GL call failed");
@@ -268,28 +272,37 @@ long covered_pixels(int width, int height) {
   return long(std::count_if(depth.begin(), depth.end(), [](float d) { return d < 1.0f; }));
 }
 
-// One frame of the hit-UV shader; writes a PFM of three channels: hit u, hit v, loop iterations (-1 where no
-// triangle covers the pixel). PFM stores rows bottom to top, as glReadPixels returns them. Returns the mean
-// iterations over the covered pixels.
-double write_hit_uv(GLsizei index_count, int width, int height, const std::string& path) {
-  const float uncovered[4] = {0, 0, -1, 0};
-  draw(index_count, uncovered);
+// The colour target as RGB floats, rows bottom to top (glReadPixels' order).
+std::vector<float> read_rgb(int width, int height) {
   std::vector<float> rgba(std::size_t(width) * std::size_t(height) * 4);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
   if (glGetError() != GL_NO_ERROR) fail("a GL call failed");
   std::vector<float> rgb;
   rgb.reserve(rgba.size() / 4 * 3);
-  double iterations = 0;
-  long covered = 0;
-  for (std::size_t i = 0; i < rgba.size(); i += 4) {
-    rgb.insert(rgb.end(), {rgba[i], rgba[i + 1], rgba[i + 2]});
-    if (rgba[i + 2] >= 0.0f) iterations += rgba[i + 2], ++covered;
-  }
+  for (std::size_t i = 0; i < rgba.size(); i += 4) rgb.insert(rgb.end(), {rgba[i], rgba[i + 1], rgba[i + 2]});
+  return rgb;
+}
+
+// A 3-channel PFM: little-endian floats, rows bottom to top as the format stores them (and GL returns them).
+void write_pfm(const std::string& path, int width, int height, const std::vector<float>& rgb) {
   FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) fail("cannot write " + path);
-  std::fprintf(f, "PF\n%d %d\n-1.0\n", width, height);  // negative scale: little-endian floats
+  std::fprintf(f, "PF\n%d %d\n-1.0\n", width, height);  // negative scale: little-endian
   const bool ok = std::fwrite(rgb.data(), sizeof(float), rgb.size(), f) == rgb.size();
   if (std::fclose(f) != 0 || !ok) fail("cannot write " + path);
+}
+
+// One frame of the hit-UV shader, written as a PFM of three channels: hit u, hit v, loop iterations (-1 where
+// no triangle covers the pixel). Returns the mean iterations over the covered pixels.
+double write_hit_uv(GLsizei index_count, int width, int height, const std::string& path) {
+  const float uncovered[4] = {0, 0, -1, 0};
+  draw(index_count, uncovered);
+  const std::vector<float> rgb = read_rgb(width, height);
+  double iterations = 0;
+  long covered = 0;
+  for (std::size_t i = 2; i < rgb.size(); i += 3)
+    if (rgb[i] >= 0.0f) iterations += rgb[i], ++covered;
+  write_pfm(path, width, height, rgb);
   return covered > 0 ? iterations / double(covered) : 0.0;
 }
 
@@ -321,7 +334,8 @@ int run(int argc, char** argv) {
                 o.hit_uv.c_str());
     return 0;
   }
-  std::vector<double> ms = time_frames(index_count, o.runs);
+  std::vector<double> ms = time_frames(index_count, o.runs, scene.background);
+  if (!o.image.empty()) write_pfm(o.image, o.width, o.height, read_rgb(o.width, o.height));
   const long covered = covered_pixels(o.width, o.height);
   std::string frames;
   for (double m : ms) frames += (frames.empty() ? "" : ", ") + std::to_string(m);

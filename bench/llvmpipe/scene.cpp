@@ -25,10 +25,14 @@ Mat4 mul(const Mat4& a, const Mat4& b) {
 
 }  // namespace
 
-Scene plane_scene() { return {{{0, -2.2f, 1.6f}, {0, 0.2f, 0}, {0, 0, 1}, 50.0f, 0.05f, 50.0f}}; }
+// Black, as llvmpipe_bench always cleared for plane.json.
+Scene plane_scene() { return {{{0, -2.2f, 1.6f}, {0, 0.2f, 0}, {0, 0, 1}, 50.0f, 0.05f, 50.0f}, {0, 0, 0, 1}}; }
 
 // 3 units from the origin at 60 degrees elevation: (0, -3 cos 60°, 3 sin 60°), as canonical.json has it.
-Scene canonical_scene() { return {{{0, -1.5f, 2.598076f}, {0, 0, 0}, {0, 0, 1}, 50.0f, 0.05f, 50.0f}}; }
+// The background is qdmr's default output/background.
+Scene canonical_scene() {
+  return {{{0, -1.5f, 2.598076f}, {0, 0, 0}, {0, 0, 1}, 50.0f, 0.05f, 50.0f}, {0.05f, 0.06f, 0.08f, 1}};
+}
 
 Mat4 view_projection(const Camera& camera, float aspect) {
   const Vec3 eye = camera.eye;

@@ -22,6 +22,7 @@ struct Camera {
 
 struct Scene {
   Camera camera;
+  float background[4];  // the clear colour
 };
 
 // scenes/plane.json and bench/llvmpipe/canonical.json (the camera; both have plane.json's light).
