@@ -191,7 +191,9 @@ def timing(qdmr, llvmpipe, args, tmp):
                     ms, info["llvmpipe"] = time_llvmpipe(llvmpipe, *case, args)
                 times[case][who].append(ms)
         print(f"round {r + 1}/{args.rounds} done, load average {os.getloadavg()[0]:.2f}", file=sys.stderr, flush=True)
-    print(f"qdmr: {info['qdmr']['isa']}, {info['qdmr']['threads']} threads; llvmpipe: {info['llvmpipe']['renderer']}\n")
+    print(f"qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
+          f"{info['qdmr']['pixels_shaded']} pixels shaded; llvmpipe: {info['llvmpipe']['renderer']}, "
+          f"{info['llvmpipe']['pixels_covered']} pixels covered (last case)\n")
     print("| technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met | llvmpipe ms per round | qdmr ms per round |")
     print("|---|---|---|---|---|---|---|---|---|")
     for technique, depth in CASES:
