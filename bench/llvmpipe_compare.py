@@ -194,7 +194,8 @@ def timing(qdmr, llvmpipe, args, tmp):
     print(f"qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
           f"{info['qdmr']['pixels_shaded']} pixels shaded; llvmpipe: {info['llvmpipe']['renderer']}, "
           f"{info['llvmpipe']['pixels_covered']} pixels covered (last case)\n")
-    print("| technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met | llvmpipe ms per round | qdmr ms per round |")
+    print("| technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met "
+          "| llvmpipe ms per round | qdmr ms per round |")
     print("|---|---|---|---|---|---|---|---|---|")
     for technique, depth in CASES:
         t = times[(technique, depth)]

@@ -134,8 +134,8 @@ std::vector<float> max_reduce(const std::vector<float>& level, int side) {
   const auto at = [&](int x, int y) { return level[std::size_t(y) * std::size_t(side) + std::size_t(x)]; };
   for (int y = 0; y < half; ++y)
     for (int x = 0; x < half; ++x)
-      out[std::size_t(y) * std::size_t(half) + std::size_t(x)] =
-          std::max(std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)), std::max(at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
+      out[std::size_t(y) * std::size_t(half) + std::size_t(x)] = std::max(
+          std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)), std::max(at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
   return out;
 }
 

@@ -103,15 +103,15 @@ Options parse(int argc, char** argv) {
       fail("unknown option " + arg + "\n" + kUsage);
     }
   }
-  if (o.technique.empty() && o.hit_uv.empty()) {
-    if (o.mesh.empty()) o.mesh = "grid";  // what llvmpipe_bench did before it had techniques
-    o.technique = "normal";
-  } else if (o.technique.empty()) {
-    o.technique = "normal";
+  // Without --technique and --hit-uv: plane.json's grid, what llvmpipe_bench did before it had techniques.
+  if (o.technique.empty() && o.hit_uv.empty() && o.mesh.empty()) o.mesh = "grid";
+  if (o.technique.empty()) o.technique = "normal";
+  if (!o.mesh.empty()) {
+    if (o.mesh != "grid" && o.mesh != "plane") fail("--mesh must be grid or plane");
+    if (o.technique != "normal")
+      fail("--mesh is plane.json's normal mapping; --technique " + o.technique + " takes no --mesh");
+    if (!o.hit_uv.empty()) fail("--hit-uv renders the canonical scene; drop --mesh");
   }
-  if (!o.mesh.empty() && o.mesh != "grid" && o.mesh != "plane") fail("--mesh must be grid or plane");
-  if (!o.mesh.empty() && o.technique != "normal") fail("--mesh renders plane.json (normal mapping); --technique " + o.technique + " needs no --mesh");
-  if (!o.mesh.empty() && !o.hit_uv.empty()) fail("--hit-uv renders the canonical scene; drop --mesh");
   if (!technique_known(o.technique)) fail("--technique must be normal, pom, relief or qdm");
   if (!(o.depth >= 0.0f && o.depth <= 100.0f)) fail("--depth must be in 0..100");
   return o;

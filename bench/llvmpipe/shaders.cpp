@@ -225,7 +225,9 @@ void main() {
 }
 )";
 
-std::string define(const char* name, int value) { return std::string("#define ") + name + " " + std::to_string(value) + "\n"; }
+std::string define(const char* name, int value) {
+  return std::string("#define ") + name + " " + std::to_string(value) + "\n";
+}
 
 const char* technique_macro(TechniqueKind kind) {
   switch (kind) {
