@@ -56,7 +56,7 @@ def arguments():
     p.add_argument("--tolerance", type=float, default=1e-3, help="hit UV agreement, UV units")
     p.add_argument("--check-only", action="store_true")
     p.add_argument("--timing-only", action="store_true")
-    p.add_argument("--keep", help="keep the images and JSON files in this folder (default: a temporary one)")
+    p.add_argument("--keep", help="keep the images and JSON files (timing.json: every round) in this folder")
     return p.parse_args()
 
 
@@ -176,21 +176,33 @@ def time_llvmpipe(llvmpipe, technique, depth, args):
     return result["median_ms"], result
 
 
-def timing(qdmr, llvmpipe, args, tmp):
-    print(f"\n## Timing: {args.width}x{args.height}, {args.threads} threads each, {args.rounds} rounds; "
-          f"qdmr bench {args.frames} frames after {args.warmup}, llvmpipe {args.frames} after 1\n")
+def measure_rounds(qdmr, llvmpipe, args, tmp):
+    """{case: {"qdmr": [ms per round], "llvmpipe": [...]}} and the last JSON of each renderer. Within a round each
+    case runs in both renderers back to back; which goes first flips every round."""
     times = {case: {"qdmr": [], "llvmpipe": []} for case in CASES}
     info = {}
     for r in range(args.rounds):
         for case in CASES:
-            order = ("llvmpipe", "qdmr") if r % 2 == 0 else ("qdmr", "llvmpipe")
-            for who in order:
+            for who in ("llvmpipe", "qdmr") if r % 2 == 0 else ("qdmr", "llvmpipe"):
                 if who == "qdmr":
-                    ms, info["qdmr"] = time_qdmr(qdmr, *case, args, tmp)
+                    ms, info[who] = time_qdmr(qdmr, *case, args, tmp)
                 else:
-                    ms, info["llvmpipe"] = time_llvmpipe(llvmpipe, *case, args)
+                    ms, info[who] = time_llvmpipe(llvmpipe, *case, args)
                 times[case][who].append(ms)
         print(f"round {r + 1}/{args.rounds} done, load average {os.getloadavg()[0]:.2f}", file=sys.stderr, flush=True)
+    return times, info
+
+
+def per_round(values):
+    return " ".join(f"{v:.1f}" for v in values)
+
+
+def timing(qdmr, llvmpipe, args, tmp):
+    print(f"\n## Timing: {args.width}x{args.height}, {args.threads} threads each, {args.rounds} rounds; "
+          f"qdmr bench {args.frames} frames after {args.warmup}, llvmpipe {args.frames} after 1\n")
+    times, info = measure_rounds(qdmr, llvmpipe, args, tmp)
+    with open(os.path.join(tmp, "timing.json"), "w") as f:  # every round's times, kept with --keep
+        json.dump([{"technique": c[0], "depth": c[1], **times[c]} for c in CASES], f, indent=1)
     print(f"qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
           f"{info['qdmr']['pixels_shaded']} pixels shaded; llvmpipe: {info['llvmpipe']['renderer']}, "
           f"{info['llvmpipe']['pixels_covered']} pixels covered (last case)\n")
@@ -202,10 +214,8 @@ def timing(qdmr, llvmpipe, args, tmp):
         lp, q = statistics.median(t["llvmpipe"]), statistics.median(t["qdmr"])
         ratio, goal = lp / q, GOALS[technique]
         depth_text = "-" if technique == "normal" else f"{depth:g}"
-        rounds = lambda v: " ".join(f"{x:.1f}" for x in v)
         print(f"| {technique} | {depth_text} | {lp:.1f} | {q:.1f} | **{ratio:.2f}x** | >= {goal:g}x "
-              f"| {'yes' if ratio >= goal else 'no'} | {rounds(t['llvmpipe'])} | {rounds(t['qdmr'])} |")
-    return times
+              f"| {'yes' if ratio >= goal else 'no'} | {per_round(t['llvmpipe'])} | {per_round(t['qdmr'])} |")
 
 
 def load_line(when):
