@@ -1,12 +1,24 @@
-// The work of qdmr's benchmarks on Mesa llvmpipe: scenes/plane.json's camera and light, at 1920x1080,
-// either its 2-triangle plane or the same plane as a 710x710 grid (1,008,200 triangles). The fragment
-// shader does what qdmr's normal-mapping program does: trilinear albedo and normal map (1024², mipmapped),
-// tangent-space normal to world, Blinn-Phong with one directional light plus ambient. Colour target:
-// RGBA32F (qdmr keeps float colour), depth: 32F. Prints the median of --runs frames (glClear + draw +
-// glFinish) after one warm-up frame that compiles the shaders, and the pixels covered (a check
-// that the work matches qdmr's pixels_shaded).
+// The work of qdmr's benchmarks on Mesa llvmpipe, through EGL (surfaceless) and OpenGL 3.3 core. Two scenes:
 //
-//   LIBGL_ALWAYS_SOFTWARE=1 LP_NUM_THREADS=2 llvmpipe_bench --mesh grid --runs 7
+//  --mesh grid|plane (the default: --mesh grid): scenes/plane.json's camera and light at 1920x1080, either its
+//     2-triangle plane or the same plane as a 710x710 grid (1,008,200 triangles); the fragment shader does what
+//     qdmr's normal-mapping program does: trilinear albedo and normal map (1024², synthetic, mipmapped),
+//     tangent-space normal to world, Blinn-Phong with one directional light plus ambient.
+//
+//  --technique normal|pom|relief|qdm --depth D: bench/llvmpipe/canonical.json, the scene of the llvmpipe
+//     comparison (bench/llvmpipe_compare.py): its camera, light, the same cobbles height map (canonical.cpp
+//     generates the bits qdmr generates, stored as r16 like qdmr stores them) and GLSL versions of qdmr's
+//     POM, relief and QDM (src/shade/pom.hpp, relief.hpp, qdm.hpp, traversal.hpp, refine.hpp) with the
+//     scene's knobs (shaders.cpp), then Blinn-Phong shading as qdmr's shade_lights does.
+//
+// Colour target: RGBA32F (qdmr keeps float colour), depth: 32F. Prints, as one JSON line, the median of --runs
+// frames (glClear + draw + glFinish) after one warm-up frame that compiles the shaders, and the pixels covered
+// (a check that the work matches qdmr's pixels_shaded). --hit-uv FILE renders one frame of the canonical scene
+// writing the UV of the hit and the loop iterations per pixel (a PFM: write_hit_uv below), for the texel check
+// of bench/llvmpipe_compare.py; --image FILE writes the last timed frame's colour (PFM) to look at.
+//
+//   LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe LP_NUM_THREADS=2 llvmpipe_bench --mesh grid --runs 7
+//   LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe LP_NUM_THREADS=2 llvmpipe_bench --technique qdm --depth 0.3
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #define GL_GLEXT_PROTOTYPES
@@ -14,152 +26,95 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace {
+#include "scene.hpp"
+#include "shaders.hpp"
 
-constexpr int kWidth = 1920, kHeight = 1080, kTextureSide = 1024;
+namespace llvmpipe_bench {
+namespace {
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error(what); }
 
-struct Mat4 {
-  float m[16] = {};  // column-major
+constexpr const char* kUsage =
+    "usage: llvmpipe_bench [--mesh grid|plane] [--technique normal|pom|relief|qdm] [--depth D] [--width W]\n"
+    "                      [--height H] [--runs N] [--hit-uv FILE] [--image FILE]\n"
+    "  --mesh: plane.json's normal-mapped plane or 710x710 grid (the default: grid; only with --technique normal)\n"
+    "  --technique: the canonical scene (bench/llvmpipe/canonical.json) with that technique, depth scale --depth\n"
+    "  --hit-uv FILE: one frame of the canonical scene, hit UV and iterations per pixel to FILE (PFM)\n"
+    "  --image FILE: the last timed frame's linear colour to FILE (PFM)";
+
+struct Options {
+  std::string mesh;       // set: the plane.json scene
+  std::string technique;  // set: the canonical scene
+  float depth = 0.1f;
+  int width = 1920, height = 1080, runs = 7;
+  std::string hit_uv;
+  std::string image;  // the last timed frame's colour (linear), PFM
 };
 
-Mat4 mul(const Mat4& a, const Mat4& b) {
-  Mat4 r;
-  for (int c = 0; c < 4; ++c)
-    for (int row = 0; row < 4; ++row)
-      for (int k = 0; k < 4; ++k) r.m[c * 4 + row] += a.m[k * 4 + row] * b.m[c * 4 + k];
-  return r;
+float to_float(const std::string& s, const char* what) {
+  char* end = nullptr;
+  const float v = std::strtof(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0') fail(std::string(what) + ": not a number: " + s);
+  return v;
 }
 
-struct Vec3 {
-  float x, y, z;
-};
-Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 normalize(Vec3 a) {
-  const float l = std::sqrt(dot(a, a));
-  return {a.x / l, a.y / l, a.z / l};
+int to_int(const std::string& s, const char* what, int low, int high) {
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  if (end == s.c_str() || *end != '\0' || v < low || v > high)
+    fail(std::string(what) + " must be an integer in " + std::to_string(low) + ".." + std::to_string(high));
+  return int(v);
 }
 
-// The camera of scenes/plane.json (glm::lookAt and glm::perspective, GL conventions).
-Mat4 view_projection(Vec3& eye_out) {
-  const Vec3 eye{0, -2.2f, 1.6f}, target{0, 0.2f, 0}, up{0, 0, 1};
-  const Vec3 f = normalize(sub(target, eye)), s = normalize(cross(f, up)), u = cross(s, f);
-  Mat4 view;
-  const float v[16] = {s.x, u.x, -f.x, 0, s.y, u.y, -f.y, 0, s.z, u.z, -f.z, 0, -dot(s, eye), -dot(u, eye), dot(f, eye), 1};
-  std::memcpy(view.m, v, sizeof v);
-  const float fov = 50.0f * 3.14159265f / 180.0f, aspect = float(kWidth) / kHeight, n = 0.05f, fa = 50.0f;
-  const float t = 1.0f / std::tan(fov / 2);
-  Mat4 proj;
-  proj.m[0] = t / aspect;
-  proj.m[5] = t;
-  proj.m[10] = -(fa + n) / (fa - n);
-  proj.m[11] = -1;
-  proj.m[14] = -2 * fa * n / (fa - n);
-  eye_out = eye;
-  return mul(proj, view);
-}
-
-// A 4x4 plane at z = 0 with uv_scale 2, as `resolution`² quads (two triangles each), normal +z, tangent +x.
-void make_grid(int resolution, std::vector<float>& vertices, std::vector<std::uint32_t>& indices) {
-  const int n = resolution + 1;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const float u = float(i) / resolution, v = float(j) / resolution;
-      vertices.insert(vertices.end(), {-2 + 4 * u, -2 + 4 * v, 0, 2 * u, 2 * v});
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--help" || arg == "-h") {
+      std::puts(kUsage);
+      std::exit(0);
+    } else if (!has_value) {
+      fail(std::string("missing value or unknown option: ") + arg + "\n" + kUsage);
+    } else if (arg == "--mesh") {
+      o.mesh = argv[++i];
+    } else if (arg == "--technique") {
+      o.technique = argv[++i];
+    } else if (arg == "--depth") {
+      o.depth = to_float(argv[++i], "--depth");
+    } else if (arg == "--width") {
+      o.width = to_int(argv[++i], "--width", 1, 16384);
+    } else if (arg == "--height") {
+      o.height = to_int(argv[++i], "--height", 1, 16384);
+    } else if (arg == "--runs") {
+      o.runs = to_int(argv[++i], "--runs", 1, 100000);
+    } else if (arg == "--hit-uv") {
+      o.hit_uv = argv[++i];
+    } else if (arg == "--image") {
+      o.image = argv[++i];
+    } else {
+      fail("unknown option " + arg + "\n" + kUsage);
     }
-  for (int j = 0; j < resolution; ++j)
-    for (int i = 0; i < resolution; ++i) {
-      const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
-      indices.insert(indices.end(), {a, b, d, a, d, c});
-    }
-}
-
-// Bricks-like albedo and a bumpy normal map; the content does not change the cost of trilinear fetches.
-GLuint make_texture(bool normal_map) {
-  std::vector<std::uint8_t> texels(std::size_t(kTextureSide) * kTextureSide * 4);
-  for (int y = 0; y < kTextureSide; ++y)
-    for (int x = 0; x < kTextureSide; ++x) {
-      std::uint8_t* t = &texels[(std::size_t(y) * kTextureSide + x) * 4];
-      const float a = std::sin(float(x) * 0.05f), b = std::cos(float(y) * 0.07f);
-      if (normal_map) {
-        const Vec3 nrm = normalize({0.4f * a, 0.4f * b, 1.0f});
-        t[0] = std::uint8_t(127.5f + 127.5f * nrm.x), t[1] = std::uint8_t(127.5f + 127.5f * nrm.y), t[2] = std::uint8_t(127.5f + 127.5f * nrm.z);
-      } else {
-        t[0] = std::uint8_t(120 + 60 * a), t[1] = std::uint8_t(70 + 30 * b), t[2] = 50;
-      }
-      t[3] = 255;
-    }
-  GLuint tex = 0;
-  glGenTextures(1, &tex);
-  glBindTexture(GL_TEXTURE_2D, tex);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, kTextureSide, kTextureSide, 0, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
-  glGenerateMipmap(GL_TEXTURE_2D);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-  return tex;
-}
-
-const char* kVertexShader = R"(#version 330 core
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec2 uv;
-uniform mat4 view_projection;
-out vec3 world;
-out vec2 tex;
-void main() {
-  world = position;
-  tex = uv;
-  gl_Position = view_projection * vec4(position, 1.0);
-}
-)";
-
-const char* kFragmentShader = R"(#version 330 core
-in vec3 world;
-in vec2 tex;
-uniform sampler2D albedo_map;
-uniform sampler2D normal_map;
-uniform vec3 eye;
-out vec4 color;
-const vec3 N = vec3(0, 0, 1), T = vec3(1, 0, 0), B = vec3(0, 1, 0);
-const vec3 light_dir = normalize(vec3(-0.5, -0.4, 0.75));
-const vec3 light = vec3(1.0, 0.96, 0.9) * 1.1, ambient = vec3(0.55, 0.65, 0.9) * 0.18;
-void main() {
-  vec3 albedo = texture(albedo_map, tex).rgb;
-  vec3 nt = texture(normal_map, tex).xyz * 2.0 - 1.0;
-  vec3 n = normalize(nt.x * T + nt.y * B + nt.z * N);
-  vec3 v = normalize(eye - world);
-  vec3 h = normalize(light_dir + v);
-  float diffuse = max(dot(n, light_dir), 0.0);
-  float specular = diffuse > 0.0 ? 0.15 * pow(max(dot(n, h), 0.0), 24.0) : 0.0;
-  color = vec4(albedo * (ambient + light * diffuse) + light * specular, 1.0);
-}
-)";
-
-GLuint compile(GLenum type, const char* source) {
-  const GLuint s = glCreateShader(type);
-  glShaderSource(s, 1, &source, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048];
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    fail(std::string("shader: ") + log);
   }
-  return s;
+  // Without --technique and --hit-uv: plane.json's grid, what llvmpipe_bench did before it had techniques.
+  if (o.technique.empty() && o.hit_uv.empty() && o.mesh.empty()) o.mesh = "grid";
+  if (o.technique.empty()) o.technique = "normal";
+  if (!o.mesh.empty()) {
+    if (o.mesh != "grid" && o.mesh != "plane") fail("--mesh must be grid or plane");
+    if (o.technique != "normal")
+      fail("--mesh is plane.json's normal mapping; --technique " + o.technique + " takes no --mesh");
+    if (!o.hit_uv.empty()) fail("--hit-uv renders the canonical scene; drop --mesh");
+  }
+  if (!technique_known(o.technique)) fail("--technique must be normal, pom, relief or qdm");
+  if (!(o.depth >= 0.0f && o.depth <= 100.0f)) fail("--depth must be in 0..100");
+  return o;
 }
 
 void make_context() {
@@ -180,91 +135,224 @@ void make_context() {
     fail("cannot create a GL 3.3 core context");
 }
 
-int run(int argc, char** argv) {
-  std::string mesh = "grid";
-  int runs = 7;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--mesh" && i + 1 < argc) mesh = argv[++i];
-    else if (arg == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else fail("usage: llvmpipe_bench [--mesh grid|plane] [--runs N]");
-  }
-  if (mesh != "grid" && mesh != "plane") fail("--mesh must be grid or plane");
-  make_context();
-
+// An FBO with an RGBA32F colour and a 32F depth renderbuffer, bound, with its viewport.
+void make_framebuffer(int width, int height) {
   GLuint fbo = 0, rb[2] = {};
   glGenFramebuffers(1, &fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glGenRenderbuffers(2, rb);
   glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, kWidth, kHeight);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, width, height);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
   glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, kWidth, kHeight);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("framebuffer incomplete");
-  glViewport(0, 0, kWidth, kHeight);
+  glViewport(0, 0, width, height);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_CULL_FACE);
+}
 
-  std::vector<float> vertices;
-  std::vector<std::uint32_t> indices;
-  make_grid(mesh == "grid" ? 710 : 1, vertices, indices);
+// Uploads the mesh (position xyz, uv) into a bound VAO; returns the index count.
+GLsizei upload_mesh(const Mesh& mesh) {
   GLuint vao = 0, buffers[2] = {};
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
   glGenBuffers(2, buffers);
   glBindBuffer(GL_ARRAY_BUFFER, buffers[0]);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(float)), vertices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.vertices.size() * sizeof(float)), mesh.vertices.data(), GL_STATIC_DRAW);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[1]);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(std::uint32_t)), indices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(std::uint32_t)), mesh.indices.data(),
+               GL_STATIC_DRAW);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), nullptr);
   glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float), reinterpret_cast<void*>(3 * sizeof(float)));
   glEnableVertexAttribArray(0);
   glEnableVertexAttribArray(1);
+  return GLsizei(mesh.indices.size());
+}
 
+GLuint compile(GLenum type, const std::string& source) {
+  const GLuint s = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(s, 1, &text, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    fail(std::string("shader: ") + log);
+  }
+  return s;
+}
+
+GLuint link_program(const std::string& fragment_source) {
   const GLuint program = glCreateProgram();
-  glAttachShader(program, compile(GL_VERTEX_SHADER, kVertexShader));
-  glAttachShader(program, compile(GL_FRAGMENT_SHADER, kFragmentShader));
+  glAttachShader(program, compile(GL_VERTEX_SHADER, vertex_shader()));
+  glAttachShader(program, compile(GL_FRAGMENT_SHADER, fragment_source));
   glLinkProgram(program);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    fail(std::string("link: ") + log);
+  }
   glUseProgram(program);
-  Vec3 eye{};
-  const Mat4 vp = view_projection(eye);
-  glUniformMatrix4fv(glGetUniformLocation(program, "view_projection"), 1, GL_FALSE, vp.m);
-  glUniform3f(glGetUniformLocation(program, "eye"), eye.x, eye.y, eye.z);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, make_texture(false));
-  glActiveTexture(GL_TEXTURE1);
-  glBindTexture(GL_TEXTURE_2D, make_texture(true));
-  glUniform1i(glGetUniformLocation(program, "albedo_map"), 0);
-  glUniform1i(glGetUniformLocation(program, "normal_map"), 1);
+  return program;
+}
 
+// A 2D texture with the given levels (level i: side >> i), wrap addressing and the filters, created on the
+// active texture unit (and left bound to it).
+void make_texture(GLenum internal_format, GLenum format, GLenum type, const std::vector<const void*>& levels, int side,
+                  GLenum min_filter, GLenum mag_filter, bool generate_mips) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    const int s = std::max(1, side >> i);
+    glTexImage2D(GL_TEXTURE_2D, GLint(i), GLint(internal_format), s, s, 0, format, type, levels[i]);
+  }
+  if (generate_mips) glGenerateMipmap(GL_TEXTURE_2D);
+  else glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, GLint(levels.size()) - 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GLint(min_filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GLint(mag_filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+}
+
+// Makes `unit` the active texture unit and points the sampler `name` at it: the next make_texture lands there.
+void use_unit(GLuint program, const char* name, int unit) {
+  glActiveTexture(GLenum(GL_TEXTURE0 + unit));
+  glUniform1i(glGetUniformLocation(program, name), unit);
+}
+
+// Albedo (sRGB) and normal map (RGBA8), trilinear as the scenes' "sampling/filter" says; for a displacement
+// technique also the heights (R32F, level 0 only, bilinear: the scene's "height_fetch") and their max chain
+// (R32F, every level, read with texelFetch).
+void bind_textures(GLuint program, const SceneTextures& t, bool displaced) {
+  const GLenum trilinear = GL_LINEAR_MIPMAP_LINEAR;
+  use_unit(program, "albedo_map", 0);
+  make_texture(t.albedo_srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.albedo.data()}, t.side,
+               trilinear, GL_LINEAR, true);
+  use_unit(program, "normal_map", 1);
+  make_texture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, {t.normal.data()}, t.side, trilinear, GL_LINEAR, true);
+  if (!displaced) return;
+  use_unit(program, "height_map", 2);
+  make_texture(GL_R32F, GL_RED, GL_FLOAT, {t.max_chain[0].data()}, t.side, GL_LINEAR, GL_LINEAR, false);
+  std::vector<const void*> levels;
+  for (const auto& level : t.max_chain) levels.push_back(level.data());
+  use_unit(program, "max_tree", 3);
+  make_texture(GL_R32F, GL_RED, GL_FLOAT, levels, t.side, GL_NEAREST_MIPMAP_NEAREST, GL_NEAREST, false);
+}
+
+void draw(GLsizei index_count, const float clear[4]) {
+  glClearColor(clear[0], clear[1], clear[2], clear[3]);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glDrawElements(GL_TRIANGLES, index_count, GL_UNSIGNED_INT, nullptr);
+  glFinish();
+}
+
+// Frame 0 is the warm-up (the shader is compiled on the first draw); the others are timed.
+std::vector<double> time_frames(GLsizei index_count, int runs, const float background[4]) {
   std::vector<double> ms;
-  for (int i = 0; i <= runs; ++i) {  // frame 0 is the warm-up
+  for (int i = 0; i <= runs; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    glClearColor(0, 0, 0, 1);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glDrawElements(GL_TRIANGLES, GLsizei(indices.size()), GL_UNSIGNED_INT, nullptr);
-    glFinish();
+    draw(index_count, background);
     if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
   if (glGetError() != GL_NO_ERROR) fail("a GL call failed");
-  std::vector<float> depth(std::size_t(kWidth) * kHeight);
-  glReadPixels(0, 0, kWidth, kHeight, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-  const auto covered = std::count_if(depth.begin(), depth.end(), [](float d) { return d < 1.0f; });
+  return ms;
+}
+
+long covered_pixels(int width, int height) {
+  std::vector<float> depth(std::size_t(width) * std::size_t(height));
+  glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+  return long(std::count_if(depth.begin(), depth.end(), [](float d) { return d < 1.0f; }));
+}
+
+// The colour target as RGB floats, rows bottom to top (glReadPixels' order).
+std::vector<float> read_rgb(int width, int height) {
+  std::vector<float> rgba(std::size_t(width) * std::size_t(height) * 4);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
+  if (glGetError() != GL_NO_ERROR) fail("a GL call failed");
+  std::vector<float> rgb;
+  rgb.reserve(rgba.size() / 4 * 3);
+  for (std::size_t i = 0; i < rgba.size(); i += 4) rgb.insert(rgb.end(), {rgba[i], rgba[i + 1], rgba[i + 2]});
+  return rgb;
+}
+
+// A 3-channel PFM: little-endian floats, rows bottom to top as the format stores them (and GL returns them).
+void write_pfm(const std::string& path, int width, int height, const std::vector<float>& rgb) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) fail("cannot write " + path);
+  std::fprintf(f, "PF\n%d %d\n-1.0\n", width, height);  // negative scale: little-endian
+  const bool ok = std::fwrite(rgb.data(), sizeof(float), rgb.size(), f) == rgb.size();
+  if (std::fclose(f) != 0 || !ok) fail("cannot write " + path);
+}
+
+// One frame of the hit-UV shader, written as a PFM of three channels: hit u, hit v, loop iterations (-1 where
+// no triangle covers the pixel). Returns the mean iterations over the covered pixels.
+double write_hit_uv(GLsizei index_count, int width, int height, const std::string& path) {
+  const float uncovered[4] = {0, 0, -1, 0};
+  draw(index_count, uncovered);
+  const std::vector<float> rgb = read_rgb(width, height);
+  double iterations = 0;
+  long covered = 0;
+  for (std::size_t i = 2; i < rgb.size(); i += 3)
+    if (rgb[i] >= 0.0f) iterations += rgb[i], ++covered;
+  write_pfm(path, width, height, rgb);
+  return covered > 0 ? iterations / double(covered) : 0.0;
+}
+
+int run(int argc, char** argv) {
+  const Options o = parse(argc, argv);
+  const bool canonical = o.mesh.empty();
+  const Scene scene = canonical ? canonical_scene() : plane_scene();
+  const Technique technique = canonical ? canonical_technique(o.technique, o.depth) : Technique{};
+  make_context();
+  make_framebuffer(o.width, o.height);
+  const GLsizei index_count = upload_mesh(make_grid(canonical || o.mesh == "plane" ? 1 : 710));
+  const bool hit_uv = !o.hit_uv.empty();
+  const GLuint program = link_program(canonical ? fragment_shader(technique, hit_uv) : legacy_fragment_shader());
+  const Mat4 vp = view_projection(scene.camera, float(o.width) / float(o.height));
+  glUniformMatrix4fv(glGetUniformLocation(program, "view_projection"), 1, GL_FALSE, vp.m);
+  glUniform3f(glGetUniformLocation(program, "eye"), scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z);
+  bind_textures(program, canonical ? canonical_textures() : plane_textures(), technique.kind != TechniqueKind::Normal);
+
+  const std::string renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string what = canonical ? "\"scene\": \"canonical\", \"technique\": \"" + o.technique +
+                                           "\", \"depth_scale\": " + std::to_string(o.depth) +
+                                           ", \"knobs\": " + technique_json(technique)
+                                     : "\"scene\": \"plane\", \"mesh\": \"" + o.mesh + "\"";
+  if (hit_uv) {
+    const double iterations = write_hit_uv(index_count, o.width, o.height, o.hit_uv);
+    std::printf("{\"renderer\": \"%s\", %s, \"width\": %d, \"height\": %d, \"pixels_covered\": %ld, "
+                "\"iterations_mean\": %.4f, \"hit_uv\": \"%s\"}\n",
+                renderer.c_str(), what.c_str(), o.width, o.height, covered_pixels(o.width, o.height), iterations,
+                o.hit_uv.c_str());
+    return 0;
+  }
+  std::vector<double> ms = time_frames(index_count, o.runs, scene.background);
+  if (!o.image.empty()) write_pfm(o.image, o.width, o.height, read_rgb(o.width, o.height));
+  const long covered = covered_pixels(o.width, o.height);
+  std::string frames;
+  for (double m : ms) frames += (frames.empty() ? "" : ", ") + std::to_string(m);
   std::sort(ms.begin(), ms.end());
-  std::printf("{\"renderer\": \"%s\", \"mesh\": \"%s\", \"triangles\": %zu, \"pixels_covered\": %td, \"runs\": %d, "
-              "\"median_ms\": %.3f}\n",
-              reinterpret_cast<const char*>(glGetString(GL_RENDERER)), mesh.c_str(), indices.size() / 3, covered, runs,
-              ms[ms.size() / 2]);
+  std::printf("{\"renderer\": \"%s\", %s, \"width\": %d, \"height\": %d, \"triangles\": %d, \"pixels_covered\": %ld, "
+              "\"runs\": %d, \"median_ms\": %.3f, \"frames_ms\": [%s]}\n",
+              renderer.c_str(), what.c_str(), o.width, o.height, index_count / 3, covered, o.runs, ms[ms.size() / 2],
+              frames.c_str());
   return 0;
 }
 
 }  // namespace
+}  // namespace llvmpipe_bench
 
 int main(int argc, char** argv) {
   try {
-    return run(argc, argv);
+    return llvmpipe_bench::run(argc, argv);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "llvmpipe_bench: %s\n", e.what());
     return 1;
