@@ -7,8 +7,6 @@
 //                                exact at level 0 (the box surface QDM intersects).
 // SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (shade/blend.hpp) combines
 // up to four. Both are small per-batch values; the algorithms are templates over the surface type.
-#include <optional>
-
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "texture/sampler.hpp"

@@ -236,13 +236,6 @@ void load_fixed(const TextureView& view, const Int& level, const Int& x, const I
   load_with(K, Wrap, view, level, x, y, out);
 }
 
-void load_generic_wrapped(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path,
-                          Float* out) {
-  SamplerKey k = sampler_key(view, SamplerState{});
-  k.fetch = path;
-  load_with(k, true, view, level, x, y, out);
-}
-
 #undef QDMR_INLINE
 
 // The common keys, instantiated: the filters programs use for colour and height (point, bilinear, trilinear) with
@@ -284,13 +277,18 @@ constexpr std::array<SampleEntry, sizeof...(I)> common_samplers(std::index_seque
 }
 constexpr std::array<SampleEntry, kCommonKeys> kCommonSamplers = common_samplers(std::make_index_sequence<kCommonKeys>());
 
-// Loads depend on the format only.
-constexpr SamplerKey load_key(TexelFormat format, bool srgb) {
+// Loads depend on the format and the fetch path only.
+constexpr SamplerKey load_key(TexelFormat format, bool srgb, FetchPath fetch = kDefaultFetch) {
   SamplerKey k;
   k.format = format;
   k.srgb = srgb;
-  k.fetch = kDefaultFetch;
+  k.fetch = fetch;
   return k;
+}
+
+void load_generic_wrapped(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path,
+                          Float* out) {
+  load_with(load_key(view.texture().format, view.texture().srgb, path), true, view, level, x, y, out);
 }
 
 struct LoadEntry {
@@ -362,9 +360,7 @@ void sample(const TextureView& view, const SamplerState& s, const Float& u, cons
 }
 
 void load(const TextureView& view, const Int& level, const Int& x, const Int& y, FetchPath path, Float* out) {
-  SamplerKey k = sampler_key(view, SamplerState{});
-  k.fetch = path;
-  load_with(k, false, view, level, x, y, out);
+  load_with(load_key(view.texture().format, view.texture().srgb, path), false, view, level, x, y, out);
 }
 
 SampleFunction sample_function(const SamplerKey& key) {
