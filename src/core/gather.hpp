@@ -58,6 +58,21 @@ inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path)
   return Int::load_aligned(value);
 }
 
+// table[index[lane]] for a table of 16 int32 and index in [0, 16), such as a texture's per-level sizes: a register
+// permute where the ISA has one (AVX2: two, AVX-512: one), far cheaper than a gather.
+inline Int lookup16(const std::int32_t* table, const Int& index) {
+#if defined(__AVX512F__)
+  return _mm512_permutexvar_epi32(__m512i(index), _mm512_loadu_si512(table));
+#elif defined(__AVX2__)
+  const __m256i i = __m256i(index);
+  const __m256i low = _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(table)), i);
+  const __m256i high = _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(table + 8)), i);
+  return _mm256_blendv_epi8(low, high, _mm256_cmpgt_epi32(i, _mm256_set1_epi32(7)));
+#else
+  return load_i32(table, index, FetchPath::Portable);
+#endif
+}
+
 inline Float load_f32(const float* table, const Int& index, FetchPath path) {
 #if defined(__AVX2__)
   if (path == FetchPath::Gather) return gather_f32<4>(table, index);

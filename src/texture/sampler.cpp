@@ -72,9 +72,11 @@ struct LevelInfo {
   Int width, height, offset;
 };
 
-QDMR_INLINE LevelInfo level_info(const TextureView& view, const Int& level, FetchPath path) {
-  return {simd::load_i32(view.widths(), level, path), simd::load_i32(view.heights(), level, path),
-          simd::load_i32(view.offsets(), level, path)};
+// level in [0, levels): the tables hold TextureView::kMaxLevels = 16 entries, a register permute's worth.
+QDMR_INLINE LevelInfo level_info(const TextureView& view, const Int& level) {
+  static_assert(TextureView::kMaxLevels == 16);
+  return {simd::lookup16(view.widths(), level), simd::lookup16(view.heights(), level),
+          simd::lookup16(view.offsets(), level)};
 }
 
 // Level 0 for every lane (the point and bilinear filters): no table lookups.
@@ -197,13 +199,13 @@ QDMR_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const
     const int bits = k.fraction_bits;
     if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
     if (k.filter == Filter::PointMipPoint || k.filter == Filter::LinearMipPoint) {
-      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f))), k.fetch), linear, out);
+      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f)))), linear, out);
     } else {  // trilinear, point-mip-linear
       const Float l0 = xsimd::floor(l), f = l - l0;
       const Int i0 = xsimd::to_int(l0);
       Float fine[4], coarse[4];
-      sample_level(view, k, ru, rv, level_info(view, i0, k.fetch), linear, fine);
-      sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1)), k.fetch), linear,
+      sample_level(view, k, ru, rv, level_info(view, i0), linear, fine);
+      sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear,
                    coarse);
       for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
     }
@@ -215,7 +217,7 @@ QDMR_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const
 QDMR_INLINE void load_with(const SamplerKey& k, bool wrap, const TextureView& view, const Int& level, const Int& x,
                            const Int& y, Float* out) {
   const Int l = xsimd::min(xsimd::max(level, Int(0)), Int(view.levels() - 1));
-  const LevelInfo info = level_info(view, l, k.fetch);
+  const LevelInfo info = level_info(view, l);
   if (wrap) {
     fetch(view, k, info, x & (info.width - Int(1)), y & (info.height - Int(1)), out);
     return;
