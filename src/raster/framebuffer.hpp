@@ -2,6 +2,7 @@
 // The render targets of a frame: colour and depth always, AOV planes only when asked for. Kept by the renderer
 // from frame to frame (resize() keeps the memory when the size allows), so a warm frame touches no new pages.
 // Never cleared as a whole: each tile clears its own pixels before drawing (clear_rect), in parallel.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -35,19 +36,23 @@ struct Framebuffer {
 
   std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
   void clear_rect(int x0, int y0, int x1, int y1) {  // inclusive bounds
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const std::size_t i = index(x, y);
-        color[3 * i] = background.x;
-        color[3 * i + 1] = background.y;
-        color[3 * i + 2] = background.z;
-        depth[i] = 1.0f;
-        for (int a = 0; a < kAovCount; ++a) {
-          if (aov[std::size_t(a)].empty()) continue;
-          const std::size_t n = std::size_t(aov_channels(Aov(a)));
-          for (std::size_t c = 0; c < n; ++c) aov[std::size_t(a)][n * i + c] = 0.0f;
-        }
+    const std::size_t n = std::size_t(x1 - x0 + 1);
+    for (int y = y0; y <= y1; ++y) {
+      const std::size_t first = index(x0, y);
+      float* rgb = color.data() + 3 * first;
+      for (std::size_t i = 0; i < n; ++i) {
+        rgb[3 * i] = background.x;
+        rgb[3 * i + 1] = background.y;
+        rgb[3 * i + 2] = background.z;
       }
+      std::fill_n(depth.data() + first, n, 1.0f);
+      for (int a = 0; a < kAovCount; ++a) {
+        PixelBuffer& plane = aov[std::size_t(a)];
+        if (plane.empty()) continue;
+        const std::size_t channels = std::size_t(aov_channels(Aov(a)));
+        std::fill_n(plane.data() + channels * first, channels * n, 0.0f);
+      }
+    }
   }
   std::size_t bytes() const {
     std::size_t floats = color.size() + depth.size();

@@ -34,6 +34,14 @@ EdgeSteps edge_steps(const TriangleSetup& s) {
   return e;
 }
 
+// w as the nearest float, as float(w) rounds it, in operations a compiler vectorises (no int64 -> float
+// instruction before AVX-512): w + 1.5 * 2^52 as a double is exact for |w| < 2^51, and rounding that exact double
+// to float is the one rounding float(w) makes. Edge values stay below 2^50 (limits::kGuardBandPixels).
+inline float edge_to_float(std::int64_t w) {
+  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52, bits 0x4338000000000000
+  return float(std::bit_cast<double>(std::uint64_t(w) + std::bit_cast<std::uint64_t>(kMagic)) - kMagic);
+}
+
 // Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside.
 int classify_block(const TriangleSetup& s, int bx, int by) {
   bool full = true;
@@ -55,7 +63,9 @@ int classify_block(const TriangleSetup& s, int bx, int by) {
 class TileRasterizer {
 public:
   TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters, FetchRecorder* recorder)
-      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters), recorder_(recorder) {}
+      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters), recorder_(recorder) {
+    for (int a = 0; a < kAovCount; ++a) any_aov_ |= !fb_.aov[std::size_t(a)].empty() && Aov(a) != Aov::CacheMisses;
+  }
 
   void triangle(const TriangleSetup& s) {
     ++counters_.bin_entries;
@@ -90,26 +100,38 @@ private:
   void batch(int x, int y, bool full) {
     const TriangleSetup& s = *setup_;
     const std::int64_t X = pixel_centre_fixed(x), Y = pixel_centre_fixed(y);
-    std::int64_t w[3][kLanes];
-    std::uint32_t inside = 0;
+    alignas(64) std::int64_t w[3][kLanes];
     for (int i = 0; i < 3; ++i) {
       const std::int64_t base = s.edge(i, X, Y);
       for (int l = 0; l < kLanes; ++l) w[i][l] = base + steps_.lane[i][l];
     }
-    for (int l = 0; l < kLanes; ++l) {
-      const int px = x + lane_dx(l), py = y + lane_dy(l);
-      if (px > tile_.x1 || py > tile_.y1) continue;
-      const bool in = full || ((w[0][l] + s.bias[0]) | (w[1][l] + s.bias[1]) | (w[2][l] + s.bias[2])) >= 0;
-      inside |= std::uint32_t(in) << l;
+    // Batches that lie wholly in the tile (all but those on its right or bottom edge) skip the per-lane bounds.
+    const bool whole = x + kBatchWidth - 1 <= tile_.x1 && y + 1 <= tile_.y1;
+    std::uint32_t inside = 0;
+    if (full && whole) {
+      inside = (1u << kLanes) - 1u;
+    } else {
+      for (int l = 0; l < kLanes; ++l) {
+        const int px = x + lane_dx(l), py = y + lane_dy(l);
+        if (px > tile_.x1 || py > tile_.y1) continue;
+        const bool in = full || ((w[0][l] + s.bias[0]) | (w[1][l] + s.bias[1]) | (w[2][l] + s.bias[2])) >= 0;
+        inside |= std::uint32_t(in) << l;
+      }
+      if (inside == 0) return;
     }
-    if (inside == 0) return;
 
     alignas(64) float e[3][kLanes];
     alignas(64) float stored_depth[kLanes];
     for (int i = 0; i < 3; ++i)
-      for (int l = 0; l < kLanes; ++l) e[i][l] = float(w[i][l]);
-    for (int l = 0; l < kLanes; ++l)
-      stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+      for (int l = 0; l < kLanes; ++l) e[i][l] = edge_to_float(w[i][l]);
+    if (whole) {
+      // Lanes outside the triangle read their pixel's depth too: harmless, every test below is masked by inside.
+      const float* row = fb_.depth.data() + fb_.index(x, y);
+      for (int l = 0; l < kLanes; ++l) stored_depth[l] = row[lane_dy(l) * fb_.width + lane_dx(l)];
+    } else {
+      for (int l = 0; l < kLanes; ++l)
+        stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+    }
     const Float e0 = Float::load_aligned(e[0]), e1 = Float::load_aligned(e[1]), e2 = Float::load_aligned(e[2]);
     const Float z = e0 * Float(s.z_over_area[0]) + e1 * Float(s.z_over_area[1]) + e2 * Float(s.z_over_area[2]);
     const std::uint32_t pass = inside & simd::to_bits(z < Float::load_aligned(stored_depth));
@@ -168,12 +190,18 @@ private:
     alignas(64) float zs[kLanes], color[3][kLanes];
     z.store_aligned(zs);
     for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
+    const std::size_t origin = fb_.index(x, y);
     for (int l = 0; l < kLanes; ++l) {
       if (!((pass >> l) & 1u)) continue;
-      const std::size_t i = fb_.index(x + lane_dx(l), y + lane_dy(l));
+      const std::size_t i = origin + std::size_t(lane_dy(l) * fb_.width + lane_dx(l));
       fb_.depth[i] = zs[l];
       for (int c = 0; c < 3; ++c) fb_.color[3 * i + c] = color[c][l];
     }
+    if (any_aov_) write_aovs(x, y, pass, in, out);
+    count(pass, out);
+  }
+
+  void write_aovs(int x, int y, std::uint32_t pass, const Fragments& in, const ShadeOutput& out) {
     // AOVs: each requested plane gets its channels, in the order aov_channels() documents.
     const Float* sources[kAovCount][3] = {
         {&in.view_depth},
@@ -199,15 +227,28 @@ private:
         for (int c = 0; c < channels; ++c) plane[std::size_t(channels) * i + std::size_t(c)] = values[c][l];
       }
     }
+  }
+
+  void count(std::uint32_t pass, const ShadeOutput& out) {
     alignas(64) float iterations[kLanes];
     out.iterations.store_aligned(iterations);
-    float longest = 0.0f;
-    for (int l = 0; l < kLanes; ++l) {
+    float longest = iterations[0], shortest = iterations[0];
+    for (int l = 1; l < kLanes; ++l) {
       longest = std::max(longest, iterations[l]);
-      if (!((pass >> l) & 1u)) continue;
-      const auto n = std::uint64_t(iterations[l]);
-      counters_.iterations_useful += n;
-      ++counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)];
+      shortest = std::min(shortest, iterations[l]);
+    }
+    if (longest == shortest) {  // every lane alike (always, for a program without a trace): one bin
+      const auto n = std::uint64_t(longest);
+      const auto lanes = std::uint64_t(std::popcount(pass));
+      counters_.iterations_useful += n * lanes;
+      counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)] += lanes;
+    } else {
+      for (int l = 0; l < kLanes; ++l) {
+        if (!((pass >> l) & 1u)) continue;
+        const auto n = std::uint64_t(iterations[l]);
+        counters_.iterations_useful += n;
+        ++counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)];
+      }
     }
     counters_.iterations_executed += std::uint64_t(longest) * kLanes;
     ++counters_.batches_shaded;
@@ -224,6 +265,7 @@ private:
   const ShadingProgram* program_ = nullptr;
   const ScreenVertex* vertex_[3] = {};
   FetchRecorder* recorder_;
+  bool any_aov_ = false;  // an AOV plane other than cache_misses (filled after the tile) is asked for
 };
 
 }  // namespace
