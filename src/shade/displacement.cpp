@@ -218,9 +218,13 @@ namespace {
 // Albedo and tangent-space normal (unnormalised) of one layer at the hit.
 void layer_colour(const TextureSampler& albedo_texture, const TextureSampler& normal_texture, const UvDerivatives& d,
                   const Float& u, const Float& v, Float* albedo, Float* normal) {
-  albedo_texture.sample(u, v, albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+  const Float albedo_lod = albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+  albedo_texture.sample(u, v, albedo_lod, albedo);
   Float n[4];
-  normal_texture.sample(u, v, normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), n);
+  normal_texture.sample(u, v,
+                        normal_texture.same_lod_as(albedo_texture) ? albedo_lod
+                                                                   : normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
+                        n);
   for (int c = 0; c < 3; ++c) normal[c] = n[c] * Float(2.0f) - Float(1.0f);
 }
 

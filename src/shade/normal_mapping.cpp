@@ -12,9 +12,11 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   const Float& v = in.varyings[kV];
   const UvDerivatives d = UvDerivatives::from(u, v, lod_mode_);
   Float albedo[4];
-  albedo_.sample(u, v, albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), albedo);
+  const Float albedo_lod = albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+  albedo_.sample(u, v, albedo_lod, albedo);
   Float tangent_normal[4];
-  normal_.sample(u, v, normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy), tangent_normal);
+  normal_.sample(u, v, normal_.same_lod_as(albedo_) ? albedo_lod : normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
+                 tangent_normal);
 
   const TangentFrame frame = TangentFrame::from(in);
   const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),

@@ -25,14 +25,12 @@ constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 Mask is_finite(const Float& x) { return (x - x) == Float(0.0f); }
 
-const float* srgb_table() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int k = 0; k < 256; ++k) t[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
-    return t;
-  }();
-  return table.data();
-}
+// Built when the program starts, not on first use: a function-local static would test its guard at every fetch.
+const std::array<float, 256> kSrgbTable = [] {
+  std::array<float, 256> t{};
+  for (int k = 0; k < 256; ++k) t[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
+  return t;
+}();
 
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
@@ -87,7 +85,7 @@ QDMR_INLINE LevelInfo level_zero(const TextureView& view) {
 QDMR_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
   const Float inv255(255.0f);
   const auto unorm8 = [&](const Int& byte, bool srgb) {
-    return srgb ? simd::load_f32(srgb_table(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
+    return srgb ? simd::load_f32(kSrgbTable.data(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
   };
   switch (k.format) {
     case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), k.srgb); return;
@@ -96,7 +94,10 @@ QDMR_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
       out[1] = unorm8((raw >> 8) & Int(0xFF), k.srgb);
       return;
     case TexelFormat::RGBA8:
-      for (int c = 0; c < 4; ++c) out[c] = unorm8((raw >> (8 * c)) & Int(0xFF), k.srgb && c < 3);
+      out[0] = unorm8(raw & Int(0xFF), k.srgb);
+      out[1] = unorm8((raw >> 8) & Int(0xFF), k.srgb);
+      out[2] = unorm8((raw >> 16) & Int(0xFF), k.srgb);
+      out[3] = unorm8(xsimd::bitwise_cast<Int>(xsimd::bitwise_cast<simd::UInt>(raw) >> 24), false);
       return;
     case TexelFormat::R16: out[0] = xsimd::to_float(raw & Int(0xFFFF)) / Float(65535.0f); return;
     case TexelFormat::R32F: out[0] = xsimd::bitwise_cast<Float>(raw); return;

@@ -115,6 +115,11 @@ public:
   simd::Float lod(const simd::Float& dudx, const simd::Float& dvdx, const simd::Float& dudy, const simd::Float& dvdy) const {
     return lod_from_derivatives(view_, dudx, dvdx, dudy, dvdy);
   }
+  // lod() depends on the level-0 size and the level count only: textures alike in both share one LOD.
+  bool same_lod_as(const TextureSampler& other) const {
+    return texture().width() == other.texture().width() && texture().height() == other.texture().height() &&
+           view_.levels() == other.view_.levels();
+  }
   // load() above, with this texture's format fixed.
   void load(const simd::Int& level, const simd::Int& x, const simd::Int& y, simd::Float* out) const {
     load_(view_, level, x, y, state_.fetch, out);
