@@ -51,9 +51,7 @@ public:
 
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes).
   simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
-    simd::Float texel[4];
-    textures_->tree.load_wrapped(level, cx, cy, texel);
-    return texel[0];
+    return textures_->tree.load_wrapped_first(level, cx, cy);
   }
 
   // The highest height anywhere (a bound for early exits).
