@@ -2,6 +2,7 @@
 // SIMD types of this build. Private to src/: the architecture is fixed by the build flags (QDMR_SIMD),
 // so these types must never appear in a public header.
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include <xsimd/xsimd.hpp>
@@ -44,9 +45,20 @@ inline Mask from_bits(std::uint32_t bits) {
   return Float::load_aligned(lanes) != Float(0.0f);
 }
 
-// Mask conversions between float and integer lanes (xsimd 8 has no batch_bool_cast), and a mask as 0/1.
-inline IntMask int_mask(const Mask& m) { return xsimd::to_int(xsimd::select(m, Float(1.0f), Float(0.0f))) != Int(0); }
-inline Mask float_mask(const IntMask& m) { return xsimd::to_float(xsimd::select(m, Int(1), Int(0))) != Float(0.0f); }
+// Mask conversions between float and integer lanes (xsimd 8 has no batch_bool_cast): a reinterpretation of the
+// register, all-ones or all-zero lanes with SSE and AVX2, the same 16-bit mask with AVX-512. And a mask as 0/1.
+template <class To, class From>
+To reinterpret_mask(const From& m) {
+  using ToRegister = typename To::register_type;
+  using FromRegister = typename From::register_type;
+  static_assert(sizeof(ToRegister) == sizeof(FromRegister));
+  const FromRegister from = m;
+  ToRegister to;
+  std::memcpy(&to, &from, sizeof to);  // a register move (std::bit_cast of vector types trips -Wignored-attributes)
+  return To(to);
+}
+inline IntMask int_mask(const Mask& m) { return reinterpret_mask<IntMask>(m); }
+inline Mask float_mask(const IntMask& m) { return reinterpret_mask<Mask>(m); }
 inline Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
 
 // Coarse derivatives (what GPUs do): per quad, d/dx = top-right - top-left, d/dy = bottom-left - top-left,

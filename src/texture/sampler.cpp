@@ -25,13 +25,6 @@ constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 Mask is_finite(const Float& x) { return (x - x) == Float(0.0f); }
 
-// Built when the program starts, not on first use: a function-local static would test its guard at every fetch.
-const std::array<float, 256> kSrgbTable = [] {
-  std::array<float, 256> t{};
-  for (int k = 0; k < 256; ++k) t[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
-  return t;
-}();
-
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
 // Every helper below is inlined into sample_with/load_with, so where the key is a constant (an instantiation)
@@ -85,7 +78,7 @@ QDMR_INLINE LevelInfo level_zero(const TextureView& view) {
 QDMR_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
   const Float inv255(255.0f);
   const auto unorm8 = [&](const Int& byte, bool srgb) {
-    return srgb ? simd::load_f32(kSrgbTable.data(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
+    return srgb ? simd::load_f32(texture_detail::kSrgbByteToLinear.data(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
   };
   switch (k.format) {
     case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), k.srgb); return;
