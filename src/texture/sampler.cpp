@@ -105,6 +105,18 @@ QDMR_INLINE void fetch(const TextureView& view, const SamplerKey& k, const Level
   decode(k, simd::load_bytes4(t.storage.data(), offset, k.fetch), out);
 }
 
+// fetch() of texels (xa, y) and (xb, y) = (xa + 1, y) of a one-channel format of 1 or 2 bytes, from one load.
+QDMR_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& xa,
+                            const Int& xb, const Int& y, Float* a, Float* b) {
+  const Texture& t = view.texture();
+  const int bytes = bytes_per_texel(k.format);
+  trace_fetch(t, level.offset, xa, y);
+  trace_fetch(t, level.offset, xb, y);
+  const Int raw = simd::load_bytes4(t.storage.data(), level.offset + (y * level.width + xa) * Int(bytes), k.fetch);
+  decode(k, raw, a);
+  decode(k, raw >> (8 * bytes), b);  // decode keeps the texel's low bytes only
+}
+
 // u * n split into the fp32 product p and its rounding error e, exactly: p + e = u * n (Dekker's product, with
 // -ffp-contract=off; |u| <= 2 and n <= 16384 keep every partial product far from overflow and underflow).
 QDMR_INLINE void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
@@ -164,10 +176,17 @@ QDMR_INLINE void sample_level(const TextureView& view, const SamplerKey& k, cons
   const Int xa = address(x0, info.width, k.address), xb = address(x0 + Int(1), info.width, k.address);
   const Int ya = address(y0, info.height, k.address), yb = address(y0 + Int(1), info.height, k.address);
   Float t00[4], t10[4], t01[4], t11[4];
-  fetch(view, k, info, xa, ya, t00);
-  fetch(view, k, info, xb, ya, t10);
-  fetch(view, k, info, xa, yb, t01);
-  fetch(view, k, info, xb, yb, t11);
+  // One-channel texels of 1 or 2 bytes: texel xa + 1 lies in the 4 bytes loaded for xa, so where every lane's
+  // xb is xa + 1 (all but the lanes at a wrap or clamp edge) one load per row gives both texels.
+  if (channel_count(k.format) == 1 && bytes_per_texel(k.format) <= 2 && xsimd::all(xb == xa + Int(1))) {
+    fetch_pair(view, k, info, xa, xb, ya, t00, t10);
+    fetch_pair(view, k, info, xa, xb, yb, t01, t11);
+  } else {
+    fetch(view, k, info, xa, ya, t00);
+    fetch(view, k, info, xb, ya, t10);
+    fetch(view, k, info, xa, yb, t01);
+    fetch(view, k, info, xb, yb, t11);
+  }
   for (int c = 0; c < channel_count(k.format); ++c) {
     const Float top = t00[c] + (t10[c] - t00[c]) * wx;
     const Float bottom = t01[c] + (t11[c] - t01[c]) * wx;

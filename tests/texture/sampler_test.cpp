@@ -264,6 +264,40 @@ TEST(TextureSampler, GatherAndPortableFetchGiveTheSameBits) {
   }
 }
 
+// Bilinear taps of 8- and 16-bit one-channel texels come two per load where a row's pair is adjacent in memory
+// (sampler.cpp, fetch_pair); they must give the bits of an fp32 texture holding the same decoded values, which
+// is fetched one texel at a time: at random points, with lanes at the wrap and clamp edges mixed into the batch.
+TEST(TextureSampler, PairedTexelLoadsGiveTheBitsOfSingleLoads) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> coord(-1.5f, 2.5f), lod(-1.0f, 6.0f);
+  for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16}) {
+    const int max_code = format == TexelFormat::R8 ? 255 : 65535;
+    Image codes(32, 16, 1);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 32; ++x) codes.at(x, y, 0) = float((x * 977 + y * 131) % (max_code + 1)) / float(max_code);
+    const Texture narrow = make_mip_texture(codes, format, false, MipReduce::Box);
+    Image decoded(32, 16, 1);  // bilinear reads level 0 only
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 32; ++x) decoded.at(x, y, 0) = narrow.texel(0, x, y, 0);
+    const Texture wide = make_mip_texture(decoded, TexelFormat::R32F, false, MipReduce::Box);
+    for (const AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
+      for (int round = 0; round < 200; ++round) {
+        Lanes u, v, l;
+        for (int i = 0; i < kLanes; ++i) {
+          u[i] = round % 4 == 0 && i == 0 ? 31.75f / 32.0f : coord(rng);  // a lane whose right tap wraps or clamps
+          v[i] = coord(rng);
+          l[i] = lod(rng);
+        }
+        const SamplerState state = state_of(Filter::Bilinear, address, 0, SamplePrecision(round % 3));
+        Float a[4], b[4];
+        sample(TextureView(narrow), state, load(u), load(v), load(l), a);
+        sample(TextureView(wide), state, load(u), load(v), load(l), b);
+        for (int i = 0; i < kLanes; ++i)
+          ASSERT_EQ(bits(lanes(a[0])[i]), bits(lanes(b[0])[i])) << int(format) << " u " << u[i] << " v " << v[i];
+      }
+  }
+}
+
 TEST(TextureSampler, DecodesEveryFormatLikeTheScalarTexelAccessor) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
