@@ -25,6 +25,9 @@ HeightLayerTextures::HeightLayerTextures(const Texture& height_texture, const Te
       tree(quadtree ? *quadtree : height_texture, max_chain_state(material_sampler)),
       has_tree(quadtree != nullptr),
       sampler(material_sampler),
-      fetch(height_fetch) {}
+      fetch(height_fetch),
+      inline_height(height.key() == inline_height_key(TexelFormat::R16)  ? InlineHeight::BilinearR16
+                    : height.key() == inline_height_key(TexelFormat::R8) ? InlineHeight::BilinearR8
+                                                                         : InlineHeight::None) {}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -7,11 +7,31 @@
 //                                exact at level 0 (the box surface QDM intersects).
 // SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (shade/blend.hpp) combines
 // up to four. Both are small per-batch values; the algorithms are templates over the surface type.
+#include <cstdint>
+
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "texture/sampler.hpp"
+#include "texture/sampling_code.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
+
+// The height fetches inlined into the tracing loops (a call through the sampler's pointer would make each loop
+// spill its vector registers): bilinear 8- and 16-bit heights with wrap addressing on a power-of-two map, the
+// default fetch of the usual height map. Any other key calls its sampler.
+enum class InlineHeight : std::uint8_t { None, BilinearR8, BilinearR16 };
+
+constexpr SamplerKey inline_height_key(TexelFormat format) {
+  SamplerKey k;
+  k.filter = Filter::Bilinear;
+  k.address = AddressMode::Wrap;
+  k.fraction_bits = 0;
+  k.exact_texel = false;
+  k.format = format;
+  k.srgb = false;
+  k.fetch = simd::kHasHardwareGather ? simd::FetchPath::Gather : simd::FetchPath::Portable;
+  return k;
+}
 
 // The textures of one height layer, bound once per program to the samplers its material fixes.
 struct HeightLayerTextures {
@@ -24,6 +44,7 @@ struct HeightLayerTextures {
   bool has_tree;
   SamplerState sampler;   // the material's
   HeightFetch fetch;
+  InlineHeight inline_height;
 };
 
 class SingleLayerSurface {
@@ -43,9 +64,17 @@ public:
 
   // The filtered surface: the nearest or bilinear level-0 texel (the surfaces the exact reference knows), or
   // trilinear with `lod` (the talk's POM), which smooths heights with distance.
-  simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const {
+  [[gnu::always_inline]] simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const {
+    const TextureSampler& t = textures_->height;
+    switch (textures_->inline_height) {
+      case InlineHeight::BilinearR16:
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R16)>(t.view(), t.state(), u, v, lod);
+      case InlineHeight::BilinearR8:
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R8)>(t.view(), t.state(), u, v, lod);
+      case InlineHeight::None: break;
+    }
     simd::Float h[4];
-    textures_->height.sample(u, v, lod, h);
+    t.sample(u, v, lod, h);
     return h[0];
   }
 

@@ -108,7 +108,8 @@ public:
   const TextureView& view() const { return view_; }
   const Texture& texture() const { return view_.texture(); }
   const SamplerState& state() const { return state_; }
-  bool specialised() const { return is_specialised(sampler_key(view_, state_)); }
+  bool specialised() const { return is_specialised(key()); }
+  SamplerKey key() const { return sampler_key(view_, state_); }
 
   void sample(const simd::Float& u, const simd::Float& v, const simd::Float& lod, simd::Float* out) const {
     sample_(view_, state_, u, v, lod, out);
