@@ -9,12 +9,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cctype>
 #include <charconv>
 #include <climits>
 #include <cstring>
 #include <fstream>
 #include <string_view>
 
+#include "io/png_writer.hpp"
 #include "qdmr/core/error.hpp"
 
 namespace qdmr {
@@ -178,6 +180,15 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
   imageio::WriteSpec stamped = spec;
   if (std::none_of(spec.strings.begin(), spec.strings.end(), [](const auto& s) { return s.first == "DateTime"; }))
     stamped.strings.emplace_back("DateTime", "");
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".png" && png_writes(stamped)) {  // no image module needed
+    write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
+      std::string error;
+      return write_png(temporary.string(), stamped, data, error) ? "" : error;
+    });
+    return;
+  }
   const imageio::Backend& backend = imageio::backend();  // loaded before the temporary exists
   write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
     std::string error;

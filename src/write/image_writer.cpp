@@ -10,11 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/det_math.hpp"
 #include "io/atomic_file.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/write/write.hpp"
+#include "write/srgb_encode.hpp"
 
 namespace qdmr {
 namespace {
@@ -30,21 +30,17 @@ Container container_of(const std::filesystem::path& file) {
   throw Error(file.string(), "unsupported image type '" + ext + "' (use .png, .tif or .exr)");
 }
 
-// Exact sRGB transfer curve, with the deterministic pow so every machine writes the same bytes.
-float linear_to_srgb(float v) {
-  if (!(v > 0.0f)) return 0.0f;  // also maps NaN to black
-  if (v >= 1.0f) return 1.0f;
-  if (v <= 0.0031308f) return 12.92f * v;
-  return 1.055f * detmath::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
+// Pixels as codes of max_code steps (255 or 65535): sRGB-encoded or linear. Non-finite linear values give 0.
 template <typename T>
 std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb) {
   std::vector<T> out(values.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      float v = srgb ? linear_to_srgb(values[i]) : values[i];
-      v = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+      if (srgb) {
+        out[i] = max_code == 255.0f ? T(srgb_code8(values[i])) : T(srgb_code(values[i], max_code));
+        continue;
+      }
+      const float v = std::isfinite(values[i]) ? std::clamp(values[i], 0.0f, 1.0f) : 0.0f;
       out[i] = T(std::floor(v * max_code + 0.5f));
     }
   });

@@ -2,11 +2,16 @@
 // image: a missing module must not matter to anything else, and must be one clear error where an image is needed.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "cli/cli_test_util.hpp"
+#include "imageio/backend.hpp"
+#include "qdmr/core/version.hpp"
+#include "write/srgb_encode.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -39,12 +44,48 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
                                                (dir / "b.bin").string()});
   // bench writes its one image through the module: without it, a clear error and nothing written.
   EXPECT_EQ(bench.exit_code, 2) << bench.output;
-  const CommandResult render = run(cli(), {"render", plane, "-o", (dir / "p.png").string(), "--width", "32",
+  // 8-bit PNG output is written with libpng directly (io/png_writer.hpp): no module needed.
+  const CommandResult png = run(cli(), {"render", plane, "-o", (dir / "p.png").string(), "--width", "32",
+                                             "--height", "18"});
+  EXPECT_EQ(png.exit_code, 0) << png.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "p.png"));
+  // Any other format goes through the module.
+  const CommandResult render = run(cli(), {"render", plane, "-o", (dir / "p.exr").string(), "--width", "32",
                                                 "--height", "18"});
   EXPECT_EQ(render.exit_code, 2) << render.output;
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "p.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
+}
+
+// The PNG written without the module holds what qdmr means to write: every byte the sRGB code of the linear
+// value the same render writes to an EXR (through the module), and the metadata qdmr stamps (bits version,
+// Software), which `qdmr check` and `qdmr diff` read back.
+TEST(ImageModule, DirectPngHoldsTheCodesOfTheLinearRender) {
+  TempDir dir;
+  const std::string plane = (source_dir() / "scenes" / "plane.json").string();
+  for (const char* name : {"p.png", "p.exr"}) {
+    const CommandResult r = run(cli(), {"render", plane, "-o", (dir / name).string(), "--width", "48", "--height", "27"});
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  std::string error;
+  imageio::ReadFile png((dir / "p.png").string(), error);
+  ASSERT_TRUE(png) << error;
+  EXPECT_EQ(png.spec().width, 48);
+  EXPECT_EQ(png.spec().height, 27);
+  ASSERT_EQ(png.spec().channels, 3);
+  EXPECT_EQ(png.spec().type, imageio::PixelType::UInt8);
+  EXPECT_EQ(png.spec().bits_version, std::to_string(kBitsVersion));
+  EXPECT_NE(png.spec().software.find("qdmr"), std::string::npos);
+  std::vector<std::uint8_t> codes(48 * 27 * 3);
+  ASSERT_TRUE(png.read(imageio::PixelType::UInt8, codes.data(), 48 * 3, error)) << error;
+  imageio::ReadFile exr((dir / "p.exr").string(), error);
+  ASSERT_TRUE(exr) << error;
+  ASSERT_EQ(exr.spec().channels, 3);
+  std::vector<float> linear(48 * 27 * 3);
+  ASSERT_TRUE(exr.read(imageio::PixelType::Float, linear.data(), 48 * 3 * sizeof(float), error)) << error;
+  for (std::size_t i = 0; i < codes.size(); ++i)
+    ASSERT_EQ(std::uint32_t(codes[i]), srgb_code(linear[i], 255.0f)) << "value " << i << ": linear " << linear[i];
 }
 
 TEST(ImageModule, TheBuiltModuleWritesAndReadsImages) {
