@@ -23,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/sanitizer.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -34,7 +35,7 @@ namespace fs = std::filesystem;
 // command's CPU time (user + system): wall time on a shared 2-core CI machine measures the other jobs too (a
 // loaded machine took 2.2 s of wall time for 0.6 s of CPU). A hang that blocks without using the CPU (a FIFO, a
 // device) is caught by the wall-time kill at 20 s. Sanitizer builds run several times slower: limit 10 s.
-#if defined(__SANITIZE_ADDRESS__)
+#ifdef QDMR_TEST_ASAN
 constexpr double kMaxSeconds = 10.0;
 #else
 constexpr double kMaxSeconds = 2.0;

@@ -18,15 +18,9 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
+#include "support/sanitizer.hpp"
 #include "support/test_support.hpp"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define QDMR_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define QDMR_TEST_ASAN 1
-#endif
-#endif
 
 namespace qdmr::test {
 namespace {
