@@ -2,6 +2,13 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+
 #include "imageio/backend.hpp"
 
 namespace qdmr::imageio {
@@ -21,12 +28,51 @@ OIIO::TypeDesc type_desc(PixelType type) {
   return OIIO::TypeDesc::FLOAT;
 }
 
-Reader* open(const std::string& path, ReadSpec& spec, std::string& error) {
-  auto input = OIIO::ImageInput::open(path);
-  if (!input) {
-    error = OIIO::geterror();
-    return nullptr;
+// The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads
+// textures from, each of which checks the magic number first (valid_file). OpenImageIO's own fallback
+// (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file:
+// each a decoder run on an untrusted file for a format qdmr refuses anyway, and a few milliseconds.
+std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, std::string& error) {
+  // OpenImageIO's "extension_list": "tiff:tif,tiff;jpeg:jpg,jpe,jpeg;..." (every reader's and writer's).
+  static const std::map<std::string, std::string> formats = [] {
+    std::map<std::string, std::string> map;
+    std::istringstream list(OIIO::get_string_attribute("extension_list"));
+    for (std::string entry; std::getline(list, entry, ';');) {
+      const std::size_t colon = entry.find(':');
+      if (colon == std::string::npos) continue;
+      std::istringstream extensions(entry.substr(colon + 1));
+      for (std::string e; std::getline(extensions, e, ',');) map.emplace(e, entry.substr(0, colon));
+    }
+    return map;
+  }();
+  std::string extension = std::filesystem::path(path).extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  std::string tried;  // the format of the extension's reader
+  if (const auto format = formats.find(extension); format != formats.end()) {
+    // A format name alone: the reader is created, not opened.
+    if (auto input = OIIO::ImageInput::create(format->second)) {
+      tried = input->format_name();
+      OIIO::ImageSpec header;
+      if (input->open(path, header)) return input;
+      error = input->geterror();
+    }
   }
+  for (const char* format : {"png", "jpeg", "openexr", "tiff", "pnm"}) {
+    if (format == tried) continue;
+    auto input = OIIO::ImageInput::create(format);
+    if (!input || !input->valid_file(path)) continue;
+    OIIO::ImageSpec header;
+    if (input->open(path, header)) return input;
+    if (error.empty()) error = input->geterror();
+  }
+  if (error.empty()) error = tried.empty() ? "not a PNG, JPEG, OpenEXR, TIFF or PNM file" : "not a " + tried + " file";
+  return nullptr;
+}
+
+Reader* open(const std::string& path, ReadSpec& spec, std::string& error) {
+  auto input = open_input(path, error);
+  if (!input) return nullptr;
   const OIIO::ImageSpec& s = input->spec();
   spec.width = s.width;
   spec.height = s.height;
@@ -44,13 +90,44 @@ Reader* open(const std::string& path, ReadSpec& spec, std::string& error) {
 
 bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {
   OIIO::ImageInput& in = *reader->input;
-  const int channels = in.spec().nchannels;
-  if (in.read_image(0, 0, 0, channels, type_desc(type), first_row, OIIO::AutoStride, OIIO::stride_t(row_stride)) &&
-      !in.has_error())
-    return true;
-  error = in.geterror();
-  if (error.empty()) error = OIIO::geterror();
-  return false;
+  const OIIO::ImageSpec& spec = in.spec();
+  const int channels = spec.nchannels;
+  const OIIO::TypeDesc want = type_desc(type);
+  const auto failed = [&] {
+    error = in.geterror();
+    if (error.empty()) error = OIIO::geterror();
+    return false;
+  };
+  // Tiled files, and channels of different types, as OpenImageIO reads them.
+  if (spec.tile_width > 0 || !spec.channelformats.empty()) {
+    if (in.read_image(0, 0, 0, channels, want, first_row, OIIO::AutoStride, OIIO::stride_t(row_stride)) &&
+        !in.has_error())
+      return true;
+    return failed();
+  }
+  // Scanlines: read as the file stores them, top-down and contiguous, a few MB at a time, then converted and
+  // flipped here. Asked for another type or row order, OpenImageIO decodes through a buffer of 64 MB whatever
+  // the image's size (ImageInput::read_scanlines), allocated for every image read.
+  const std::size_t row_values = std::size_t(spec.width) * std::size_t(channels);
+  const std::size_t row_bytes = row_values * spec.format.size();
+  const int strip = std::max(1, spec.get_int_attribute("tiff:RowsPerStrip", 64));
+  const int rows = std::min(spec.height, std::max(1, int((std::size_t(4) << 20) / row_bytes) / strip) * strip);
+  std::unique_ptr<unsigned char[]> native(new unsigned char[row_bytes * std::size_t(rows)]);
+  for (int y0 = 0; y0 < spec.height; y0 += rows) {
+    const int y1 = std::min(y0 + rows, spec.height);
+    if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, channels, spec.format, native.get()) ||
+        in.has_error())
+      return failed();
+    for (int y = y0; y < y1; ++y) {
+      const unsigned char* from = native.get() + row_bytes * std::size_t(y - y0);
+      void* to = static_cast<char*>(first_row) + row_stride * y;
+      if (!OIIO::convert_pixel_values(spec.format, from, want, to, int(row_values))) {
+        error = "no conversion from " + std::string(spec.format.c_str()) + " pixels";
+        return false;
+      }
+    }
+  }
+  return true;
 }
 
 void close(Reader* reader) { delete reader; }

@@ -1,5 +1,6 @@
 #include "scene/overrides.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -51,22 +52,32 @@ void apply_override(nlohmann::json& document, const SceneOverride& override_, co
   }
   if (pointer.empty()) fail("cannot replace the whole document");
   const nlohmann::json::json_pointer parent_pointer = pointer.parent_pointer();
-  const std::string parent_text = parent_pointer.empty() ? "/" : parent_pointer.to_string();
+  // The parent's tokens, root first. The walk below goes down one token at a time from the node above: building
+  // every ancestor's pointer (and its text) made an override of N tokens cost N^2 string copies.
+  std::vector<std::string> tokens;
+  for (auto p = parent_pointer; !p.empty(); p.pop_back()) tokens.push_back(p.back());
+  std::reverse(tokens.begin(), tokens.end());
+  const auto text_of = [&](std::size_t count) {  // the pointer of the first `count` tokens, for messages
+    nlohmann::json::json_pointer p;
+    for (std::size_t i = 0; i < count; ++i) p.push_back(tokens[i]);
+    return p.empty() ? std::string("/") : p.to_string();
+  };
   // Optional blocks the file leaves out (a material's "technique", the "camera") are created as empty objects
   // on the way, so any value can be set; validation then reports misspelt keys with suggestions. Array
   // elements are never created, except by '-' at the end.
-  std::vector<nlohmann::json::json_pointer> ancestors;  // the parent and its ancestors, root-most first
-  for (auto p = parent_pointer; !p.empty(); p = p.parent_pointer()) ancestors.insert(ancestors.begin(), p);
-  for (const nlohmann::json::json_pointer& next : ancestors) {
-    if (document.contains(next)) continue;
-    const nlohmann::json::json_pointer above = next.parent_pointer();
-    nlohmann::json& node = document[above];
-    const std::string above_text = above.empty() ? "/" : above.to_string();
-    if (node.is_array()) fail(above_text + " has no element '" + next.back() + "'");
-    if (!node.is_object()) fail(above_text + " is a " + std::string(node.type_name()) + ", not an object or array");
-    node[next.back()] = nlohmann::json::object();
+  nlohmann::json* node = &document;
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    nlohmann::json::json_pointer step;
+    step.push_back(tokens[i]);
+    if (node->contains(step)) {  // contains() accepts only well-formed, in-range indices
+      node = &node->at(step);
+      continue;
+    }
+    if (node->is_array()) fail(text_of(i) + " has no element '" + tokens[i] + "'");
+    if (!node->is_object()) fail(text_of(i) + " is a " + std::string(node->type_name()) + ", not an object or array");
+    node = &((*node)[tokens[i]] = nlohmann::json::object());
   }
-  nlohmann::json& parent = document[parent_pointer];
+  nlohmann::json& parent = *node;
   const std::string& key = pointer.back();
   nlohmann::json value = parse_value(override_.value, file + ": " + override_.pointer);
 
@@ -79,11 +90,11 @@ void apply_override(nlohmann::json& document, const SceneOverride& override_, co
     }
     // contains() accepts only well-formed, in-range indices.
     if (!document.contains(pointer))
-      fail("no element '" + key + "' in " + parent_text + " (it has " + std::to_string(parent.size()) +
+      fail("no element '" + key + "' in " + text_of(tokens.size()) + " (it has " + std::to_string(parent.size()) +
            " elements; use '-' to append)");
     document[pointer] = std::move(value);
   } else {
-    fail(parent_text + " is a " + parent.type_name() + ", not an object or array");
+    fail(text_of(tokens.size()) + " is a " + parent.type_name() + ", not an object or array");
   }
 }
 

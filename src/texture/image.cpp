@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <string_view>
@@ -73,6 +74,86 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   return "";
 }
 
+// OpenEXR: OpenEXR allocates each header attribute's value at the size the file declares before reading it
+// (a 64 KiB file can claim a 2 GB string), and the tables of a part from its data window. So the headers are
+// walked here first, without allocating: every attribute's value must fit in the file, and the first part's
+// data window (the image qdmr reads) must be within the size limit. Returns what is wrong, or "" (also when the
+// walk meets what it does not know, a name longer than OpenEXR's 255 bytes: left to OpenEXR's own checks).
+std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
+  std::ifstream in(file, std::ios::binary);
+  const auto le32 = [](const unsigned char* b) {
+    return std::int32_t(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24);
+  };
+  unsigned char head[8];
+  if (!in.read(reinterpret_cast<char*>(head), 8)) return "truncated OpenEXR header";
+  const bool multipart = (le32(head + 4) & 0x1000) != 0;
+  std::uint64_t at = 8;
+  // A null-terminated string of at most 255 bytes; false at the end of the file or when longer.
+  const auto text = [&](std::string& out, bool& truncated) {
+    out.clear();
+    for (char c; in.get(c);) {
+      ++at;
+      if (c == '\0') return true;
+      if (out.size() == 255) return false;
+      out += c;
+    }
+    truncated = true;
+    return false;
+  };
+  for (int part = 0;; ++part) {
+    for (bool first = true;; first = false) {
+      std::string name, type;
+      bool truncated = false;
+      if (!text(name, truncated)) return truncated ? "truncated OpenEXR header" : "";
+      if (name.empty()) {
+        if (!multipart || (first && part > 0)) return "";  // the end of the header (or of the list of headers)
+        break;                                               // the end of this part's header
+      }
+      if (!text(type, truncated)) return truncated ? "truncated OpenEXR header" : "";
+      unsigned char field[4];
+      if (!in.read(reinterpret_cast<char*>(field), 4)) return "truncated OpenEXR header";
+      at += 4;
+      const std::int32_t bytes = le32(field);
+      if (bytes < 0 || at + std::uint64_t(bytes) > size)
+        return "damaged OpenEXR header: attribute '" + name + "' claims " + std::to_string(bytes) +
+               " bytes, the file has " + std::to_string(size - at) + " left";
+      if (part == 0 && name == "dataWindow" && type == "box2i" && bytes == 16) {
+        unsigned char box[16];
+        if (!in.read(reinterpret_cast<char*>(box), 16)) return "truncated OpenEXR header";
+        const std::int64_t width = std::int64_t(le32(box + 8)) - le32(box) + 1;
+        const std::int64_t height = std::int64_t(le32(box + 12)) - le32(box + 4) + 1;
+        if (width < 1 || height < 1 || width > limits::kMaxTextureSide || height > limits::kMaxTextureSide)
+          return "size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +
+                 std::to_string(limits::kMaxTextureSide);
+      } else {
+        in.seekg(bytes, std::ios::cur);
+      }
+      at += std::uint64_t(bytes);
+    }
+  }
+}
+
+// PNG: libpng allocates and clears a buffer of each chunk's declared length (up to 8 MB) before it reads the
+// chunk's data. The chunks are walked here first, without reading their data: each (length, type, data, CRC)
+// must fit in the file. Returns what is wrong, or "".
+std::string check_png_chunks(const std::filesystem::path& file, std::uint64_t size) {
+  std::ifstream in(file, std::ios::binary);
+  std::uint64_t at = 8;  // after the signature
+  unsigned char head[8];
+  while (at + 8 <= size) {
+    in.seekg(std::streamoff(at));
+    if (!in.read(reinterpret_cast<char*>(head), 8)) return "";
+    const std::uint64_t length =
+        std::uint64_t(head[0]) << 24 | std::uint64_t(head[1]) << 16 | std::uint64_t(head[2]) << 8 | head[3];
+    if (length > 0x7FFFFFFF || at + 12 + length > size)
+      return "truncated PNG (the chunk at byte " + std::to_string(at) + " claims " + std::to_string(length) +
+             " bytes, the file has " + std::to_string(size - at) + " from there)";
+    if (std::memcmp(head + 4, "IEND", 4) == 0) return "";
+    at += 12 + length;
+  }
+  return "";  // what is left is shorter than a chunk: the IEND check refuses it
+}
+
 // OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line.
 Error read_error(const std::string& where, const std::filesystem::path& file, std::string message) {
   while (!message.empty() && message.back() == '\n') message.pop_back();
@@ -85,6 +166,11 @@ Error read_error(const std::string& where, const std::filesystem::path& file, st
 std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& file, const std::string& where) {
   const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const std::uint64_t size = check_input_file(file, where, InputKind::Image);
+  // OpenImageIO gives a file to OpenEXR by its magic number whatever its extension.
+  if (bytes_of(file, 0, 4) == "\x76\x2F\x31\x01")
+    if (const std::string problem = check_exr(file, size); !problem.empty()) throw fail(problem);
+  if (bytes_of(file, 0, 8) == "\x89PNG\r\n\x1A\n")
+    if (const std::string problem = check_png_chunks(file, size); !problem.empty()) throw fail(problem);
   std::string error;
   auto in = std::make_unique<imageio::ReadFile>(file.string(), error);
   if (!*in) throw fail(error);

@@ -79,6 +79,11 @@ def png_chunk(kind, data):
 def png_header_only(w, h, color=2, depth=8):
     return b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, color, 0, 0, 0))
 
+def exr_window(data, xmin, ymin, xmax, ymax):
+    key = b"dataWindow\0box2i\0" + struct.pack("<i", 16)
+    at = data.index(key) + len(key)
+    return data[:at] + struct.pack("<iiii", xmin, ymin, xmax, ymax) + data[at + 16:]
+
 # --- bad images: (file, reason fragment) --------------------------------------------------------------
 images = [
     ("empty.png", b"", "is empty (0 bytes)"),
@@ -92,12 +97,19 @@ images = [
     ("png_zero_width.png", png_header_only(0, 64) + png[33:], "cannot read"),
     ("png_huge.png", png_header_only(100000, 100000) + png[33:], "cannot read"),
     ("png_wide.png", png_header_only(20000, 1) + png[33:], "outside 1..16384"),
+    # libpng allocates and clears a chunk's declared length before reading it.
+    ("png_chunk_past_end.png", png_header_only(64, 64) + struct.pack(">I", 7000000) + b"zTXt" + bytes(100) +
+     png_chunk(b"IEND", b""), "truncated PNG (the chunk at byte 33 claims 7000000 bytes"),
     ("jpeg_truncated_half.jpg", jpg[: len(jpg) // 2], "truncated JPEG"),
     ("jpeg_truncated_end.jpg", jpg[:-2], "truncated JPEG"),
     ("jpeg_soi_only.jpg", jpg[:2], "cannot read"),
     ("jpeg_header_only.jpg", jpg[:300], "cannot read"),
     ("exr_truncated.exr", exr[: len(exr) // 2], "cannot read"),
     ("exr_magic_only.exr", exr[:4], "cannot read"),
+    # Header fields OpenEXR allocates from before anything is checked: refused by qdmr's walk of the header.
+    ("exr_attribute_past_end.exr", exr[:8] + b"comments\0string\0" + struct.pack("<i", 200000000) + b"x" * 64,
+     "attribute 'comments' claims 200000000 bytes"),
+    ("exr_data_window_huge.exr", exr_window(exr, 0, 0, 99999, 99999), "size 100000x100000 is outside 1..16384"),
     ("tiff_truncated.tif", tif[: len(tif) // 2], "cannot read"),
     ("tiff_header_only.tif", tif[:8], "cannot read"),
     ("five_channels.tif", None, "5 channels (textures take 1 to 4)"),
