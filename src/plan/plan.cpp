@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -62,24 +63,59 @@ std::string request_key(const TextureDesc& d, TexturePurpose purpose, const Laye
 struct SourceInfo {
   int width = 1, height = 1;
   int bits = 8;  // per channel: 8 or 16 for integer files, 32 otherwise (as Image::source_bits)
+  std::optional<ImageHeader> file;  // a file's header
 };
 
-// Level-0 size and bit depth of a texture without building it (file headers are read).
+// Level-0 size and bit depth of a texture without building it (file headers are read). A from_height normal
+// map's are those of the layer's height.
 SourceInfo texture_source(const TextureDesc& d, const LayerDesc& layer, const std::string& where) {
   switch (d.source) {
     case TextureSource::None:
     case TextureSource::Constant: return {};
-    case TextureSource::Procedural: return {d.procedural.size, d.procedural.size, 16};
+    case TextureSource::Procedural: return {d.procedural.size, d.procedural.size, 16, std::nullopt};
     case TextureSource::FromHeight:
       if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {};
       return texture_source(layer.height, layer, where);
     case TextureSource::File: {
       // The same checks as when the texture is read (kind, size, format, header), nothing decoded.
       const ImageHeader header = read_image_header(d.file, where + "/file");
-      return {header.width, header.height, header.source_bits};
+      return {header.width, header.height, header.source_bits, header};
     }
   }
   return {};
+}
+
+// What building the request holds at once besides the finished texture: prepare's build_texture, step by step.
+std::uint64_t texture_working_bytes(const TextureRequest& r, const SourceInfo& source) {
+  const ImageHeader* file = source.file ? &*source.file : nullptr;
+  const std::uint64_t texels = std::uint64_t(r.width) * std::uint64_t(r.height);
+  const std::uint64_t height_image = texels * sizeof(float), colour_image = 3 * height_image;
+  std::uint64_t peak = 0;
+  if (r.purpose == TexturePurpose::Height) {
+    // The layer's heights, then that image while the chain is made from it.
+    peak = std::max(make_texture_bytes(r.desc, r.purpose, r.width, r.height, file), height_image + r.bytes);
+  } else if (r.desc.source == TextureSource::FromHeight) {
+    const std::uint64_t stored = mip_chain_bytes(r.width, r.height, height_format(r.layer.height, source.bits));
+    peak = std::max({make_texture_bytes(r.layer.height, TexturePurpose::Height, r.width, r.height, file),
+                     height_image + stored,  // the heights as stored, and then their level 0 decoded from that
+                     height_image + make_texture_bytes(r.desc, r.purpose, r.width, r.height, nullptr),  // normals
+                     colour_image + r.bytes});  // level 0 while the chain is made
+  } else {
+    peak = std::max(make_texture_bytes(r.desc, r.purpose, r.width, r.height, file), colour_image + r.bytes);
+  }
+  return peak > r.bytes ? peak - r.bytes : 0;
+}
+
+// Textures are built kTexturesBuiltAtOnce at a time, in any order: the most their builds hold at once is the sum of
+// that many of the largest.
+std::uint64_t textures_working_bytes(const std::vector<TextureRequest>& textures) {
+  std::vector<std::uint64_t> working;
+  for (const TextureRequest& t : textures) working.push_back(t.working_bytes);
+  std::sort(working.begin(), working.end(), std::greater<>());
+  working.resize(std::min(working.size(), kTexturesBuiltAtOnce));
+  std::uint64_t sum = 0;
+  for (std::uint64_t w : working) sum += w;
+  return sum;
 }
 
 int mip_levels(int w, int h) {
@@ -90,17 +126,6 @@ int mip_levels(int w, int h) {
     ++levels;
   }
   return levels;
-}
-
-// Storage of a typed chain: levels at 64-byte aligned offsets plus the gather padding (see mip_texture.hpp).
-std::uint64_t chain_bytes(int w, int h, TexelFormat format) {
-  std::uint64_t bytes = 0;
-  for (;;) {
-    bytes = (bytes + 63) / 64 * 64 + std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(bytes_per_texel(format));
-    if (w == 1 && h == 1) return bytes + Texture::kTailPadding;
-    w = std::max(1, w / 2);
-    h = std::max(1, h / 2);
-  }
 }
 
 const char* reduce_name(MipReduce r) {
@@ -135,7 +160,8 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.srgb = purpose == TexturePurpose::Albedo;
   r.format = purpose == TexturePurpose::Height ? height_format(desc, source.bits) : TexelFormat::RGBA8;
   r.levels = mip_levels(r.width, r.height);
-  r.bytes = chain_bytes(r.width, r.height, r.format);
+  r.bytes = mip_chain_bytes(r.width, r.height, r.format);
+  r.working_bytes = texture_working_bytes(r, source);
   r.users.push_back(user);
   textures.push_back(std::move(r));
   return int(textures.size() - 1);
@@ -292,7 +318,7 @@ public:
       const bool needs_combined = c.combined_quadtree || m.reference || c.blend_ao;
       if (m.weight_mode == WeightMode::Pixel || needs_combined)
         m.weights = add(DerivedKind::WeightTexture, wkey, where + "/blend/weights", {}, index,
-                        chain_bytes(w.resolution, w.resolution, TexelFormat::RGBA8));
+                        mip_chain_bytes(w.resolution, w.resolution, TexelFormat::RGBA8));
       if (needs_combined) {
         if (!whole)
           throw Error(where + "/blend/weights/scale", m.reference ? "error AOVs of a blend need a whole number of repeats"
@@ -318,7 +344,7 @@ public:
           ao.resolution = c.ao_side;
           m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + combined_key + "|" + ao_key(ao, desc.technique.depth_scale),
                            where + "/ao", {m.combined_surface}, index,
-                           chain_bytes(c.ao_side, c.ao_side, TexelFormat::R16), -1, c.ao_side);
+                           mip_chain_bytes(c.ao_side, c.ao_side, TexelFormat::R16), -1, c.ao_side);
         }
       }
     }
@@ -331,7 +357,7 @@ public:
                                                   : h.height;
         m.layers[l].ao = add(DerivedKind::LayerAoMap,
                              "ao|" + plan_.derived[std::size_t(field)].key + "|" + ao_key(desc.ao, desc.technique.depth_scale),
-                             where + "/ao", {field}, index, chain_bytes(side_w, side_h, TexelFormat::R16), -1, side_w);
+                             where + "/ao", {field}, index, mip_chain_bytes(side_w, side_h, TexelFormat::R16), -1, side_w);
       }
     }
     const bool bilinear_patch =
@@ -352,7 +378,7 @@ public:
       }
       if (bilinear_patch)
         m.bilinear_bound = add(DerivedKind::BilinearBound, "bilinear_bound|" + field_key, where + "/technique/refinement",
-                               {field}, index, chain_bytes(h.width, h.height, TexelFormat::R32F));
+                               {field}, index, mip_chain_bytes(h.width, h.height, TexelFormat::R32F));
     }
   }
 
@@ -461,7 +487,7 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
                           : "'combined' needs blend/weights/scale to be a whole number of repeats (use 'product')");
       if (fits) {
         choices.combined_quadtree = true;
-        choices.combined_bytes = chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
+        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
       }
     }
   }
@@ -528,6 +554,8 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
 
   for (const MeshPlan& m : plan.meshes) plan.mesh_bytes += m.bytes;
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
+  plan.texture_working_bytes = textures_working_bytes(plan.textures);
+  plan.working_bytes = plan.texture_working_bytes;
   for (const DerivedPlan& d : plan.derived) {
     plan.derived_bytes += d.bytes;
     plan.working_bytes = std::max(plan.working_bytes, d.working_bytes);
@@ -576,7 +604,9 @@ std::string FramePlan::describe() const {
     const TextureRequest& t = textures[i];
     s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << " "
       << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
-      << t.levels << " levels, " << mib(t.bytes) << "  <- " << t.where;
+      << t.levels << " levels, " << mib(t.bytes);
+    if (t.working_bytes >= (1 << 20) / 100) s << " (" << mib(t.working_bytes) << " more while it is built)";
+    s << "  <- " << t.where;
     if (t.desc.source == TextureSource::File) s << " (" << t.desc.file.filename().string() << ")";
     s << "\n";
   }
@@ -617,7 +647,9 @@ std::string FramePlan::describe() const {
       << c.region << " region\n";
   s << "memory: framebuffer " << mib(framebuffer_bytes) << ", textures " << mib(texture_bytes)
     << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes);
-  if (working_bytes > 0) s << ", working " << mib(working_bytes) << " (while a cone map is baked)";
+  if (working_bytes > 0)
+    s << ", working " << mib(working_bytes)
+      << (working_bytes == texture_working_bytes ? " (while textures are built)" : " (while a cone map is baked)");
   s << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
@@ -642,7 +674,8 @@ nlohmann::json FramePlan::to_json() const {
   for (const TextureRequest& t : textures) {
     nlohmann::json entry = {{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                             {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
-                            {"levels", t.levels}, {"bytes", t.bytes}, {"where", t.where}, {"users", t.users}};
+                            {"levels", t.levels}, {"bytes", t.bytes}, {"working_bytes", t.working_bytes},
+                            {"where", t.where}, {"users", t.users}};
     if (t.desc.source == TextureSource::File) entry["file"] = t.desc.file.string();
     j["textures"].push_back(entry);
   }
@@ -666,7 +699,8 @@ nlohmann::json FramePlan::to_json() const {
                           {"replacement", cache_replacement_name(c.replacement)}, {"layout", texel_layout_name(c.layout)},
                           {"quadtree", quadtree_storage_name(c.quadtree)}, {"region", c.region}, {"warp", c.warp}};
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
-                 {"derived_bytes", derived_bytes}, {"working_bytes", working_bytes}, {"total_bytes", total_bytes()}};
+                 {"derived_bytes", derived_bytes},
+                 {"texture_working_bytes", texture_working_bytes}, {"working_bytes", working_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

@@ -1,6 +1,7 @@
 #include "prepare/assets.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 
 #include <map>
 #include <mutex>
@@ -13,29 +14,34 @@
 namespace qdmr {
 namespace {
 
-// Builds one requested texture. Heights (and the heights behind from_height normals) go through the storage
-// the scene asks for — quantisation, BC3 — so what is rendered is what a GPU would sample.
-Texture build_texture(const TextureRequest& request, TextureStat& stat) {
-  const bool needs_height = request.purpose == TexturePurpose::Height || request.desc.source == TextureSource::FromHeight;
-  Texture texture;
-  Image height;
-  if (needs_height) {
-    // Behind a from_height normal map only level 0 is used: any reduction will do.
-    const MipReduce reduce = request.purpose == TexturePurpose::Height ? request.reduce : MipReduce::Box;
-    HeightTexture stored = make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce);
-    stat.height_format = format_name(stored.texture.format);
-    if (stored.bc3) {
-      stat.bc3 = true;
-      stat.bc3_max_error = stored.bc3->max_error;
-      stat.bc3_rms_error = stored.bc3->rms_error;
-    }
-    if (request.purpose == TexturePurpose::Height)
-      texture = std::move(stored.texture);
-    else
-      height = stored.texture.level_image(0);
+// A layer's heights through the storage the scene asks for (quantisation, BC3), so what is rendered is what a
+// GPU would sample; the BC3 error goes to `stat`.
+HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, TextureStat& stat) {
+  HeightTexture stored = make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce);
+  stat.height_format = format_name(stored.texture.format);
+  if (stored.bc3) {
+    stat.bc3 = true;
+    stat.bc3_max_error = stored.bc3->max_error;
+    stat.bc3_rms_error = stored.bc3->rms_error;
   }
-  if (request.purpose != TexturePurpose::Height) {
-    Image level0 = make_texture(request.desc, request.purpose, request.layer, needs_height ? &height : nullptr, request.where);
+  return stored;
+}
+
+// Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
+// texture_build_bytes counts the most this holds at once, step by step.
+Texture build_texture(const TextureRequest& request, TextureStat& stat) {
+  Texture texture;
+  if (request.purpose == TexturePurpose::Height) {
+    texture = stored_height(request, request.reduce, stat).texture;
+  } else {
+    Image level0;
+    if (request.desc.source == TextureSource::FromHeight) {
+      // Behind a from_height normal map only level 0 is used: any reduction will do.
+      const Image height = stored_height(request, MipReduce::Box, stat).texture.level_image(0);
+      level0 = make_texture(request.desc, request.purpose, request.layer, &height, request.where);
+    } else {
+      level0 = make_texture(request.desc, request.purpose, request.layer, nullptr, request.where);
+    }
     if (request.purpose == TexturePurpose::Normal)
       for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
     texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
@@ -149,16 +155,27 @@ private:
     const std::size_t n = plan_.textures.size();
     assets_.textures.resize(n);
     assets_.texture_stats.resize(n);
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-      const TextureRequest& request = plan_.textures[i];
-      if (auto it = previous_.textures.find(request.key); it != previous_.textures.end()) {
-        assets_.textures[i] = it->second.first;
-        assets_.texture_stats[i] = it->second.second;
-        return;
-      }
-      assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
-      record("texture " + request.key);
-    });
+    // At most kTexturesBuiltAtOnce in flight (the plan counts that many builds' working memory); each build's
+    // own loops use every thread.
+    std::size_t next = 0;
+    tbb::parallel_pipeline(
+        kTexturesBuiltAtOnce,
+        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                            [&](tbb::flow_control& fc) -> std::size_t {
+                                              if (next < n) return next++;
+                                              fc.stop();
+                                              return 0;
+                                            }) &
+            tbb::make_filter<std::size_t, void>(tbb::filter_mode::parallel, [&](std::size_t i) {
+              const TextureRequest& request = plan_.textures[i];
+              if (auto it = previous_.textures.find(request.key); it != previous_.textures.end()) {
+                assets_.textures[i] = it->second.first;
+                assets_.texture_stats[i] = it->second.second;
+                return;
+              }
+              assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
+              record("texture " + request.key);
+            }));
   }
 
   void derived(std::size_t index) {

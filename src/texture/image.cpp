@@ -212,6 +212,11 @@ ImageHeader read_image_header(const std::filesystem::path& file, const std::stri
   return {spec.width, spec.height, spec.channels, source_bits(spec)};
 }
 
+std::uint64_t read_image_bytes(const ImageHeader& header) {
+  const std::uint64_t values = std::uint64_t(header.width) * std::uint64_t(header.height) * std::uint64_t(header.channels);
+  return values * sizeof(float) + values * std::uint64_t(header.source_bits / 8);
+}
+
 Image read_image(const std::filesystem::path& file, const std::string& where) {
   const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const auto in = open_checked(file, where);
@@ -227,11 +232,18 @@ Image read_image(const std::filesystem::path& file, const std::string& where) {
     if (!in->read(type, last_row, -row, error)) throw fail(error);
   };
   // 8- and 16-bit integers are converted here as k / (2^bits - 1), correctly rounded, so values are exact
-  // (OIIO multiplies by a rounded reciprocal).
+  // (OIIO multiplies by a rounded reciprocal). They are read into the front of the float buffer and widened from
+  // the back, so no second buffer is held: float i (bytes 4i..4i+3) only overwrites integers i and above, which
+  // are widened already.
   const auto convert = [&](auto integer, float max) {
-    std::vector<decltype(integer)> raw(image.texels.size());
-    read(sizeof(integer) == 1 ? imageio::PixelType::UInt8 : imageio::PixelType::UInt16, sizeof(integer), raw.data());
-    for (std::size_t i = 0; i < raw.size(); ++i) image.texels[i] = float(raw[i]) / max;
+    using Integer = decltype(integer);
+    unsigned char* const bytes = reinterpret_cast<unsigned char*>(image.texels.data());
+    read(sizeof(Integer) == 1 ? imageio::PixelType::UInt8 : imageio::PixelType::UInt16, sizeof(Integer), bytes);
+    for (std::size_t i = image.texels.size(); i-- > 0;) {
+      Integer k;
+      std::memcpy(&k, bytes + i * sizeof(Integer), sizeof(Integer));
+      image.texels[i] = float(k) / max;
+    }
   };
   const int bits = source_bits(spec);
   if (bits == 8) {

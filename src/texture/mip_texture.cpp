@@ -152,6 +152,26 @@ Image Texture::level_image(int level) const {
   return image;
 }
 
+namespace {
+
+// The levels of a chain (into `levels` when not null) and its storage bytes, tail padding included.
+std::uint64_t chain_layout(int width, int height, TexelFormat format, std::vector<TextureLevel>* levels) {
+  std::uint64_t offset = 0;
+  for (int w = width, h = height;; w = std::max(1, w / 2), h = std::max(1, h / 2)) {
+    offset = (offset + kLevelAlignment - 1) / kLevelAlignment * kLevelAlignment;
+    if (levels) levels->push_back({w, h, std::size_t(offset)});
+    offset += std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(bytes_per_texel(format));
+    if (w == 1 && h == 1) break;
+  }
+  return offset + Texture::kTailPadding;
+}
+
+}  // namespace
+
+std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format) {
+  return chain_layout(width, height, format, nullptr);
+}
+
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
   if (width < 1 || height < 1 || width > limits::kMaxTextureSide || height > limits::kMaxTextureSide)
     throw Error("texture", "size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +
@@ -161,16 +181,9 @@ Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
   Texture t;
   t.format = format;
   t.srgb = srgb;
-  std::size_t offset = 0;
-  for (int w = width, h = height;; w = std::max(1, w / 2), h = std::max(1, h / 2)) {
-    offset = (offset + kLevelAlignment - 1) / kLevelAlignment * kLevelAlignment;
-    t.levels.push_back({w, h, offset});
-    offset += std::size_t(w) * std::size_t(h) * std::size_t(bytes_per_texel(format));
-    if (w == 1 && h == 1) break;
-  }
-  const std::size_t total = offset + Texture::kTailPadding;
-  if (total >= (std::size_t(1) << 31)) throw Error("texture", "the mip chain does not fit 32-bit byte offsets");
-  t.storage.assign(total, 0);
+  const std::uint64_t total = chain_layout(width, height, format, &t.levels);
+  if (total >= (std::uint64_t(1) << 31)) throw Error("texture", "the mip chain does not fit 32-bit byte offsets");
+  t.storage.assign(std::size_t(total), 0);
   return t;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <utility>
 #include <cmath>
 #include <vector>
 
@@ -60,7 +61,12 @@ std::vector<int> select_channels(const Image& image, Channel channel, int count,
   return std::vector<int>(std::size_t(count), single);
 }
 
-Image pick(const Image& src, const std::vector<int>& channels) {
+// `src` with the channels listed, in that order. Taken by value and freed on return, so the file image and the
+// picked one are not both held after it; a selection of all channels in order returns `src` itself.
+Image pick(Image src, const std::vector<int>& channels) {
+  bool identity = int(channels.size()) == src.channels;
+  for (std::size_t c = 0; c < channels.size(); ++c) identity = identity && channels[c] == int(c);
+  if (identity) return src;
   Image out(src.width, src.height, int(channels.size()));
   out.source_bits = src.source_bits;
   for_rows(src.height, [&](int y) {
@@ -101,8 +107,9 @@ Image albedo_texture(const TextureDesc& desc, const std::string& where) {
     case TextureSource::None: return constant({1.0f, 1.0f, 1.0f});
     case TextureSource::Constant: return constant({desc.constant.r, desc.constant.g, desc.constant.b});
     case TextureSource::File: {
-      const Image file = read_image(desc.file, where);
-      Image rgb = pick(file, select_channels(file, desc.channel, 3, desc, where));
+      Image file = read_image(desc.file, where);
+      const std::vector<int> channels = select_channels(file, desc.channel, 3, desc, where);
+      Image rgb = pick(std::move(file), channels);
       if (desc.srgb) {
         // 8-bit values (k / 255 exactly, as read_image gives them) from a table; the same results, faster.
         std::array<float, 256> table;
@@ -170,18 +177,19 @@ Image normal_texture(const TextureDesc& desc, const LayerDesc& layer, const Imag
       return constant({x, y, z});
     }
     case TextureSource::File: {
-      const Image file = read_image(desc.file, where);
+      Image file = read_image(desc.file, where);
       if (desc.channel != Channel::Default && desc.channel != Channel::RGB)
         throw Error(where, std::string("a normal map takes channels 'rgb', not '") + channel_name(desc.channel) + "'");
       if (file.channels < 3)
         throw Error(where, "'" + desc.file.string() + "' has " + std::to_string(file.channels) +
                                " channel(s); a normal map needs 3");
-      Image out(file.width, file.height, 3);
+      // Decoded in place: the file's RGB texels become the normals.
+      Image out = pick(std::move(file), {0, 1, 2});
       for_rows(out.height, [&](int y) {
         for (int x = 0; x < out.width; ++x) {
-          float nx = (2.0f * file.at(x, y, 0) - 1.0f) * strength;
-          float ny = (2.0f * file.at(x, y, 1) - 1.0f) * strength * flip;
-          float nz = 2.0f * file.at(x, y, 2) - 1.0f;
+          float nx = (2.0f * out.at(x, y, 0) - 1.0f) * strength;
+          float ny = (2.0f * out.at(x, y, 1) - 1.0f) * strength * flip;
+          float nz = 2.0f * out.at(x, y, 2) - 1.0f;
           normalise(nx, ny, nz);
           out.at(x, y, 0) = nx, out.at(x, y, 1) = ny, out.at(x, y, 2) = nz;
         }
@@ -205,8 +213,9 @@ Image height_texture(const TextureDesc& desc, const LayerDesc& layer, const std:
       out.source_bits = 8;
       break;
     case TextureSource::File: {
-      const Image file = read_image(desc.file, where);
-      out = pick(file, select_channels(file, desc.channel, 1, desc, where));
+      Image file = read_image(desc.file, where);
+      const std::vector<int> channels = select_channels(file, desc.channel, 1, desc, where);
+      out = pick(std::move(file), channels);
       break;
     }
     case TextureSource::Procedural:
@@ -257,6 +266,32 @@ Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerD
 
 Image make_layer_height(const LayerDesc& layer, const std::string& where) {
   return make_texture(layer.height, TexturePurpose::Height, layer, nullptr, where);
+}
+
+// Mirrors the slot functions above step by step: each step's peak is what it allocates plus what is still held.
+std::uint64_t make_texture_bytes(const TextureDesc& desc, TexturePurpose purpose, int width, int height,
+                                 const ImageHeader* file) {
+  const std::uint64_t texels = std::uint64_t(width) * std::uint64_t(height);
+  const std::uint64_t out_channels = purpose == TexturePurpose::Height ? 1 : 3;
+  const std::uint64_t out = texels * out_channels * sizeof(float);
+  switch (desc.source) {
+    case TextureSource::None:
+    case TextureSource::Constant: return out_channels * sizeof(float);
+    case TextureSource::FromHeight: return out;  // normals_from_height's result; the height is the caller's
+    case TextureSource::Procedural:
+      // The albedo's colours are made from a pattern with its cell ids (2 channels), held until they are done.
+      return purpose == TexturePurpose::Albedo ? texels * 2 * sizeof(float) + out : out;
+    case TextureSource::File: {
+      if (!file) return out;
+      const std::uint64_t decoded = texels * std::uint64_t(file->channels) * sizeof(float);
+      // pick() hands the file's image on when the selection is all its channels in order, else holds both.
+      const bool all_in_order = out_channels == 1 ? desc.channel == Channel::Default || desc.channel == Channel::R
+                                                  : desc.channel == Channel::Default || desc.channel == Channel::RGB;
+      const bool in_place = std::uint64_t(file->channels) == out_channels && all_in_order;
+      return std::max(read_image_bytes(*file), in_place ? decoded : decoded + out);
+    }
+  }
+  return out;
 }
 
 }  // namespace qdmr

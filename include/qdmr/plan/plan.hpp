@@ -33,8 +33,15 @@ struct TextureRequest {
   MipReduce reduce = MipReduce::Box;
   int width = 0, height = 0, levels = 0;
   std::uint64_t bytes = 0;   // level 0 and its mip chain
+  // What its build allocates on top of `bytes` and frees again, at the most: the decoded file, level 0 in floats,
+  // the heights behind from_height normals.
+  std::uint64_t working_bytes = 0;
   std::vector<std::string> users;  // material names
 };
+
+// prepare() builds at most this many textures at once (each of them with every thread), so that their working
+// memory is bounded whatever the number of threads.
+inline constexpr std::size_t kTexturesBuiltAtOnce = 2;
 
 // Data derived from textures, meshes and material settings, built after them.
 enum class DerivedKind {
@@ -110,10 +117,12 @@ struct FramePlan {
   std::vector<MeshPlan> meshes;          // one per scene object
   std::vector<Aov> aovs;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, derived_bytes = 0;
-  // The largest DerivedPlan::working_bytes: derived data is built one item at a time, so at most one build's
-  // working memory is held at once, on top of everything built before it.
+  // The working memory of the kTexturesBuiltAtOnce textures whose builds need the most.
+  std::uint64_t texture_working_bytes = 0;
+  // The most working memory held at once: texture_working_bytes, or the largest DerivedPlan::working_bytes
+  // (derived data is built one item at a time, after the textures). Counted on top of everything kept.
   std::uint64_t working_bytes = 0;
-  // The estimate --max-memory is checked against: everything kept, plus the largest build's working memory.
+  // The estimate --max-memory is checked against: everything kept, plus the most working memory held at once.
   std::uint64_t total_bytes() const {
     return framebuffer_bytes + texture_bytes + mesh_bytes + derived_bytes + working_bytes;
   }

@@ -2,6 +2,7 @@
 // Image: a level of texels as 32-bit floats, row-major, interleaved channels, row 0 at v = 0.
 // Files are read bottom-up: the last row of an image file is row 0 (OpenGL convention).
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -36,5 +37,9 @@ struct ImageHeader {
 };
 // The checks of read_image up to the header; nothing decoded (for plans and memory estimates).
 ImageHeader read_image_header(const std::filesystem::path& file, const std::string& where);
+
+// The most memory read_image holds at once for a file with this header: the float image it returns and the
+// decoder's own buffer (a PNG decoder holds the whole image, as the file stores it).
+std::uint64_t read_image_bytes(const ImageHeader& header);
 
 }  // namespace qdmr

@@ -49,6 +49,9 @@ public:
   Image level_image(int level) const;
 };
 
+// The storage bytes of the chain allocate_texture makes (for memory plans).
+std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format);
+
 // Allocates the chain for a w x h level 0 (all levels, zeroed, with the tail padding).
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb);
 

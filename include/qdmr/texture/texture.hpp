@@ -1,5 +1,6 @@
 #pragma once
 // Textures of a material: level-0 images made from TextureDesc, and their box-filtered mip chains.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -27,5 +28,11 @@ Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerD
 
 // Level 0 of a layer's height with scale/offset applied; a layer without one is flat at the top (1x1, h = 1).
 Image make_layer_height(const LayerDesc& layer, const std::string& where);
+
+// The most memory make_texture holds at once, its result included (not the `height` image passed in), for a slot
+// whose level 0 is width x height; `file`: the header of the slot's file (TextureSource::File), else null. For
+// memory plans: nothing is read or built.
+std::uint64_t make_texture_bytes(const TextureDesc& desc, TexturePurpose purpose, int width, int height,
+                                 const ImageHeader* file);
 
 }  // namespace qdmr
