@@ -21,17 +21,23 @@ struct Framebuffer {
   PixelBuffer depth;       // window depth in [0, 1], cleared to 1
   std::array<PixelBuffer, kAovCount> aov;  // indexed by Aov; aov_channels() per pixel; empty when not asked for
 
-  // Sizes the planes for a frame; AOV planes not asked for are emptied but keep their memory.
+  // Sizes the planes for a frame. A plane keeps its memory when its size is unchanged; one larger than the frame
+  // needs (a smaller frame, an AOV no longer asked for) is released, so the planes hold what the plan counts.
   void resize(int w, int h, const std::vector<Aov>& aovs) {
     width = w;
     height = h;
     const std::size_t pixels = std::size_t(w) * std::size_t(h);
-    color.resize(pixels * 3);
-    depth.resize(pixels);
+    fit(color, pixels * 3);
+    fit(depth, pixels);
     std::array<bool, kAovCount> wanted{};
     for (Aov a : aovs) wanted[std::size_t(a)] = true;
     for (int a = 0; a < kAovCount; ++a)
-      aov[std::size_t(a)].resize(wanted[std::size_t(a)] ? pixels * std::size_t(aov_channels(Aov(a))) : 0);
+      fit(aov[std::size_t(a)], wanted[std::size_t(a)] ? pixels * std::size_t(aov_channels(Aov(a))) : 0);
+  }
+
+  static void fit(PixelBuffer& plane, std::size_t size) {
+    if (plane.capacity() > size) PixelBuffer().swap(plane);  // its values are overwritten by the tiles anyway
+    plane.resize(size);
   }
 
   std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <mutex>
 #include <optional>
+#include <set>
+#include <string>
 #include <thread>
 
 #include <tbb/global_control.h>
@@ -31,6 +33,22 @@ std::uint64_t peak_rss_bytes() {
   getrusage(RUSAGE_SELF, &usage);
   return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux reports KiB
 }
+
+// Bytes of the previous plan's items (textures, derived data, meshes) that the next plan does not share: prepare
+// builds the next scene's items while they are still held.
+std::uint64_t unshared_bytes(const FramePlan& previous, const FramePlan& next) {
+  std::set<std::string> keys;
+  for (const TextureRequest& t : next.textures) keys.insert("texture " + t.key);
+  for (const DerivedPlan& d : next.derived) keys.insert("derived " + d.key);
+  for (const MeshPlan& m : next.meshes) keys.insert("mesh " + m.key);
+  std::uint64_t bytes = 0;
+  for (const TextureRequest& t : previous.textures) bytes += keys.count("texture " + t.key) ? 0 : t.bytes;
+  for (const DerivedPlan& d : previous.derived) bytes += keys.count("derived " + d.key) ? 0 : d.bytes;
+  for (const MeshPlan& m : previous.meshes) bytes += keys.count("mesh " + m.key) ? 0 : m.bytes;
+  return bytes;
+}
+
+std::uint64_t capacity_bytes(const PixelBuffer& plane) { return plane.capacity() * sizeof(float); }
 
 int thread_count(const RenderOptions& options) {
   return options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -64,6 +82,14 @@ struct Renderer::State {
   Frame frame;
   double pending_plan_ms = 0, pending_prepare_ms = 0;
   std::uint64_t pending_built = 0, pending_reused = 0;
+
+  // The memory of the framebuffer's planes, those lent to the last frame included.
+  std::uint64_t frame_bytes() const {
+    std::uint64_t bytes = capacity_bytes(fb.color) + capacity_bytes(fb.depth) + capacity_bytes(frame.color);
+    for (const PixelBuffer& plane : fb.aov) bytes += capacity_bytes(plane);
+    for (const AovImage& a : frame.aovs) bytes += capacity_bytes(a.pixels);
+    return bytes;
+  }
 
   explicit State(const RenderOptions& o)
       : options(o), threads(thread_count(o)), kernel(&kernel_for(resolve_isa(o.isa))),
@@ -104,6 +130,17 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
     throw Error(scene.file.string(), "the job needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +
                                          " MiB (see qdmr plan), more than the limit of " + std::to_string(limit >> 20) +
                                          " MiB");
+  // While the new scene is prepared the previous frame's planes and the previous items it does not share are
+  // still held. When that is over the limit (the new scene alone is not), the previous scene goes first: then a
+  // failure to prepare leaves the renderer without a scene.
+  if (limit > 0 && s.plan &&
+      needed - plan.framebuffer_bytes + s.frame_bytes() + unshared_bytes(*s.plan, plan) > limit) {
+    s.programs.clear();
+    s.assets = Assets{};
+    s.plan.reset();
+    s.fb = Framebuffer{};
+    s.frame = Frame{};
+  }
   start = Clock::now();
   if (s.options.progress) s.options.progress("prepare", 0.0);
   s.arena.execute([&] {

@@ -346,5 +346,45 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
 #endif
 }
 
+// A new scene whose items replace the previous scene's: the previous items are held while the new ones are built.
+// When that would take the renderer over max_memory_bytes (the new scene alone fits), set_scene releases the
+// previous scene first: the peak of the second set_scene stays below the new plan's total less the previous
+// albedo (21.3 MiB), where holding it would peak at the whole total.
+TEST(MaxMemory, ANewSceneReleasesThePreviousOneWhenBothWouldNotFit) {
+#ifdef QDMR_TEST_ASAN
+  GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
+#else
+  TempDir dir;
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);  // as in ConeBakeEstimateCoversTheBakersPeak
+  const auto scene = [&](int seed) {
+    write_file(dir / "scene.json", R"({"output": {"width": 64, "height": 64},
+  "camera": {"position": [0, -2, 1.5], "target": [0, 0, 0], "up": [0, 0, 1]},
+  "lights": [{"type": "directional", "direction": [0, -0.5, 1]}],
+  "materials": {"m": {"layers": [{"albedo": {"procedural": "bricks", "size": 2048, "seed": )" +
+                                            std::to_string(seed) + R"(}}]}},
+  "objects": [{"mesh": {"type": "plane", "size": [2, 2]}, "material": "m"}]})");
+    return load_scene(dir / "scene.json");
+  };
+  const SceneDesc first = scene(1), second = scene(2);
+  const FramePlan first_plan = plan_frame(first), second_plan = plan_frame(second);
+  ASSERT_NE(first_plan.textures[0].key, second_plan.textures[0].key);
+  const std::uint64_t albedo = first_plan.textures[0].bytes;
+  ASSERT_GT(albedo, std::uint64_t(20) << 20);
+  RenderOptions options;
+  options.threads = 2;
+  options.max_memory_bytes = second_plan.total_bytes() + albedo / 2;  // room for the new scene, not for both
+  Renderer renderer(options);
+  renderer.set_scene(first);
+  (void)renderer.draw();
+  const std::optional<std::uint64_t> growth = peak_growth([&] { renderer.set_scene(second); });
+  if (!growth) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
+  std::printf("second scene: peak growth %.1f MiB, its plan %.1f MiB, the first albedo %.1f MiB\n",
+              double(*growth) / (1 << 20), double(second_plan.total_bytes()) / (1 << 20), double(albedo) / (1 << 20));
+  EXPECT_LE(*growth, second_plan.total_bytes() - albedo + (std::uint64_t(4) << 20));
+  EXPECT_EQ(renderer.plan().textures[0].key, second_plan.textures[0].key);
+  EXPECT_EQ(renderer.draw().width, 64);
+#endif
+}
+
 }  // namespace
 }  // namespace qdmr::test

@@ -64,7 +64,9 @@ public:
   Renderer& operator=(const Renderer&) = delete;
 
   // Plans the scene with these AOVs and prepares what the previous scene did not already have. Throws
-  // qdmr::Error(scene file, ...) when the plan needs more than max_memory_bytes.
+  // qdmr::Error(scene file, ...) when the plan needs more than max_memory_bytes. The previous scene stays until
+  // the new one is ready (a failure leaves it in place), unless its frame and the items the new scene does not
+  // share, held meanwhile, would take the renderer over max_memory_bytes: then it is released first.
   void set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs);
   void set_scene(const SceneDesc& scene) { set_scene(scene, options_aovs()); }
   const FramePlan& plan() const;  // of the current scene (throws if none)
