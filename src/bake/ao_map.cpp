@@ -24,15 +24,7 @@ namespace {
 constexpr std::uint32_t kAoFormatVersion = 2;
 constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
 
-struct MapSize {
-  int width, height;
-};
-
-MapSize map_size(const HeightField& field, const AoDesc& desc) {
-  if (desc.resolution <= 0) return {field.width, field.height};
-  const auto h = std::int64_t(desc.resolution) * field.height / field.width;
-  return {desc.resolution, int(std::max<std::int64_t>(1, h))};
-}
+AoMapSize map_size(const HeightField& field, const AoDesc& desc) { return ao_map_size(field.width, field.height, desc); }
 
 // Level-0 texel index of i under the address mode (the rule of HeightField::at).
 std::int64_t address(std::int64_t i, std::int64_t n, AddressMode mode) {
@@ -49,19 +41,24 @@ std::int64_t address(std::int64_t i, std::int64_t n, AddressMode mode) {
 
 // The max pyramid of the heights, shaped like the max-quadtree: level k+1 has max(1, floor(n/2)) cells per axis,
 // the last one also covering the leftover row/column, so texel x of level 0 lies in cell min(x >> k, n_k - 1).
+// Level 0 is the field's own heights (not copied).
 struct MaxPyramid {
   std::vector<int> width, height;
-  std::vector<std::vector<double>> level;
+  std::vector<const std::vector<double>*> level;
+  std::vector<std::vector<double>> parents;  // levels 1..
 
   explicit MaxPyramid(const HeightField& field) {
     width.push_back(field.width);
     height.push_back(field.height);
-    level.push_back(field.h);
+    int levels = 1;
+    for (int w = field.width, h = field.height; w > 1 || h > 1; w = std::max(1, w / 2), h = std::max(1, h / 2)) ++levels;
+    parents.reserve(std::size_t(levels - 1));  // level's pointers stay valid
+    level.push_back(&field.h);
     while (width.back() > 1 || height.back() > 1) {
       const int w = width.back(), h = height.back();
       const int pw = std::max(1, w / 2), ph = std::max(1, h / 2);
       std::vector<double> parent(std::size_t(pw) * std::size_t(ph), 0.0);
-      const std::vector<double>& child = level.back();
+      const std::vector<double>& child = *level.back();
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
           double& p = parent[std::size_t(std::min(y / 2, ph - 1)) * std::size_t(pw) + std::size_t(std::min(x / 2, pw - 1))];
@@ -69,7 +66,8 @@ struct MaxPyramid {
         }
       width.push_back(pw);
       height.push_back(ph);
-      level.push_back(std::move(parent));
+      parents.push_back(std::move(parent));
+      level.push_back(&parents.back());
     }
   }
 
@@ -78,7 +76,7 @@ struct MaxPyramid {
   double cell_max(int k, std::int64_t x, std::int64_t y) const {
     const std::int64_t cx = std::min<std::int64_t>(x >> k, width[std::size_t(k)] - 1);
     const std::int64_t cy = std::min<std::int64_t>(y >> k, height[std::size_t(k)] - 1);
-    return level[std::size_t(k)][std::size_t(cy * width[std::size_t(k)] + cx)];
+    return (*level[std::size_t(k)])[std::size_t(cy * width[std::size_t(k)] + cx)];
   }
 };
 
@@ -113,10 +111,27 @@ double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double dept
 
 }  // namespace
 
+AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc) {
+  if (desc.resolution <= 0) return {field_width, field_height};
+  const auto h = std::int64_t(desc.resolution) * field_height / field_width;
+  return {desc.resolution, int(std::max<std::int64_t>(1, h))};
+}
+
+std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc) {
+  const AoMapSize size = ao_map_size(field_width, field_height, desc);
+  std::uint64_t bytes = std::uint64_t(size.width) * std::uint64_t(size.height) * sizeof(float);
+  if (desc.coarse)
+    for (int w = field_width, h = field_height; w > 1 || h > 1;) {
+      w = std::max(1, w / 2), h = std::max(1, h / 2);
+      bytes += std::uint64_t(w) * std::uint64_t(h) * sizeof(double);
+    }
+  return bytes;
+}
+
 Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc) {
   if (field.width <= 0 || field.height <= 0 || field.h.size() != std::size_t(field.width) * std::size_t(field.height))
     throw Error("ao map", "empty or inconsistent height field");
-  const MapSize size = map_size(field, desc);
+  const AoMapSize size = map_size(field, desc);
   const std::optional<MaxPyramid> pyramid = desc.coarse ? std::optional<MaxPyramid>(field) : std::nullopt;
   const ao::Taps taps = ao::make_taps(desc, field.width, field.height);
   Image map(size.width, size.height, 1);
@@ -130,7 +145,7 @@ Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& de
 }
 
 std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {
-  const MapSize size = map_size(field, desc);
+  const AoMapSize size = map_size(field, desc);
   Fnv1a f;
   f.value(kAoFormatVersion);
   f.value(std::int32_t(field.width));
@@ -153,10 +168,13 @@ Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const Ao
   if (field.width <= 0 || field.height <= 0) return bake_ao_map(field, depth_scale, desc);  // throws
   const std::uint64_t key = ao_map_key(field, depth_scale, desc);
   const std::filesystem::path file = cache_dir / ("ao-" + hex(key) + ".bin");
-  const MapSize size = map_size(field, desc);
+  const AoMapSize size = map_size(field, desc);
   const FloatCacheId id{kMagic, kAoFormatVersion, 0, size.width, size.height, key};
   if (std::optional<std::vector<float>> cached = read_float_cache(file, id, 0.0f, 1.0f)) {
-    Image map(size.width, size.height, 1);
+    Image map;  // the cached values themselves, not a second buffer
+    map.width = size.width;
+    map.height = size.height;
+    map.channels = 1;
     map.texels = std::move(*cached);
     return map;
   }

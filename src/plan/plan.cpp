@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "program/variant.hpp"
+#include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/texture/height_texture.hpp"
@@ -112,9 +113,8 @@ std::uint64_t textures_working_bytes(const std::vector<TextureRequest>& textures
   std::vector<std::uint64_t> working;
   for (const TextureRequest& t : textures) working.push_back(t.working_bytes);
   std::sort(working.begin(), working.end(), std::greater<>());
-  working.resize(std::min(working.size(), kTexturesBuiltAtOnce));
   std::uint64_t sum = 0;
-  for (std::uint64_t w : working) sum += w;
+  for (std::size_t i = 0; i < working.size() && i < kTexturesBuiltAtOnce; ++i) sum += working[i];
   return sum;
 }
 
@@ -342,9 +342,12 @@ public:
         if (c.blend_ao) {
           AoDesc ao = desc.ao;
           ao.resolution = c.ao_side;
+          const int field_w = h.width * m.weights_scale, field_h = h.height * m.weights_scale;
+          const AoMapSize side = ao_map_size(field_w, field_h, ao);
           m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + combined_key + "|" + ao_key(ao, desc.technique.depth_scale),
                            where + "/ao", {m.combined_surface}, index,
-                           mip_chain_bytes(c.ao_side, c.ao_side, TexelFormat::R16), -1, c.ao_side);
+                           mip_chain_bytes(side.width, side.height, TexelFormat::R16), -1, side.width);
+          plan_.derived[std::size_t(m.blend_ao)].working_bytes = ao_bake_bytes(field_w, field_h, ao);
         }
       }
     }
@@ -352,12 +355,13 @@ public:
       for (std::size_t l = 0; l < m.layers.size(); ++l) {
         const int field = field_of(l);
         const TextureRequest& h = plan_.textures[std::size_t(m.layers[l].height)];
-        const int side_w = desc.ao.resolution > 0 ? desc.ao.resolution : h.width;
-        const int side_h = desc.ao.resolution > 0 ? std::max(1, int(std::int64_t(desc.ao.resolution) * h.height / h.width))
-                                                  : h.height;
+        const AoMapSize side = ao_map_size(h.width, h.height, desc.ao);
         m.layers[l].ao = add(DerivedKind::LayerAoMap,
                              "ao|" + plan_.derived[std::size_t(field)].key + "|" + ao_key(desc.ao, desc.technique.depth_scale),
-                             where + "/ao", {field}, index, mip_chain_bytes(side_w, side_h, TexelFormat::R16), -1, side_w);
+                             where + "/ao", {field}, index, mip_chain_bytes(side.width, side.height, TexelFormat::R16), -1,
+                             side.width);
+        // Baked (unless cached): the map in floats and, for coarse taps, the heights' max pyramid.
+        plan_.derived[std::size_t(m.layers[l].ao)].working_bytes = ao_bake_bytes(h.width, h.height, desc.ao);
       }
     }
     const bool bilinear_patch =
@@ -649,7 +653,7 @@ std::string FramePlan::describe() const {
     << (derived_bytes > 0 ? ", derived " + mib(derived_bytes) : std::string()) << ", meshes " << mib(mesh_bytes);
   if (working_bytes > 0)
     s << ", working " << mib(working_bytes)
-      << (working_bytes == texture_working_bytes ? " (while textures are built)" : " (while a cone map is baked)");
+      << (working_bytes == texture_working_bytes ? " (while textures are built)" : " (while a map is baked)");
   s << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }

@@ -65,8 +65,9 @@ struct DerivedPlan {
   int material = -1;    // the first material that asked for it
   int side = 0;         // ao maps: the map's width
   std::uint64_t bytes = 0;  // what it keeps
-  // What its build allocates on top of `bytes` and frees again (a cone bake: the baker's grid of doubles and max
-  // hierarchy, qdmr::cone_bake_bytes less the map). 0 for the other kinds.
+  // What its build allocates on top of `bytes` and frees again: a cone bake, the baker's grid of doubles and max
+  // hierarchy (qdmr::cone_bake_bytes less the map); an AO bake, the map in floats and the max pyramid of coarse
+  // taps (qdmr::ao_bake_bytes). 0 for the other kinds.
   std::uint64_t working_bytes = 0;
 };
 
