@@ -9,6 +9,10 @@ find_package(nlohmann_json CONFIG REQUIRED)
 find_package(tinyobjloader CONFIG REQUIRED)  # reports "2rc10": no version argument
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)  # SHA-1 (core/sha1.hpp); FindOpenSSL, Debian ships no config
 find_package(PNG REQUIRED)  # io/png_writer.hpp: PNG output without the image module; FindPNG
+# io/png_writer.hpp: the PNG's pixel data compressed by libdeflate (several times zlib's speed); Debian's
+# libdeflate-dev ships a pkg-config file only.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 
 # OpenImageIO's target names /usr/include/opencv4, which exists only with libopencv-dev.
 foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)

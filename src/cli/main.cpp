@@ -48,6 +48,7 @@ struct RenderArgs {
   std::string isa = "auto";
   std::string stats;
   bool timestamp = false;  // write the current time into the images
+  bool smallest_png = false;
   std::optional<std::int64_t> max_memory_mib;  // absent: half the RAM
 };
 
@@ -160,7 +161,7 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   // Every output written to a temporary first, then all renamed: all of them or none.
   qdmr::OutputBatch batch;
   start = Clock::now();
-  const qdmr::WriteOptions write{.timestamp = render.timestamp};
+  const qdmr::WriteOptions write{.timestamp = render.timestamp, .smallest_png = render.smallest_png};
   qdmr::write_frame(frame, render.output, write);
   for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file, write);
   frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -309,6 +310,9 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--timestamp", render.timestamp,
                        "Write the current local time into the images (EXR capDate, TIFF DateTime, PNG tIME). Off by "
                        "default: the same scene gives byte-identical files");
+  render_cmd->add_flag("--smallest-png", render.smallest_png,
+                       "Compress PNG outputs as small as possible (about 20 % smaller, seconds for a 1080p frame) "
+                       "instead of as fast as possible (tens of milliseconds). The same pixels either way");
   render_cmd->add_option("--max-memory", render.max_memory_mib,
                          "Refuse a job whose estimated memory (see qdmr plan) exceeds this many MiB (default: half the RAM)");
 

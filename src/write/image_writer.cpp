@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
-#include <string>
 #include <memory>
+#include <string>
 #include <span>
 #include <vector>
 
@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/png_writer.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/write/write.hpp"
@@ -35,9 +36,11 @@ template <typename T>
 std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb) {
   std::vector<T> out(values.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16), [&](const auto& range) {
+    if constexpr (sizeof(T) == 1)
+      if (srgb) return srgb_codes8(values.data() + range.begin(), range.size(), out.data() + range.begin());
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       if (srgb) {
-        out[i] = max_code == 255.0f ? T(srgb_code8(values[i])) : T(srgb_code(values[i], max_code));
+        out[i] = T(srgb_code(values[i], max_code));
         continue;
       }
       const float v = std::isfinite(values[i]) ? std::clamp(values[i], 0.0f, 1.0f) : 0.0f;
@@ -92,8 +95,8 @@ void write_pixels(const std::filesystem::path& file, int width, int height, int 
   const Encoded encoded = encode(container, pixels, srgb);
   imageio::WriteSpec spec{width, height, channels, encoded.format, {}, {}, {}};
   if (encoded.format != imageio::PixelType::Float) spec.strings.emplace_back("oiio:ColorSpace", "sRGB");
-  // zlib level 6 (the default) costs several times level 3 for a few percent of file size.
-  if (container == Container::Png) spec.ints.emplace_back("png:compressionLevel", 3);
+  if (container == Container::Png)
+    spec.ints.emplace_back("png:compressionLevel", write.smallest_png ? kPngSmallestLevel : kPngFastLevel);
   // TIFF keeps only its own tags: there the bits version is in Software (tag 305) alone.
   spec.strings.emplace_back("qdmr:bits_version", std::to_string(kBitsVersion));
   spec.strings.emplace_back("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");

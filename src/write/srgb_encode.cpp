@@ -11,7 +11,7 @@ namespace {
 // srgb_code(v, 255) is a non-decreasing function of v, so it is the number of steps whose threshold (the least
 // float with that code, found by bisection over the float bit patterns, which order positive floats) v reaches.
 // A first guess per top-16-bit prefix of v (the code of the prefix's least float) is at most a step short
-// wherever the curve is (a prefix spans under 1/128 of its value), so one or two comparisons finish it.
+// wherever the curve is (a prefix spans under 1/128 of its value), so two comparisons finish it.
 class Srgb8Table {
 public:
   Srgb8Table() {
@@ -32,7 +32,9 @@ public:
     if (v >= 1.0f) return 255;
     const std::uint32_t bits = std::bit_cast<std::uint32_t>(v);
     std::uint32_t c = first_code_[bits >> 16];
-    while (bits >= threshold_[c + 1]) ++c;
+    // Two steps without branches (the guess is at most one short; the test checks every threshold's both sides).
+    c += bits >= threshold_[c + 1];
+    c += bits >= threshold_[c + 1];
     return std::uint8_t(c);
   }
 
@@ -43,6 +45,11 @@ private:
   std::array<std::uint8_t, (kOneBits >> 16)> first_code_{};
 };
 
+const Srgb8Table& srgb8_table() {
+  static const Srgb8Table table;
+  return table;
+}
+
 }  // namespace
 
 float linear_to_srgb(float v) {
@@ -52,9 +59,11 @@ float linear_to_srgb(float v) {
   return 1.055f * detmath::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
-std::uint8_t srgb_code8(float v) {
-  static const Srgb8Table table;
-  return table(v);
+std::uint8_t srgb_code8(float v) { return srgb8_table()(v); }
+
+void srgb_codes8(const float* values, std::size_t size, std::uint8_t* out) {
+  const Srgb8Table& table = srgb8_table();
+  for (std::size_t i = 0; i < size; ++i) out[i] = table(values[i]);
 }
 
 }  // namespace qdmr

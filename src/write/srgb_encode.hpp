@@ -2,6 +2,7 @@
 // Linear colour to the sRGB codes image files store: the exact transfer curve with the deterministic pow (every
 // machine writes the same bytes), and its 8-bit codes by table, which PNG output takes for every channel.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 namespace qdmr {
@@ -17,5 +18,7 @@ inline std::uint32_t srgb_code(float v, float max_code) {
 
 // srgb_code(v, 255), bit for bit, from a table of the 255 steps' thresholds (no pow per value).
 std::uint8_t srgb_code8(float v);
+// srgb_code8 of every value, into out[0 .. size): the table looked up once, the loop inlined.
+void srgb_codes8(const float* values, std::size_t size, std::uint8_t* out);
 
 }  // namespace qdmr

@@ -104,6 +104,10 @@ TEST(CliSameBytesControl, TimestampWritesTheTime) {
     EXPECT_NE(stamp, date_time(second.path() / file)) << file;
     EXPECT_NE(read_file(first.path() / file), read_file(second.path() / file)) << file;
   }
+  // PNG's own time chunk (tIME: 7 bytes, the length 0x00000007 before the type), not a text entry.
+  const std::string png = read_file(first.path() / "image.png");
+  EXPECT_NE(png.find(std::string("\0\0\0\x07tIME", 8)), std::string::npos);
+  EXPECT_EQ(png.find("DateTime"), std::string::npos);
 }
 
 }  // namespace
