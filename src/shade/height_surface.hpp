@@ -33,6 +33,10 @@ constexpr SamplerKey inline_height_key(TexelFormat format) {
   return k;
 }
 
+// The max chain's texel loads inlined into QDM's traversal, which reads one every step, for 8- and 16-bit chains
+// (max chains of 8- and 16-bit heights) fetched as inline_height_key's are; any other chain calls its sampler.
+enum class InlineMaxChain : std::uint8_t { None, R8, R16 };
+
 // The textures of one height layer, bound once per program to the samplers its material fixes.
 struct HeightLayerTextures {
   // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material needs
@@ -45,6 +49,7 @@ struct HeightLayerTextures {
   SamplerState sampler;   // the material's
   HeightFetch fetch;
   InlineHeight inline_height;
+  InlineMaxChain inline_max_chain;
 };
 
 class SingleLayerSurface {
@@ -80,7 +85,19 @@ public:
 
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes).
   simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
-    return textures_->tree.load_wrapped_first(level, cx, cy);
+    const TextureSampler& t = textures_->tree;
+    simd::Float texel[4];
+    switch (textures_->inline_max_chain) {
+      case InlineMaxChain::R16:
+        sampling_code::load_with(inline_height_key(TexelFormat::R16), true, t.view(), level, cx, cy, texel);
+        return texel[0];
+      case InlineMaxChain::R8:
+        sampling_code::load_with(inline_height_key(TexelFormat::R8), true, t.view(), level, cx, cy, texel);
+        return texel[0];
+      case InlineMaxChain::None: break;
+    }
+    t.load_wrapped(level, cx, cy, texel);
+    return texel[0];
   }
 
   // The highest height anywhere (a bound for early exits).

@@ -130,28 +130,6 @@ public:
   void load_wrapped(const simd::Int& level, const simd::Int& x, const simd::Int& y, simd::Float* out) const {
     load_wrapped_(view_, level, x, y, state_.fetch, out);
   }
-  // load_wrapped()'s first channel. Inlined for R8 and R16 textures (max chains of 8- and 16-bit heights, which
-  // QDM reads every step: a call would make the caller spill its vector registers), with the same operations.
-  simd::Float load_wrapped_first(const simd::Int& level, const simd::Int& x, const simd::Int& y) const {
-    const TexelFormat format = texture().format;
-    if ((format != TexelFormat::R16 && format != TexelFormat::R8) || texture().srgb) {
-      simd::Float texel[4];
-      load_wrapped_(view_, level, x, y, state_.fetch, texel);
-      return texel[0];
-    }
-    static_assert(TextureView::kMaxLevels == 16, "level tables are looked up by a 16-entry permute");
-    const simd::Int l = xsimd::min(xsimd::max(level, simd::Int(0)), simd::Int(view_.levels() - 1));
-    const simd::Int width = simd::lookup16(view_.widths(), l), height = simd::lookup16(view_.heights(), l);
-    const simd::Int level_offset = simd::lookup16(view_.offsets(), l);
-    const simd::Int cx = x & (width - simd::Int(1)), cy = y & (height - simd::Int(1));
-    const bool wide = format == TexelFormat::R16;
-    trace_fetch(texture(), level_offset, cx, cy);
-    const simd::Int raw = simd::load_bytes4(texture().storage.data(),
-                                            level_offset + (cy * width + cx) * simd::Int(wide ? 2 : 1), state_.fetch);
-    return wide ? xsimd::to_float(raw & simd::Int(0xFFFF)) / simd::Float(65535.0f)
-                : xsimd::to_float(raw & simd::Int(0xFF)) / simd::Float(255.0f);
-  }
-
 private:
   TextureView view_;
   SamplerState state_;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "program/variant.hpp"
+#include "shade/height_surface.hpp"
 #include "texture/sampler.hpp"
 #include "texture/sampler_test_util.hpp"
 
@@ -396,26 +397,32 @@ TEST(TextureSampler, LoadWrappedWrapsIntoTheLevel) {
       }
 }
 
-// QDM's per-step load, inlined for 8- and 16-bit chains: the same bits as load_wrapped(), lane by lane, with every
-// lane on its own level (out-of-range levels clamp) and cell (wrapping far out on both sides).
-TEST(TextureSampler, FirstChannelLoadIsLoadWrapped) {
+// The max chain's reads in QDM's traversal (SingleLayerSurface::cell_max): inlined for R8 and R16 chains, through
+// the sampler for others; the bits of load_wrapped()'s first channel either way, every lane on its own level
+// (out-of-range levels clamp) and cell (wrapping far out on both sides).
+TEST(TextureSampler, CellMaxIsLoadWrapped) {
   for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16, TexelFormat::R32F}) {
     Image img(16, 8, 1);
     for (int y = 0; y < 8; ++y)
       for (int x = 0; x < 16; ++x) img.at(x, y, 0) = float((x * 7 + y * 13) % 31) / 30.0f;
-    const Texture c = make_mip_texture(img, format, false, MipReduce::Max);
-    const TextureSampler bound(c, SamplerState{});
+    const Texture heights = make_mip_texture(img, format, false, MipReduce::Box);
+    const Texture chain = make_mip_texture(img, format, false, MipReduce::Max);
+    const HeightLayerTextures textures(heights, &chain, SamplerState{}, HeightFetch::Bilinear);
+    EXPECT_EQ(textures.inline_max_chain, format == TexelFormat::R16 ? InlineMaxChain::R16
+                                         : format == TexelFormat::R8 ? InlineMaxChain::R8
+                                                                     : InlineMaxChain::None);
+    const SingleLayerSurface surface(textures);
     alignas(64) std::int32_t level[kLanes], x[kLanes], y[kLanes];
     for (int round = 0; round < 64; ++round) {
       for (int l = 0; l < kLanes; ++l) {
-        level[l] = (round + l) % (c.level_count() + 2) - 1;
+        level[l] = (round + l) % (chain.level_count() + 2) - 1;
         x[l] = (round * 5 + l * 11) % 71 - 35;
         y[l] = (round * 3 + l * 17) % 43 - 21;
       }
       const simd::Int lv = simd::Int::load_aligned(level), xv = simd::Int::load_aligned(x), yv = simd::Int::load_aligned(y);
       Float wrapped[4];
-      bound.load_wrapped(lv, xv, yv, wrapped);
-      const Lanes expected = lanes(wrapped[0]), got = lanes(bound.load_wrapped_first(lv, xv, yv));
+      textures.tree.load_wrapped(lv, xv, yv, wrapped);
+      const Lanes expected = lanes(wrapped[0]), got = lanes(surface.cell_max(lv, xv, yv));
       for (int l = 0; l < kLanes; ++l)
         ASSERT_EQ(bits(got[l]), bits(expected[l])) << int(format) << " lane " << l << " level " << level[l];
     }
