@@ -28,7 +28,7 @@ HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, Tex
 }
 
 // Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
-// texture_build_bytes counts the most this holds at once, step by step.
+// texture_working_bytes counts the most this holds at once, step by step.
 Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   Texture texture;
   if (request.purpose == TexturePurpose::Height) {
