@@ -23,8 +23,9 @@ namespace {
 void on_warning(png_structp, png_const_charp) {}
 
 // The IDAT payload: every row with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
-// less zeros), as one zlib stream from libdeflate at `level`. Up is the fastest filter to apply and, on renders,
-// compresses about as well as libpng's per-row choice among all five. Empty on failure.
+// less zeros), as one zlib stream from libdeflate at `level`. Up is the fastest filter to apply; on the canonical
+// 1080p render it gives 1.67 MB at level 1, where libpng's per-row choice among all five with zlib level 3 gave
+// 1.71 MB (docs/performance.md). Empty on failure.
 std::vector<unsigned char> compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows,
                                            int level) {
   std::vector<unsigned char> filtered((row_bytes + 1) * rows);
