@@ -235,6 +235,19 @@ template <class Work>
   return peak > *before ? peak - *before : 0;
 }
 
+// The checks of every estimate-against-peak test: printed with `what`, the peak growth covered by the estimate (a few
+// MiB above it allowed: the threads' stacks, the allocator's own) and not below `least` of it (the estimate is what
+// the code allocates, not a guess).
+[[maybe_unused]] void expect_estimate_covers(std::uint64_t growth, std::uint64_t estimate, double least,
+                                             const std::string& what) {
+  std::printf("%s: peak growth %.1f MiB, estimate %.1f MiB\n", what.c_str(), double(growth) / (1 << 20),
+              double(estimate) / (1 << 20));
+  const std::string message =
+      what + ": peak growth " + std::to_string(growth) + ", estimate " + std::to_string(estimate);
+  EXPECT_LE(growth, estimate + (std::uint64_t(4) << 20)) << message;
+  EXPECT_GE(double(growth), least * double(estimate)) << message;
+}
+
 // cone_bake_bytes against what the baker really holds: the peak resident memory of this process while it bakes
 // (the peak reset just before, Linux's /proc/self/clear_refs "5"), less its resident memory then. A flat field
 // bakes in a moment (no texel binds) but allocates and fills the grid, the hierarchy and the map as any other.
@@ -271,14 +284,9 @@ TEST(MaxMemory, ConeBakeEstimateCoversTheBakersPeak) {
       EXPECT_EQ(map.ratio.size(), field.h.size());
     });
     if (!measured) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
-    const std::uint64_t growth = *measured;
-    std::printf("%dx%d %s %s: peak growth %.1f MiB, estimate %.1f MiB\n", c.width, c.height, cone_kind_name(c.kind),
-                c.address == AddressMode::Mirror ? "mirror" : "wrap", double(growth) / (1 << 20),
-                double(estimate) / (1 << 20));
-    // Covered: at most a few MiB of the threads' stacks and the allocator's own above the estimate.
-    EXPECT_LE(growth, estimate + (std::uint64_t(4) << 20)) << "peak growth " << growth << ", estimate " << estimate;
-    // And the estimate not far above it: it is what the baker allocates, not a guess.
-    EXPECT_GE(double(growth), 0.9 * double(estimate)) << "peak growth " << growth << ", estimate " << estimate;
+    expect_estimate_covers(*measured, estimate, 0.9,
+                           std::to_string(c.width) + "x" + std::to_string(c.height) + " " + cone_kind_name(c.kind) +
+                               (c.address == AddressMode::Mirror ? " mirror" : " wrap"));
   }
 #endif
 }
@@ -350,11 +358,9 @@ TEST(MaxMemory, AoBakeEstimateCoversTheBakersPeak) {
       EXPECT_EQ(map.height, size.height);
     });
     if (!measured) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
-    const std::uint64_t growth = *measured;
-    std::printf("%d² %s to %d: peak growth %.1f MiB, estimate %.1f MiB\n", c.side, c.coarse ? "coarse" : "fine",
-                c.resolution, double(growth) / (1 << 20), double(estimate) / (1 << 20));
-    EXPECT_LE(growth, estimate + (std::uint64_t(4) << 20)) << "peak growth " << growth << ", estimate " << estimate;
-    EXPECT_GE(double(growth), 0.9 * double(estimate)) << "peak growth " << growth << ", estimate " << estimate;
+    expect_estimate_covers(*measured, estimate, 0.9,
+                           std::to_string(c.side) + "² " + (c.coarse ? "coarse" : "fine") + " to " +
+                               std::to_string(c.resolution));
   }
 #endif
 }
@@ -414,13 +420,8 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
     const std::optional<std::uint64_t> measured =
         peak_growth([&] { EXPECT_EQ(prepare(plan).texture_bytes(), plan.texture_bytes); });
     if (!measured) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
-    const std::uint64_t growth = *measured;
-    std::printf("%s (%s): peak growth %.1f MiB, estimate %.1f MiB\n", c.layer.c_str(), c.technique.c_str(),
-                double(growth) / (1 << 20), double(estimate) / (1 << 20));
-    // Covered, with a few MiB for the threads' stacks, the allocator's own and the decoder's row buffers.
-    EXPECT_LE(growth, estimate + (std::uint64_t(4) << 20)) << "peak growth " << growth << ", estimate " << estimate;
-    // Not far above: two builds at once rarely peak together, so the estimate may exceed the peak by a third.
-    EXPECT_GE(double(growth), 0.75 * double(estimate)) << "peak growth " << growth << ", estimate " << estimate;
+    // Two builds at once rarely peak together, so the estimate may exceed the peak by a third.
+    expect_estimate_covers(*measured, estimate, 0.75, c.layer + " (" + c.technique + ")");
   }
 #endif
 }
