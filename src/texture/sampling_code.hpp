@@ -66,22 +66,23 @@ QDMR_SAMPLER_INLINE LevelInfo level_zero(const TextureView& view) {
   return {Int(view.widths()[0]), Int(view.heights()[0]), Int(view.offsets()[0])};
 }
 
+QDMR_SAMPLER_INLINE Float decode_unorm8(const SamplerKey& k, const Int& byte, bool srgb) {
+  return srgb ? simd::load_f32(texture_detail::kSrgbByteToLinear.data(), byte, k.fetch)
+              : xsimd::to_float(byte) / Float(255.0f);
+}
+
 QDMR_SAMPLER_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
-  const Float inv255(255.0f);
-  const auto unorm8 = [&](const Int& byte, bool srgb) {
-    return srgb ? simd::load_f32(texture_detail::kSrgbByteToLinear.data(), byte, k.fetch) : xsimd::to_float(byte) / inv255;
-  };
   switch (k.format) {
-    case TexelFormat::R8: out[0] = unorm8(raw & Int(0xFF), k.srgb); return;
+    case TexelFormat::R8: out[0] = decode_unorm8(k, raw & Int(0xFF), k.srgb); return;
     case TexelFormat::RG8:
-      out[0] = unorm8(raw & Int(0xFF), k.srgb);
-      out[1] = unorm8((raw >> 8) & Int(0xFF), k.srgb);
+      out[0] = decode_unorm8(k, raw & Int(0xFF), k.srgb);
+      out[1] = decode_unorm8(k, (raw >> 8) & Int(0xFF), k.srgb);
       return;
     case TexelFormat::RGBA8:
-      out[0] = unorm8(raw & Int(0xFF), k.srgb);
-      out[1] = unorm8((raw >> 8) & Int(0xFF), k.srgb);
-      out[2] = unorm8((raw >> 16) & Int(0xFF), k.srgb);
-      out[3] = unorm8(xsimd::bitwise_cast<Int>(xsimd::bitwise_cast<simd::UInt>(raw) >> 24), false);
+      out[0] = decode_unorm8(k, raw & Int(0xFF), k.srgb);
+      out[1] = decode_unorm8(k, (raw >> 8) & Int(0xFF), k.srgb);
+      out[2] = decode_unorm8(k, (raw >> 16) & Int(0xFF), k.srgb);
+      out[3] = decode_unorm8(k, xsimd::bitwise_cast<Int>(xsimd::bitwise_cast<simd::UInt>(raw) >> 24), false);
       return;
     case TexelFormat::R16: out[0] = xsimd::to_float(raw & Int(0xFFFF)) / Float(65535.0f); return;
     case TexelFormat::R32F: out[0] = xsimd::bitwise_cast<Float>(raw); return;
@@ -96,16 +97,25 @@ QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, con
   decode(k, simd::load_bytes4(t.storage.data(), offset, k.fetch), out);
 }
 
-// fetch() of texels (xa, y) and (xb, y) = (xa + 1, y) of a one-channel format of 1 or 2 bytes, from one load.
+// fetch() of texels (xa, y) and (xb, y) = (xa + 1, y), adjacent in memory, from one load per lane: 4 bytes for
+// texels of 1 or 2 bytes, 8 bytes for texels of 4.
 QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& xa,
                             const Int& xb, const Int& y, Float* a, Float* b) {
   const Texture& t = view.texture();
   const int bytes = bytes_per_texel(k.format);
   trace_fetch(t, level.offset, xa, y);
   trace_fetch(t, level.offset, xb, y);
-  const Int raw = simd::load_bytes4(t.storage.data(), level.offset + (y * level.width + xa) * Int(bytes), k.fetch);
-  decode(k, raw, a);
-  decode(k, raw >> (8 * bytes), b);  // decode keeps the texel's low bytes only
+  const Int offset = level.offset + (y * level.width + xa) * Int(bytes);
+  if (bytes <= 2) {
+    const Int raw = simd::load_bytes4(t.storage.data(), offset, k.fetch);
+    decode(k, raw, a);
+    decode(k, raw >> (8 * bytes), b);  // decode keeps the texel's low bytes only
+    return;
+  }
+  Int first, second;
+  simd::load_bytes8(t.storage.data(), offset, k.fetch, first, second);
+  decode(k, first, a);
+  decode(k, second, b);
 }
 
 // u * n split into the fp32 product p and its rounding error e, exactly: p + e = u * n (Dekker's product, with
@@ -167,9 +177,9 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   const Int xa = address(x0, info.width, k.address), xb = address(x0 + Int(1), info.width, k.address);
   const Int ya = address(y0, info.height, k.address), yb = address(y0 + Int(1), info.height, k.address);
   Float t00[4], t10[4], t01[4], t11[4];
-  // One-channel texels of 1 or 2 bytes: texel xa + 1 lies in the 4 bytes loaded for xa, so where every lane's
-  // xb is xa + 1 (all but the lanes at a wrap or clamp edge) one load per row gives both texels.
-  if (channel_count(k.format) == 1 && bytes_per_texel(k.format) <= 2 && xsimd::all(xb == xa + Int(1))) {
+  // Texel xa + 1 follows texel xa in memory, so where every lane's xb is xa + 1 (all but the lanes at a wrap or
+  // clamp edge) one load per row gives both texels.
+  if (xsimd::all(xb == xa + Int(1))) {
     fetch_pair(view, k, info, xa, xb, ya, t00, t10);
     fetch_pair(view, k, info, xa, xb, yb, t01, t11);
   } else {

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "program/variant.hpp"
 #include "shade/height_surface.hpp"
@@ -265,22 +267,30 @@ TEST(TextureSampler, GatherAndPortableFetchGiveTheSameBits) {
   }
 }
 
-// Bilinear taps of 8- and 16-bit one-channel texels come two per load where a row's pair is adjacent in memory
-// (sampler.cpp, fetch_pair); they must give the bits of an fp32 texture holding the same decoded values, which
-// is fetched one texel at a time: at random points, with lanes at the wrap and clamp edges mixed into the batch.
+// Bilinear taps come two per load where a row's pair is adjacent in memory (sampling_code.hpp, fetch_pair: 4 bytes
+// for texels of 1 or 2 bytes, 8 for texels of 4); they must give the bits of fp32 textures holding the same decoded
+// values, one per channel, which are fetched one texel at a time: at random points, with lanes at the wrap and
+// clamp edges mixed into the batch, on both fetch paths.
 TEST(TextureSampler, PairedTexelLoadsGiveTheBitsOfSingleLoads) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> coord(-1.5f, 2.5f), lod(-1.0f, 6.0f);
-  for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16}) {
-    const int max_code = format == TexelFormat::R8 ? 255 : 65535;
-    Image codes(32, 16, 1);
+  const std::pair<TexelFormat, bool> formats[] = {{TexelFormat::R8, false},    {TexelFormat::R16, false},
+                                                  {TexelFormat::RG8, false},   {TexelFormat::RGBA8, false},
+                                                  {TexelFormat::RGBA8, true},  {TexelFormat::R32F, false}};
+  for (const auto& [format, srgb] : formats) {
+    const int channels = channel_count(format);
+    Image codes(32, 16, channels);
     for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 32; ++x) codes.at(x, y, 0) = float((x * 977 + y * 131) % (max_code + 1)) / float(max_code);
-    const Texture narrow = make_mip_texture(codes, format, false, MipReduce::Box);
-    Image decoded(32, 16, 1);  // bilinear reads level 0 only
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 32; ++x) decoded.at(x, y, 0) = narrow.texel(0, x, y, 0);
-    const Texture wide = make_mip_texture(decoded, TexelFormat::R32F, false, MipReduce::Box);
+      for (int x = 0; x < 32; ++x)
+        for (int c = 0; c < channels; ++c) codes.at(x, y, c) = float((x * 977 + y * 131 + c * 61) % 256) / 255.0f;
+    const Texture narrow = make_mip_texture(codes, format, srgb, MipReduce::Box);
+    std::vector<Texture> wide;  // bilinear reads level 0 only
+    for (int c = 0; c < channels; ++c) {
+      Image decoded(32, 16, 1);
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 32; ++x) decoded.at(x, y, 0) = narrow.texel(0, x, y, c);
+      wide.push_back(make_mip_texture(decoded, TexelFormat::R32F, false, MipReduce::Box));
+    }
     for (const AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
       for (int round = 0; round < 200; ++round) {
         Lanes u, v, l;
@@ -289,12 +299,17 @@ TEST(TextureSampler, PairedTexelLoadsGiveTheBitsOfSingleLoads) {
           v[i] = coord(rng);
           l[i] = lod(rng);
         }
-        const SamplerState state = state_of(Filter::Bilinear, address, 0, SamplePrecision(round % 3));
-        Float a[4], b[4];
+        SamplerState state = state_of(Filter::Bilinear, address, 0, SamplePrecision(round % 3));
+        state.fetch = round % 2 == 0 ? simd::FetchPath::Gather : simd::FetchPath::Portable;
+        Float a[4];
         sample(TextureView(narrow), state, load(u), load(v), load(l), a);
-        sample(TextureView(wide), state, load(u), load(v), load(l), b);
-        for (int i = 0; i < kLanes; ++i)
-          ASSERT_EQ(bits(lanes(a[0])[i]), bits(lanes(b[0])[i])) << int(format) << " u " << u[i] << " v " << v[i];
+        for (int c = 0; c < channels; ++c) {
+          Float b[4];
+          sample(TextureView(wide[std::size_t(c)]), state, load(u), load(v), load(l), b);
+          for (int i = 0; i < kLanes; ++i)
+            ASSERT_EQ(bits(lanes(a[c])[i]), bits(lanes(b[0])[i]))
+                << "format " << int(format) << " srgb " << srgb << " channel " << c << " u " << u[i] << " v " << v[i];
+        }
       }
   }
 }
