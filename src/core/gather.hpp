@@ -76,6 +76,44 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   second = Int::load_aligned(b);
 }
 
+// Two texels of 4 floats at base + index[lane] (unaligned): floats 0-3 into first[0..3], floats 4-7 into
+// second[0..3], one vector per float. AVX2 transposes them from 128-bit loads.
+[[gnu::always_inline]] inline void load_f32x4_pair(const float* base, const Int& index, FetchPath path, Float* first,
+                                                   Float* second) {
+#if defined(__AVX2__) && !defined(__AVX512F__)
+  if (path == FetchPath::Gather) {
+    alignas(32) std::int32_t o[kLanes];
+    index.store_aligned(o);
+    const auto transpose = [&](int at, Float* out) {
+      const auto row = [&](int lane) {  // lane's texel in the low half, lane + 4's in the high half
+        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + o[lane] + at)),
+                                    _mm_loadu_ps(base + o[lane + 4] + at), 1);
+      };
+      const __m256 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+      const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+      const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+      out[0] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+      out[1] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+      out[2] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+      out[3] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+    };
+    transpose(0, first);
+    transpose(4, second);
+    return;
+  }
+#endif
+  (void)path;
+  alignas(64) std::int32_t o[kLanes];
+  alignas(64) float value[8][kLanes];
+  index.store_aligned(o);
+  for (int lane = 0; lane < kLanes; ++lane)
+    for (int i = 0; i < 8; ++i) value[i][lane] = base[o[lane] + i];
+  for (int i = 0; i < 4; ++i) {
+    first[i] = Float::load_aligned(value[i]);
+    second[i] = Float::load_aligned(value[4 + i]);
+  }
+}
+
 // table[index[lane]] for int32 and float tables.
 inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path) {
 #if defined(__AVX2__)

@@ -160,7 +160,7 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.srgb = purpose == TexturePurpose::Albedo;
   r.format = purpose == TexturePurpose::Height ? height_format(desc, source.bits) : TexelFormat::RGBA8;
   r.levels = mip_levels(r.width, r.height);
-  r.bytes = mip_chain_bytes(r.width, r.height, r.format);
+  r.bytes = mip_chain_bytes(r.width, r.height, r.format) + linear_copy_bytes(r.width, r.height, r.format, r.srgb);
   r.working_bytes = texture_working_bytes(r, source);
   r.users.push_back(user);
   textures.push_back(std::move(r));

@@ -45,6 +45,7 @@ Texture build_texture(const TextureRequest& request, TextureStat& stat) {
     if (request.purpose == TexturePurpose::Normal)
       for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
     texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+    add_linear_copy(texture);
   }
   stat.where = request.where;
   stat.purpose = purpose_name(request.purpose);

@@ -172,6 +172,29 @@ std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format) {
   return chain_layout(width, height, format, nullptr);
 }
 
+std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool srgb) {
+  if (format != TexelFormat::RGBA8 || !srgb) return 0;
+  const std::uint64_t bytes = mip_chain_bytes(width, height, format) * sizeof(float);
+  return bytes <= kLinearCopyMaxBytes ? bytes : 0;
+}
+
+void add_linear_copy(Texture& texture) {
+  if (texture.levels.empty() || linear_copy_bytes(texture.width(), texture.height(), texture.format, texture.srgb) == 0)
+    return;
+  texture.linear.assign(texture.storage.size(), 0.0f);
+  const Codec codec{texture.format, texture.srgb};
+  for (int k = 0; k < texture.level_count(); ++k) {
+    const TextureLevel& l = texture.levels[std::size_t(k)];
+    for_rows(l.height, std::size_t(l.width) * 16, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < l.width; ++x) {
+          const std::size_t at = l.offset + (std::size_t(y) * std::size_t(l.width) + std::size_t(x)) * 4;
+          for (int c = 0; c < 4; ++c) texture.linear[at + std::size_t(c)] = codec.decode(texture.storage.data() + at, c);
+        }
+    });
+  }
+}
+
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
   if (width < 1 || height < 1 || width > limits::kMaxTextureSide || height > limits::kMaxTextureSide)
     throw Error("texture", "size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +

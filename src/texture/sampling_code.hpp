@@ -118,6 +118,15 @@ QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k
   decode(k, second, b);
 }
 
+// fetch_pair() of an RGBA8 sRGB texture from its decoded copy (Texture::linear): whole texels, no table lookups.
+QDMR_SAMPLER_INLINE void fetch_linear_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level,
+                                           const Int& xa, const Int& xb, const Int& y, Float* a, Float* b) {
+  const Texture& t = view.texture();
+  trace_fetch(t, level.offset, xa, y);
+  trace_fetch(t, level.offset, xb, y);
+  simd::load_f32x4_pair(t.linear.data(), level.offset + (y * level.width + xa) * Int(4), k.fetch, a, b);
+}
+
 // u * n split into the fp32 product p and its rounding error e, exactly: p + e = u * n (Dekker's product, with
 // -ffp-contract=off; |u| <= 2 and n <= 16384 keep every partial product far from overflow and underflow).
 QDMR_SAMPLER_INLINE void exact_product(const Float& u, const Float& n, Float& p, Float& e) {
@@ -180,8 +189,13 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   // Texel xa + 1 follows texel xa in memory, so where every lane's xb is xa + 1 (all but the lanes at a wrap or
   // clamp edge) one load per row gives both texels.
   if (xsimd::all(xb == xa + Int(1))) {
-    fetch_pair(view, k, info, xa, xb, ya, t00, t10);
-    fetch_pair(view, k, info, xa, xb, yb, t01, t11);
+    if (k.format == TexelFormat::RGBA8 && k.srgb && !view.texture().linear.empty()) {
+      fetch_linear_pair(view, k, info, xa, xb, ya, t00, t10);
+      fetch_linear_pair(view, k, info, xa, xb, yb, t01, t11);
+    } else {
+      fetch_pair(view, k, info, xa, xb, ya, t00, t10);
+      fetch_pair(view, k, info, xa, xb, yb, t01, t11);
+    }
   } else {
     fetch(view, k, info, xa, ya, t00);
     fetch(view, k, info, xb, ya, t10);

@@ -32,12 +32,16 @@ public:
   bool srgb = false;  // RGBA8/RG8/R8 colour: the rgb channels are sRGB-encoded
   std::vector<TextureLevel> levels;
   std::vector<std::uint8_t> storage;
+  // RGBA8 sRGB only, and only where add_linear_copy kept it: every texel decoded as texel() decodes it (rgb
+  // through the sRGB table, alpha / 255), 4 floats per texel, float i for byte i of `storage`. The sampler reads
+  // whole texels from it instead of looking each channel up in a table (the same bits, fewer loads).
+  std::vector<float> linear;
 
   int width() const { return levels.empty() ? 0 : levels[0].width; }
   int height() const { return levels.empty() ? 0 : levels[0].height; }
   int level_count() const { return int(levels.size()); }
   int channels() const { return channel_count(format); }
-  std::size_t bytes() const { return storage.size(); }
+  std::size_t bytes() const { return storage.size() + linear.size() * sizeof(float); }
 
   const std::uint8_t* texel_address(int level, int x, int y) const {
     const TextureLevel& l = levels[std::size_t(level)];
@@ -51,6 +55,16 @@ public:
 
 // The storage bytes of the chain allocate_texture makes (for memory plans).
 std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format);
+
+// The bytes of Texture::linear that add_linear_copy keeps for such a chain: 4 floats per storage byte for RGBA8
+// sRGB chains of up to kLinearCopyMaxBytes, else 0 (larger chains are decoded per channel: 4x the memory is too
+// dear there).
+inline constexpr std::uint64_t kLinearCopyMaxBytes = std::uint64_t(256) << 20;
+std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool srgb);
+
+// Fills Texture::linear from the finished chain when linear_copy_bytes says so; call it after the last change to
+// the storage.
+void add_linear_copy(Texture& texture);
 
 // Allocates the chain for a w x h level 0 (all levels, zeroed, with the tail padding).
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb);
