@@ -314,6 +314,23 @@ TEST(TextureSampler, PairedTexelLoadsGiveTheBitsOfSingleLoads) {
   }
 }
 
+// Every filter, address mode, precision, math mode (sm4, sm3) and fetch path this build has, LOD bias 0.25.
+std::vector<SamplerState> every_sampler_state() {
+  std::vector<SamplerState> states;
+  for (Filter f : kFilters)
+    for (AddressMode m : kAddressModes)
+      for (SamplePrecision p : kPrecisions)
+        for (MathMode math : {MathMode::Sm4, MathMode::Sm3})
+          for (simd::FetchPath path : {simd::FetchPath::Gather, simd::FetchPath::Portable}) {
+            if (path == simd::FetchPath::Gather && !simd::kHasHardwareGather) continue;
+            SamplerState state = state_of(f, m, 0.25f, p);
+            state.math = math;
+            state.fetch = path;
+            states.push_back(state);
+          }
+  return states;
+}
+
 // An RGBA8 sRGB chain keeps a decoded copy (Texture::linear) that the sampler reads whole texels from; sampling
 // with it must give the bits of the per-channel table decode, for every filter, address mode, precision, math mode
 // and fetch path, specialised and generic, with non-finite coordinates and lanes at the wrap and clamp edges.
@@ -329,33 +346,26 @@ TEST(TextureSampler, TheDecodedCopyOfAnSrgbTextureGivesTheTableDecodesBits) {
   EXPECT_EQ(copied.bytes(), linear_copy_bytes(64, 32, TexelFormat::RGBA8, true) + copied.storage.size());
   EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::RGBA8, false), 0u);
   EXPECT_EQ(linear_copy_bytes(8192, 8192, TexelFormat::RGBA8, true), 0u) << "above kLinearCopyMaxBytes";
-  for (Filter f : kFilters)
-    for (AddressMode m : kAddressModes)
-      for (SamplePrecision p : kPrecisions)
-        for (MathMode math : {MathMode::Sm4, MathMode::Sm3})
-          for (simd::FetchPath path : {simd::FetchPath::Gather, simd::FetchPath::Portable}) {
-            if (path == simd::FetchPath::Gather && !simd::kHasHardwareGather) continue;
-            SamplerState state = state_of(f, m, 0.25f, p);
-            state.math = math;
-            state.fetch = path;
-            const TextureSampler with_table(table_decoded, state), with_copy(copied, state);
-            for (int round = 0; round < 16; ++round) {
-              Lanes u, v, l;
-              for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
-              if (round == 0) u[1] = kNaN, v[2] = -kInf, l[3] = kNaN;
-              if (round % 2 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
-                for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
-              Float a[4], b[4], c[4];
-              with_table.sample(load(u), load(v), load(l), a);
-              with_copy.sample(load(u), load(v), load(l), b);
-              sample(with_copy.view(), state, load(u), load(v), load(l), c);
-              for (int ch = 0; ch < 4; ++ch)
-                for (int i = 0; i < kLanes; ++i) {
-                  ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(b[ch])[i])) << filter_name(f) << " channel " << ch;
-                  ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(c[ch])[i])) << filter_name(f) << " generic";
-                }
-            }
-          }
+  for (const SamplerState& state : every_sampler_state()) {
+    const Filter f = state.filter;
+    const TextureSampler with_table(table_decoded, state), with_copy(copied, state);
+    for (int round = 0; round < 16; ++round) {
+      Lanes u, v, l;
+      for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+      if (round == 0) u[1] = kNaN, v[2] = -kInf, l[3] = kNaN;
+      if (round % 2 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
+        for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
+      Float a[4], b[4], c[4];
+      with_table.sample(load(u), load(v), load(l), a);
+      with_copy.sample(load(u), load(v), load(l), b);
+      sample(with_copy.view(), state, load(u), load(v), load(l), c);
+      for (int ch = 0; ch < 4; ++ch)
+        for (int i = 0; i < kLanes; ++i) {
+          ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(b[ch])[i])) << filter_name(f) << " channel " << ch;
+          ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(c[ch])[i])) << filter_name(f) << " generic";
+        }
+    }
+  }
 }
 
 TEST(TextureSampler, DecodesEveryFormatLikeTheScalarTexelAccessor) {
@@ -401,40 +411,34 @@ TEST(TextureSampler, SpecialisedSamplersGiveTheGenericBits) {
     Image img(c.w, c.h, channel_count(c.format) == 2 ? 2 : channel_count(c.format) == 1 ? 1 : 3);
     for (float& t : img.texels) t = unit(rng);
     const Texture texture = make_mip_texture(img, c.format, c.srgb, MipReduce::Box);
-    for (Filter f : kFilters)
-      for (AddressMode m : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
-        for (SamplePrecision p : {SamplePrecision::Exact, SamplePrecision::Hw8, SamplePrecision::Hw6})
-          for (MathMode math : {MathMode::Sm4, MathMode::Sm3})
-            for (simd::FetchPath path : {simd::FetchPath::Gather, simd::FetchPath::Portable}) {
-              if (path == simd::FetchPath::Gather && !simd::kHasHardwareGather) continue;
-              SamplerState state = state_of(f, m, 0.25f, p);
-              state.math = math;
-              state.fetch = path;
-              const TextureSampler bound(texture, state);
-              specialised += bound.specialised() ? 1 : 0;
-              for (int round = 0; round < 8; ++round) {
-                Lanes u, v, l;
-                for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
-                if (round == 0) u[1] = std::numeric_limits<float>::quiet_NaN(), v[2] = -INFINITY, l[3] = NAN;
-                Float generic[4], fixed[4];
-                sample(bound.view(), state, load(u), load(v), load(l), generic);
-                bound.sample(load(u), load(v), load(l), fixed);
-                for (int ch = 0; ch < texture.channels(); ++ch)
-                  for (int i = 0; i < kLanes; ++i)
-                    ASSERT_EQ(bits(lanes(generic[ch])[i]), bits(lanes(fixed[ch])[i]))
-                        << filter_name(f) << " format " << int(c.format) << " lane " << i;
-                std::array<std::int32_t, kLanes> level, x, y;
-                for (int i = 0; i < kLanes; ++i)
-                  level[std::size_t(i)] = int(rng() % 6) - 1, x[std::size_t(i)] = int(rng() % 200) - 50,
-                  y[std::size_t(i)] = int(rng() % 200) - 50;
-                const simd::Int li = simd::Int::load_unaligned(level.data()), xi = simd::Int::load_unaligned(x.data()),
-                                yi = simd::Int::load_unaligned(y.data());
-                load(bound.view(), li, xi, yi, path, generic);
-                bound.load(li, xi, yi, fixed);
-                for (int ch = 0; ch < texture.channels(); ++ch)
-                  ASSERT_EQ(simd::to_bits(generic[ch] == fixed[ch]), (1u << kLanes) - 1) << "load, format " << int(c.format);
-              }
-            }
+    for (const SamplerState& state : every_sampler_state()) {
+      const Filter f = state.filter;
+      const simd::FetchPath path = state.fetch;
+      const TextureSampler bound(texture, state);
+      specialised += bound.specialised() ? 1 : 0;
+      for (int round = 0; round < 8; ++round) {
+        Lanes u, v, l;
+        for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+        if (round == 0) u[1] = std::numeric_limits<float>::quiet_NaN(), v[2] = -INFINITY, l[3] = NAN;
+        Float generic[4], fixed[4];
+        sample(bound.view(), state, load(u), load(v), load(l), generic);
+        bound.sample(load(u), load(v), load(l), fixed);
+        for (int ch = 0; ch < texture.channels(); ++ch)
+          for (int i = 0; i < kLanes; ++i)
+            ASSERT_EQ(bits(lanes(generic[ch])[i]), bits(lanes(fixed[ch])[i]))
+                << filter_name(f) << " format " << int(c.format) << " lane " << i;
+        std::array<std::int32_t, kLanes> level, x, y;
+        for (int i = 0; i < kLanes; ++i)
+          level[std::size_t(i)] = int(rng() % 6) - 1, x[std::size_t(i)] = int(rng() % 200) - 50,
+          y[std::size_t(i)] = int(rng() % 200) - 50;
+        const simd::Int li = simd::Int::load_unaligned(level.data()), xi = simd::Int::load_unaligned(x.data()),
+                        yi = simd::Int::load_unaligned(y.data());
+        load(bound.view(), li, xi, yi, path, generic);
+        bound.load(li, xi, yi, fixed);
+        for (int ch = 0; ch < texture.channels(); ++ch)
+          ASSERT_EQ(simd::to_bits(generic[ch] == fixed[ch]), (1u << kLanes) - 1) << "load, format " << int(c.format);
+      }
+    }
   }
   // Point, bilinear and trilinear with wrap, exact or 8-bit weights, sm4 and sm3, on the default path: 3 x 2 x 2
   // keys per format with a specialisation (5 of the 6 formats).
