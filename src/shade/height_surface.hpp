@@ -84,7 +84,7 @@ public:
   }
 
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes).
-  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
+  [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
     const TextureSampler& t = textures_->tree;
     simd::Float texel[4];
     switch (textures_->inline_max_chain) {
