@@ -144,10 +144,13 @@ QDMR_SAMPLER_INLINE void exact_product(const Float& u, const Float& n, Float& p,
 // off by the two rounding errors, which together are below the distance from q to any other multiple of
 // 2^-bits (for the coordinates the address modes leave: u * n in [-n, 2n]), so q's floor is right unless q * 2^bits
 // is an integer that the exact x lies just below (docs/sampling.md, "Math modes"). The weight is q minus the
-// index in fixed point or in fp32 (1 when the exact index is the one below q).
-QDMR_SAMPLER_INLINE void split(const Float& u, const Float& n, float offset, int bits, bool exact, Int& index, Float& weight) {
-  Float p, e;
-  if (exact)
+// index in fixed point or in fp32 (1 when the exact index is the one below q). `n_power_of_two`: n is a power
+// of two, so u * n is exact (no underflow or overflow for these u and n) and its rounding error e is 0 without
+// Dekker's product (the same bits, 14 operations fewer).
+QDMR_SAMPLER_INLINE void split(const Float& u, const Float& n, bool n_power_of_two, float offset, int bits, bool exact,
+                               Int& index, Float& weight) {
+  Float p, e(0.0f);
+  if (exact && !n_power_of_two)
     exact_product(u, n, p, e);
   else
     p = u * n;
@@ -171,18 +174,19 @@ QDMR_SAMPLER_INLINE void split(const Float& u, const Float& n, float offset, int
 QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
                               const LevelInfo& info, bool linear, Float* out) {
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
+  const bool pow2 = view.power_of_two();
   if (!linear) {
     Int x, y;
     Float unused;
-    split(u, w, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
-    split(v, h, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
+    split(u, w, pow2, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
+    split(v, h, pow2, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
     fetch(view, k, info, address(x, info.width, k.address), address(y, info.height, k.address), out);
     return;
   }
   Int x0, y0;
   Float wx, wy;
-  split(u, w, 0.5f, k.fraction_bits, k.exact_texel, x0, wx);
-  split(v, h, 0.5f, k.fraction_bits, k.exact_texel, y0, wy);
+  split(u, w, pow2, 0.5f, k.fraction_bits, k.exact_texel, x0, wx);
+  split(v, h, pow2, 0.5f, k.fraction_bits, k.exact_texel, y0, wy);
   const Int xa = address(x0, info.width, k.address), xb = address(x0 + Int(1), info.width, k.address);
   const Int ya = address(y0, info.height, k.address), yb = address(y0 + Int(1), info.height, k.address);
   Float t00[4], t10[4], t01[4], t11[4];
