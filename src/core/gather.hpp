@@ -9,6 +9,8 @@
 
 #if defined(__AVX2__)
 #include <immintrin.h>
+#elif defined(__SSE2__)
+#include <xmmintrin.h>
 #endif
 
 namespace qdmr::QDMR_ISA_NAMESPACE::simd {
@@ -101,6 +103,24 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
     transpose(4, second);
     return;
   }
+#elif defined(__SSE2__) && !defined(__AVX__)
+  // The 4-lane builds: each texel is a 4x4 transpose of four 128-bit loads (a lane-by-lane loop through memory
+  // costs a store-forwarding stall per vector).
+  static_assert(kLanes == 4);
+  (void)path;
+  alignas(16) std::int32_t lane_index[kLanes];
+  index.store_aligned(lane_index);
+  for (int at : {0, 4}) {
+    const auto row = [&](int lane) { return _mm_loadu_ps(base + lane_index[lane] + at); };
+    __m128 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    Float* out = at == 0 ? first : second;
+    out[0] = Float(r0);
+    out[1] = Float(r1);
+    out[2] = Float(r2);
+    out[3] = Float(r3);
+  }
+  return;
 #endif
   (void)path;
   alignas(64) std::int32_t o[kLanes];
