@@ -511,6 +511,21 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
   return plan;
 }
 
+// Whether building the frame reads an image file (the `qdmr` command then loads its image module).
+bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
+  const auto file = [](const TextureDesc& d) { return d.source == TextureSource::File; };
+  for (const TextureRequest& t : plan.textures)
+    if (file(t.desc) || (t.desc.source == TextureSource::FromHeight && file(t.layer.height))) return true;
+  for (const ObjectDesc& object : scene.objects)
+    if (file(object.mesh.height_map)) return true;
+  for (const MaterialPlan& m : plan.materials) {
+    const WeightsDesc& w = m.desc.blend.weights;
+    if (!m.blend) continue;
+    if (w.source == WeightSource::File || (w.source == WeightSource::Terrain && file(w.height))) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
@@ -567,6 +582,7 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
   std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
+  plan.image_module_bytes = reads_image_files(scene, plan) ? kImageModuleBytes : 0;
   return plan;
 }
 
@@ -654,6 +670,7 @@ std::string FramePlan::describe() const {
   if (working_bytes > 0)
     s << ", working " << mib(working_bytes)
       << (working_bytes == texture_working_bytes ? " (while textures are built)" : " (while a map is baked)");
+  if (image_module_bytes > 0) s << ", image library " << mib(image_module_bytes) << " (to read image files)";
   s << ", total " << mib(total_bytes()) << "\n";
   return s.str();
 }
@@ -704,7 +721,8 @@ nlohmann::json FramePlan::to_json() const {
                           {"quadtree", quadtree_storage_name(c.quadtree)}, {"region", c.region}, {"warp", c.warp}};
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
                  {"derived_bytes", derived_bytes},
-                 {"texture_working_bytes", texture_working_bytes}, {"working_bytes", working_bytes}, {"total_bytes", total_bytes()}};
+                 {"texture_working_bytes", texture_working_bytes}, {"working_bytes", working_bytes},
+                 {"image_module_bytes", image_module_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }
 

@@ -202,13 +202,53 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
       EXPECT_GT(cones.working_bytes, 4 * cones.bytes);  // the grid of doubles alone is 4 times the map
       EXPECT_EQ(field_plan.working_bytes, 0u);
       EXPECT_EQ(plan.working_bytes, cones.working_bytes);
+      EXPECT_EQ(plan.image_module_bytes, kImageModuleBytes);  // h.pgm is read
       EXPECT_EQ(plan.total_bytes(), plan.framebuffer_bytes + plan.texture_bytes + plan.mesh_bytes + plan.derived_bytes +
-                                        cones.working_bytes);
+                                        cones.working_bytes + kImageModuleBytes);
       // And --max-memory is checked against it: refused one byte short, before anything is built.
       RenderOptions tight;
       tight.max_memory_bytes = plan.total_bytes() - 1;
       EXPECT_THROW(Renderer(tight).set_scene(plan.scene), Error);
     }
+}
+
+// The image library's own memory (kImageModuleBytes, measured by bench/image_module_memory.sh) is counted when,
+// and only when, building the frame reads an image file: an albedo, a height behind from_height normals, a grid's
+// height map or a weight map, each a file; procedural and constant textures read none.
+TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
+  TempDir dir;
+  write_file(dir / "t.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
+  const auto plan_with = [&](const std::string& material, const std::string& mesh) {
+    write_file(dir / "scene.json", R"({"output": {"width": 16, "height": 16},
+  "camera": {"position": [0, -2, 1.5], "target": [0, 0, 0], "up": [0, 0, 1]},
+  "lights": [{"type": "directional", "direction": [0, -0.5, 1]}],
+  "materials": {"m": )" + material + R"(},
+  "objects": [{"mesh": )" + mesh + R"(, "material": "m"}]})");
+    return plan_frame(load_scene(dir / "scene.json"));
+  };
+  const std::string plane = R"({"type": "plane", "size": [2, 2]})";
+  const FramePlan none = plan_with(R"({"layers": [{"albedo": {"procedural": "bricks", "size": 16},
+                "height": {"procedural": "cobbles", "size": 16}, "normal": "from_height"}]})",
+                                   plane);
+  EXPECT_EQ(none.image_module_bytes, 0u);
+  EXPECT_EQ(none.total_bytes(), none.framebuffer_bytes + none.texture_bytes + none.mesh_bytes + none.derived_bytes +
+                                    none.working_bytes);
+  for (const auto& [material, mesh] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"layers": [{"albedo": "t.pgm"}]})", plane},
+           {R"({"layers": [{"albedo": {"constant": 0.5}, "height": "t.pgm", "normal": "from_height"}]})", plane},
+           {R"({"layers": [{"albedo": {"constant": 0.5}}]})",
+            R"({"type": "grid", "size": [2, 2], "resolution": 4, "height": 0.1, "height_map": "t.pgm"})"},
+           {R"({"layers": [{"albedo": {"constant": 0.2}, "height": {"procedural": "cobbles", "size": 16}},
+                           {"albedo": {"constant": 0.8}, "height": {"procedural": "bricks", "size": 16}}],
+               "blend": {"weights": {"source": "file", "file": "t.pgm"}}})", plane}}) {
+    SCOPED_TRACE(material + " on " + mesh);
+    const FramePlan plan = plan_with(material, mesh);
+    EXPECT_EQ(plan.image_module_bytes, kImageModuleBytes);
+    EXPECT_EQ(plan.total_bytes(), plan.framebuffer_bytes + plan.texture_bytes + plan.mesh_bytes + plan.derived_bytes +
+                                      plan.working_bytes + kImageModuleBytes);
+    EXPECT_NE(plan.describe().find("image library 48.00 MiB (to read image files)"), std::string::npos)
+        << plan.describe();
+  }
 }
 
 // This process's resident memory (VmRSS) or its peak (VmHWM) in bytes, from /proc/self/status; nullopt if absent.
@@ -429,7 +469,7 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
 // A new scene whose items replace the previous scene's: the previous items are held while the new ones are built.
 // When that would take the renderer over max_memory_bytes (the new scene alone fits), set_scene releases the
 // previous scene first: the peak of the second set_scene stays below the new plan's total less the previous
-// albedo (21.3 MiB), where holding it would peak at the whole total.
+// albedo (106.7 MiB with its decoded copy), where holding it would peak at the whole total.
 TEST(MaxMemory, ANewSceneReleasesThePreviousOneWhenBothWouldNotFit) {
 #ifdef QDMR_TEST_ASAN
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
