@@ -1,7 +1,8 @@
 #pragma once
-// Per-lane loads for texel fetch. The AVX2 and AVX-512 builds use the hardware gathers (xsimd 8.1 never emits them);
-// the portable versions load lane by lane. Both return the same bits; FetchPath picks one at run time so
-// they can be measured side by side.
+// Per-lane loads for texel fetch. On the Gather path the AVX2 and AVX-512 builds use the hardware gathers (xsimd
+// 8.1 never emits them), except where loads built by hand were measured faster (texel pairs, load_bytes8 and
+// load_f32x4_pair); the portable versions load lane by lane. Both return the same bits; FetchPath picks one at run
+// time so they can be measured side by side.
 #include <cstdint>
 #include <cstring>
 
@@ -51,7 +52,8 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
 // 8 bytes at base + byte_offset[lane] (unaligned): bytes 0-3 as `first`, bytes 4-7 as `second` (two adjacent
 // 4-byte texels from one load). AVX2 builds them from 64-bit loads by hand: measured on this project's machines, a
 // pair costs what one 8-lane vpgatherdd of single texels does, where two 4-lane vpgatherdq take 1.2-1.4x that.
-[[gnu::always_inline]] inline void load_bytes8(const std::uint8_t* base, const Int& byte_offset, FetchPath path, Int& first, Int& second) {
+[[gnu::always_inline]] inline void load_bytes8(const std::uint8_t* base, const Int& byte_offset, FetchPath path,
+                                               Int& first, Int& second) {
 #if defined(__AVX2__) && !defined(__AVX512F__)
   if (path == FetchPath::Gather) {
     alignas(32) std::int32_t o[kLanes];

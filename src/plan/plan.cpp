@@ -519,8 +519,8 @@ bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
   for (const ObjectDesc& object : scene.objects)
     if (file(object.mesh.height_map)) return true;
   for (const MaterialPlan& m : plan.materials) {
-    const WeightsDesc& w = m.desc.blend.weights;
     if (!m.blend) continue;
+    const WeightsDesc& w = m.desc.blend.weights;
     if (w.source == WeightSource::File || (w.source == WeightSource::Terrain && file(w.height))) return true;
   }
   return false;
