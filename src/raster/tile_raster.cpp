@@ -80,6 +80,7 @@ public:
     program_ = static_cast<const ShadingProgram*>(ctx_.programs[s.material]);
     for (int v = 0; v < 3; ++v) vertex_[v] = &ctx_.geometry->vertices[s.vertex[v]];
 
+    pair_batches_ = recorder_ == nullptr && program_->pairs_batches();
     for (int by = r.y0 - r.y0 % kBlock; by <= r.y1; by += kBlock) {
       for (int bx = r.x0 - r.x0 % kBlock; bx <= r.x1; bx += kBlock) {
         const int kind = classify_block(s, bx, by);
@@ -94,10 +95,63 @@ public:
           for (int x = x_begin; x <= x_end; x += kBatchWidth) batch(x, y, kind == 2);
       }
     }
+    if (waiting_) {  // the triangle's last batch had no partner
+      waiting_ = false;
+      ShadeOutput out;
+      program_->shade(pending_[0].in, out);
+      finish(pending_[0], out);
+    }
   }
 
 private:
+  // A batch that passed the early depth test, with what its shading needs and what its writing needs.
+  struct PendingBatch {
+    int x = 0, y = 0;
+    std::uint32_t pass = 0;  // lanes to write
+    Float z;                 // the polygon's window depth
+    alignas(64) float stored_depth[kLanes];
+    Fragments in;
+  };
+
   void batch(int x, int y, bool full) {
+    PendingBatch& p = pending_[waiting_ ? 1 : 0];
+    if (!prepare(x, y, full, p)) return;
+    if (pair_batches_) {
+      // Batches of one triangle share no pixel, so the second one's early depth test may run before the first
+      // one's write.
+      if (!waiting_) {
+        waiting_ = true;
+        return;
+      }
+      waiting_ = false;
+      ShadeOutput out[2];
+      program_->shade_pair(pending_[0].in, out[0], pending_[1].in, out[1]);
+      finish(pending_[0], out[0]);
+      finish(pending_[1], out[1]);
+      return;
+    }
+    ShadeOutput out;
+    if (recorder_ != nullptr) {
+      // The texture cache sees the quads a GPU would run: every lane of a quad with a pixel to write.
+      std::uint32_t issuing = 0;
+      for (int q = 0; q < simd::kQuadsPerBatch; ++q)
+        if ((p.pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
+      int lane_x[kLanes], lane_y[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
+        lane_x[l] = x + lane_dx(l);
+        lane_y[l] = y + lane_dy(l);
+      }
+      recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
+      program_->shade(p.in, out);
+      recorder_->end_batch();
+    } else {
+      program_->shade(p.in, out);
+    }
+    finish(p, out);
+  }
+
+  // Coverage, early depth test and interpolation of the batch at (x, y) into p; false when no lane passes.
+  bool prepare(int x, int y, bool full, PendingBatch& p) {
     const TriangleSetup& s = *setup_;
     const std::int64_t X = pixel_centre_fixed(x), Y = pixel_centre_fixed(y);
     alignas(64) std::int64_t w[3][kLanes];
@@ -117,11 +171,11 @@ private:
         const bool in = full || ((w[0][l] + s.bias[0]) | (w[1][l] + s.bias[1]) | (w[2][l] + s.bias[2])) >= 0;
         inside |= std::uint32_t(in) << l;
       }
-      if (inside == 0) return;
+      if (inside == 0) return false;
     }
 
     alignas(64) float e[3][kLanes];
-    alignas(64) float stored_depth[kLanes];
+    float* stored_depth = p.stored_depth;
     for (int i = 0; i < 3; ++i)
       for (int l = 0; l < kLanes; ++l) e[i][l] = edge_to_float(w[i][l]);
     if (whole) {
@@ -136,7 +190,7 @@ private:
     const Float z = e0 * Float(s.z_over_area[0]) + e1 * Float(s.z_over_area[1]) + e2 * Float(s.z_over_area[2]);
     const std::uint32_t pass = inside & simd::to_bits(z < Float::load_aligned(stored_depth));
     counters_.pixels_depth_failed += std::popcount(inside) - std::popcount(pass);
-    if (pass == 0) return;
+    if (pass == 0) return false;
 
     // Perspective-correct barycentrics: edge values weighted by 1/w, normalised.
     const Float p0 = e0 * Float(s.inv_w[0]), p1 = e1 * Float(s.inv_w[1]), p2 = e2 * Float(s.inv_w[2]);
@@ -144,7 +198,7 @@ private:
     const Float inv_sum = Float(1.0f) / sum;
     const Float b0 = p0 * inv_sum, b1 = p1 * inv_sum, b2 = p2 * inv_sum;
 
-    Fragments in;
+    Fragments& in = p.in;
     alignas(64) float px[kLanes], py[kLanes];
     for (int l = 0; l < kLanes; ++l) {
       px[l] = float(x + lane_dx(l)) + 0.5f;
@@ -157,33 +211,24 @@ private:
                        b2 * Float(vertex_[2]->varyings[k]);
     in.view_depth = Float(float(s.area2)) * inv_sum;
     in.covered = simd::from_bits(pass);
+    p.x = x;
+    p.y = y;
+    p.pass = pass;
+    p.z = z;
+    return true;
+  }
 
-    ShadeOutput out;
-    if (recorder_ != nullptr) {
-      // The texture cache sees the quads a GPU would run: every lane of a quad with a pixel to write.
-      std::uint32_t issuing = 0;
-      for (int q = 0; q < simd::kQuadsPerBatch; ++q)
-        if ((pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
-      int lane_x[kLanes], lane_y[kLanes];
-      for (int l = 0; l < kLanes; ++l) {
-        lane_x[l] = x + lane_dx(l);
-        lane_y[l] = y + lane_dy(l);
-      }
-      recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
-      program_->shade(in, out);
-      recorder_->end_batch();
-    } else {
-      program_->shade(in, out);
-    }
+  // The late depth test of a program that moved the surface, then the write.
+  void finish(PendingBatch& p, const ShadeOutput& out) {
     if (out.writes_depth) {
-      const std::uint32_t late = pass & simd::to_bits(out.depth < Float::load_aligned(stored_depth));
-      counters_.pixels_depth_failed += std::popcount(pass) - std::popcount(late);
+      const std::uint32_t late = p.pass & simd::to_bits(out.depth < Float::load_aligned(p.stored_depth));
+      counters_.pixels_depth_failed += std::popcount(p.pass) - std::popcount(late);
       if (late == 0) return;
-      in.view_depth = out.view_depth;
-      write(x, y, late, out.depth, in, out);
+      p.in.view_depth = out.view_depth;
+      write(p.x, p.y, late, out.depth, p.in, out);
       return;
     }
-    write(x, y, pass, z, in, out);
+    write(p.x, p.y, p.pass, p.z, p.in, out);
   }
 
   void write(int x, int y, std::uint32_t pass, const Float& z, const Fragments& in, const ShadeOutput& out) {
@@ -265,6 +310,9 @@ private:
   const ShadingProgram* program_ = nullptr;
   const ScreenVertex* vertex_[3] = {};
   FetchRecorder* recorder_;
+  bool pair_batches_ = false;  // the program shades batches in pairs (and no recorder listens)
+  bool waiting_ = false;       // pending_[0] waits for a partner
+  PendingBatch pending_[2];
   bool any_aov_ = false;  // an AOV plane other than cache_misses (filled after the tile) is asked for
 };
 

@@ -39,7 +39,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     : ShadingProgram(program_variant(material, select(trace_options(material)).options), inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      shade_(select(trace_options(material)).shade), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
+      shade_(select(trace_options(material)).shade), shade_pair_(select(trace_options(material)).shade_pair), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
@@ -174,7 +174,6 @@ struct DisplacementProgram::Setup {
 
 template <class V, class Surface>
 DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup, Float& ds) const {
-  const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
@@ -196,21 +195,26 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
     hit.box_s = hit.s;
     hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {
-    Float stop(0.0f);
-    if (technique_.lod_stop)
-      stop = xsimd::max(xsimd::floor(layers_[0].height->tree.lod(d.dudx, d.dvdx, d.dudy, d.dvdy)),
-                        Float(0.0f));
-    Int cap(technique_.max_iterations);
-    if (technique_.min_iterations > 0) {
-      const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
-      cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
-                          Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
-    }
-    hit = trace::qdm<V>(surface, ray, ds, stop, cap, active);
+    const QdmBudget budget = qdm_budget(setup);
+    hit = trace::qdm<V>(surface, ray, ds, budget.stop_level, budget.cap, active);
     hit.box_s = hit.s;
     hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   }
   return hit;
+}
+
+DisplacementProgram::QdmBudget DisplacementProgram::qdm_budget(const Setup& setup) const {
+  const UvDerivatives& d = setup.d;
+  QdmBudget budget{Float(0.0f), Int(technique_.max_iterations)};
+  if (technique_.lod_stop)
+    budget.stop_level =
+        xsimd::max(xsimd::floor(layers_[0].height->tree.lod(d.dudx, d.dvdx, d.dudy, d.dvdy)), Float(0.0f));
+  if (technique_.min_iterations > 0) {
+    const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
+    budget.cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
+                               Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
+  }
+  return budget;
 }
 
 namespace {
@@ -257,10 +261,16 @@ void blend_factors(BlendOperator op, float width, int count, const Float* h, con
 template <class V, class Surface>
 void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup, const Surface& surface,
                                         ShadeOutput& out) const {
+  Float ds = setup.ds;
+  const Hit hit = trace<V>(surface, setup, ds);
+  shade_hit<V>(in, setup, surface, hit, ds, out);
+}
+
+template <class V, class Surface>
+void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, Hit hit,
+                                    const Float& ds, ShadeOutput& out) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
-  Float ds = setup.ds;
-  Hit hit = trace<V>(surface, setup, ds);
   if (technique_.exact_hits) hit = exact_hit(ray, ds, hit, setup.active);
 
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
@@ -372,8 +382,45 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
 
 void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const { (this->*shade_)(in, out); }
 
+void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
+                                     ShadeOutput& out_b) const {
+  (this->*shade_pair_)(a, out_a, b, out_b);
+}
+
+// Single-layer QDM: both batches set up, their walks interleaved, then each shaded at its hit. Any other
+// program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
 template <class V>
-void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) const {
+void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
+                                             ShadeOutput& out_b) const {
+  if constexpr (V::technique == TechniqueKind::Qdm) {
+    if (layers_.size() == 1) {
+      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+      const SingleLayerSurface surface = layer_surface(0);
+      const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
+      trace::QdmWalk<V, SingleLayerSurface> walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap,
+                                                   setup_a.active);
+      trace::QdmWalk<V, SingleLayerSurface> walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap,
+                                                   setup_b.active);
+      trace::qdm_pair(walk_a, walk_b);
+      const auto refined = [&](const Setup& setup, Hit hit) {
+        hit.box_s = hit.s;
+        hit.s = trace::refine(surface, setup.ray, setup.ds, hit.s, hit.iterations, setup.active, technique_, surface_);
+        return hit;
+      };
+      shade_hit<V>(a, setup_a, surface, refined(setup_a, walk_a.hit()), setup_a.ds, out_a);
+      shade_hit<V>(b, setup_b, surface, refined(setup_b, walk_b.hit()), setup_b.ds, out_b);
+      return;
+    }
+  }
+  shade_variant<V>(a, out_a);
+  shade_variant<V>(b, out_b);
+}
+
+bool DisplacementProgram::pairs_batches() const {
+  return technique_.kind == TechniqueKind::Qdm && layers_.size() == 1;
+}
+
+DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
   const Float& u = in.varyings[kU];
   const Float& v = in.varyings[kV];
   Setup setup;
@@ -394,7 +441,12 @@ void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) c
   setup.active = in.covered;
   if (layers_[0].height)
     setup.height_lod = layers_[0].height->height.lod(setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
+  return setup;
+}
 
+template <class V>
+void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) const {
+  const Setup setup = setup_for(in);
   const int count = int(layers_.size());
   if (count == 1) {
     shade_surface<V>(in, setup, layer_surface(0), out);
@@ -421,7 +473,7 @@ void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) c
 
 template <class V>
 DisplacementProgram::Variant DisplacementProgram::variant() {
-  return {&DisplacementProgram::shade_variant<V>, V::options()};
+  return {&DisplacementProgram::shade_variant<V>, &DisplacementProgram::shade_pair_variant<V>, V::options()};
 }
 
 // Every combination of the trace options is instantiated (program/variant.hpp): 5 techniques, and for qdm

@@ -36,6 +36,8 @@ class DisplacementProgram final : public ShadingProgram {
 public:
   DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material, const LightRig& lights);
   void shade(const Fragments& in, ShadeOutput& out) const override;
+  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
+  bool pairs_batches() const override;
 
   using Ray = trace::Ray;
   using Hit = trace::Hit;
@@ -51,19 +53,35 @@ private:
   struct Setup;
   // The instantiation of shade_variant for a material's trace options, and the options of the type it runs.
   using ShadeFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&) const;
+  using ShadePairFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&, const Fragments&,
+                                                    ShadeOutput&) const;
   struct Variant {
     ShadeFn shade;
+    ShadePairFn shade_pair;
     TraceOptions options;
+  };
+  // QDM's lowest level and iteration cap per lane.
+  struct QdmBudget {
+    simd::Float stop_level;
+    simd::Int cap;
   };
   static Variant select(const TraceOptions& options);
   template <class V>
   static Variant variant();
 
   SingleLayerSurface layer_surface(int i) const;
+  Setup setup_for(const Fragments& in) const;
   template <class V>
   void shade_variant(const Fragments& in, ShadeOutput& out) const;
+  template <class V>
+  void shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
+  // Everything after the trace: the surface's colour and normal at the hit, lighting, AOVs, depth.
+  template <class V, class Surface>
+  void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, Hit hit, const simd::Float& ds,
+                 ShadeOutput& out) const;
+  QdmBudget qdm_budget(const Setup& setup) const;
   template <class V, class Surface>
   Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
@@ -81,6 +99,7 @@ private:
   Hit exact_hit(const Ray& ray, const simd::Float& depth_scale, const Hit& traced, const simd::Mask& covered) const;
 
   ShadeFn shade_;
+  ShadePairFn shade_pair_;
   std::vector<Layer> layers_;
   std::optional<TextureSampler> weights_;
   std::optional<TextureSampler> combined_;

@@ -12,86 +12,126 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 // level-0 cell the ray is at or below is the hit on the box surface. Cells are integer indices stepped exactly
 // across walls (sm4, exact), or recomputed from the fp32 position (sm3 emulation); where the ray crosses walls and
 // mid lines is computed in fp32, or in fp64 and rounded once (exact).
+//
+// One walk is one batch of rays, advanced one iteration per step(). Each step waits on the max-chain fetch of
+// the step before, so one walk per thread leaves the core idle most of the time: qdm_pair() advances two walks in
+// one loop, whose independent steps the core overlaps. Every lane's result is the same either way.
 template <class V, class Surface>
-Hit qdm(const Surface& surface, const Ray& ray, const Float& ds,
-                                                 const Float& stop_level, const Int& cap, Mask active) {
-  constexpr bool fp64 = V::math == MathMode::Exact;
-  const int top = surface.top_level();
-  const float width = float(surface.width()), height = float(surface.height());
-  const IntMask none = Int(0) != Int(0);
-  const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);
-  const Float dx = ray.du * Float(width), dy = ray.dv * Float(height);  // texels per unit of depth
-  const IntMask step_x_pos = int_mask(dx > Float(0.0f)), step_y_pos = int_mask(dy > Float(0.0f));
+class QdmWalk {
+public:
+  QdmWalk(const Surface& surface, const Ray& ray, const Float& ds, const Float& stop_level, const Int& cap,
+          const Mask& active)
+      : surface_(surface), ray_(ray), ds_(ds), top_(surface.top_level()),
+        x0_(ray.u0 * Float(float(surface.width()))), y0_(ray.v0 * Float(float(surface.height()))),
+        dx_(ray.du * Float(float(surface.width()))), dy_(ray.dv * Float(float(surface.height()))),
+        step_x_pos_(int_mask(dx_ > Float(0.0f))), step_y_pos_(int_mask(dy_ > Float(0.0f))), level_(top_),
+        cx_(xsimd::to_int(xsimd::floor(x0_)) >> top_), cy_(xsimd::to_int(xsimd::floor(y0_)) >> top_),
+        stop_(xsimd::to_int(stop_level)), active_(active), loop_(cap, FetchPhase::Trace) {}
+  QdmWalk(const QdmWalk&) = delete;
+  QdmWalk& operator=(const QdmWalk&) = delete;
 
-  Int level(top);
-  Int cx = xsimd::to_int(xsimd::floor(x0)) >> top, cy = xsimd::to_int(xsimd::floor(y0)) >> top;
-  Float s(0.0f);
-  const Int stop = xsimd::to_int(stop_level);
-  CappedLoop loop(cap, FetchPhase::Trace);
-  while (loop.next(active)) {
-
+  // One iteration of every running lane; false (and nothing done) once no lane is left.
+  [[gnu::always_inline]] bool step() {
+    constexpr bool fp64 = V::math == MathMode::Exact;
+    if (!loop_.next(active_)) return false;
     // The cell's highest point (wrap addressing: power-of-two level sizes), or LinearMipMapLinear at the ray's
     // position on this level, which smooths the maxima and so can miss features.
     Float hmax;
     if constexpr (V::filtered_max)
-      hmax = surface.cell_max_filtered(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, xsimd::to_float(level));
+      hmax = surface_.cell_max_filtered(ray_.u0 + ray_.du * s_, ray_.v0 + ray_.dv * s_, xsimd::to_float(level_));
     else
-      hmax = surface.cell_max(level, cx, cy);
-    const Float top_depth = ds * (Float(1.0f) - hmax);
-    const Mask below = active & (s >= top_depth);
-    const IntMask at_stop = level <= stop;
+      hmax = surface_.cell_max(level_, cx_, cy_);
+    const Float top_depth = ds_ * (Float(1.0f) - hmax);
+    const Mask below = active_ & (s_ >= top_depth);
+    const IntMask at_stop = level_ <= stop_;
     const Mask hit = below & float_mask(at_stop);
-    active = active & !hit;
-    // Below the cell's top but not at the last level: descend into the child that holds the ray.
-    const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) descend_to_child<fp64>(descend, s, x0, y0, dx, dy, level, cx, cy);
+    active_ = active_ & !hit;
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
-    const Mask above = active & !below;
-    if (!xsimd::any(above)) continue;
+    const Mask above = active_ & !below;
     Float tx, ty;
-    exit_walls<fp64>(level, cx, cy, x0, y0, dx, dy, step_x_pos, step_y_pos, tx, ty);
-    const Float t_wall = xsimd::max(xsimd::min(tx, ty), s);
+    exit_walls<fp64>(level_, cx_, cy_, x0_, y0_, dx_, dy_, step_x_pos_, step_y_pos_, tx, ty);
+    const Float t_wall = xsimd::max(xsimd::min(tx, ty), s_);
     const Mask to_plane = above & (top_depth <= t_wall);
-    s = xsimd::select(to_plane, top_depth, s);
+    s_ = xsimd::select(to_plane, top_depth, s_);
+    // Below the cell's top but not at the last level: descend into the child that holds the ray. On the cell's
+    // top plane the ray is at its highest point: the hit at the last level, else descend now, as the next
+    // iteration would after reading the same cell again (a filtered max moves with the ray: it reads again).
+    Mask descend = below & !hit;
     if constexpr (!V::filtered_max) {
-      // On the cell's top plane the ray is at its highest point: the hit at the last level, else descend now, as
-      // the next iteration would after reading the same cell again (a filtered max moves with the ray: it reads).
       const Mask plane_hit = to_plane & float_mask(at_stop);
-      active = active & !plane_hit;
-      const IntMask plane_descend = int_mask(to_plane & !plane_hit);
-      if (xsimd::any(plane_descend)) descend_to_child<fp64>(plane_descend, s, x0, y0, dx, dy, level, cx, cy);
+      active_ = active_ & !plane_hit;
+      descend = descend | (to_plane & !plane_hit);
     }
+    // No branch on whether any lane descends or crosses: a mispredicted one would also throw away the other
+    // walk's steps in flight (qdm_pair).
+    descend_to_child<fp64>(int_mask(descend), s_, x0_, y0_, dx_, dy_, level_, cx_, cy_);
     const Mask cross = above & !to_plane;
-    s = xsimd::select(cross, t_wall, s);
+    s_ = xsimd::select(cross, t_wall, s_);
     const IntMask cross_i = int_mask(cross);
     const IntMask cross_x = cross_i & int_mask(tx <= ty);
     const IntMask cross_y = cross_i & int_mask(ty <= tx);
     if constexpr (V::math == MathMode::Sm3) {
       // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
       const Float nudge = Float(1.0f / 64.0f);
-      const Float cell = xsimd::to_float(Int(1) << level);
-      const Float px = x0 + dx * s + xsimd::select(dx > Float(0.0f), nudge, Float(0.0f) - nudge);
-      const Float py = y0 + dy * s + xsimd::select(dy > Float(0.0f), nudge, Float(0.0f) - nudge);
-      cx = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx);
-      cy = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy);
+      const Float cell = xsimd::to_float(Int(1) << level_);
+      const Float px = x0_ + dx_ * s_ + xsimd::select(dx_ > Float(0.0f), nudge, Float(0.0f) - nudge);
+      const Float py = y0_ + dy_ * s_ + xsimd::select(dy_ > Float(0.0f), nudge, Float(0.0f) - nudge);
+      cx_ = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx_);
+      cy_ = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy_);
     } else {
-      cx = xsimd::select(cross_x, xsimd::select(step_x_pos, cx + Int(1), cx - Int(1)), cx);
-      cy = xsimd::select(cross_y, xsimd::select(step_y_pos, cy + Int(1), cy - Int(1)), cy);
+      cx_ = xsimd::select(cross_x, xsimd::select(step_x_pos_, cx_ + Int(1), cx_ - Int(1)), cx_);
+      cy_ = xsimd::select(cross_y, xsimd::select(step_y_pos_, cy_ + Int(1), cy_ - Int(1)), cy_);
     }
     // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
     // while the wall just crossed is also a wall of the parent.
-    IntMask up = cross_i & (level < Int(top));
-    if constexpr (V::level_up == QdmLevelUp::Stay) {
-      up = none;
+    if constexpr (V::level_up == QdmLevelUp::One) {
+      const IntMask up = cross_i & (level_ < Int(top_));
+      level_ = xsimd::select(up, level_ + Int(1), level_);
+      cx_ = xsimd::select(up, cx_ >> 1, cx_);
+      cy_ = xsimd::select(up, cy_ >> 1, cy_);
     } else if constexpr (V::level_up == QdmLevelUp::Aligned) {
-      climb_aligned(level, cx, cy, up, cross_x, cross_y, step_x_pos, step_y_pos, top);
-      up = none;
+      climb_aligned(level_, cx_, cy_, cross_i, cross_x, cross_y, step_x_pos_, step_y_pos_, top_);
     }
-    level = xsimd::select(up, level + Int(1), level);
-    cx = xsimd::select(up, cx >> 1, cx);
-    cy = xsimd::select(up, cy >> 1, cy);
+    return true;
   }
-  return {xsimd::min(s, ds), loop.iterations(), Float(0.0f)};
+
+  // The hit on the box surface (depth_scale where the ray found none), and the iterations per lane.
+  Hit hit() const { return {xsimd::min(s_, ds_), loop_.iterations(), Float(0.0f)}; }
+
+private:
+  const Surface& surface_;
+  const Ray& ray_;
+  const Float ds_;
+  const int top_;
+  const Float x0_, y0_, dx_, dy_;  // the ray in texels per unit of depth
+  const IntMask step_x_pos_, step_y_pos_;
+  Int level_, cx_, cy_;
+  const Int stop_;
+  Float s_ = Float(0.0f);
+  Mask active_;
+  CappedLoop loop_;
+};
+
+template <class V, class Surface>
+Hit qdm(const Surface& surface, const Ray& ray, const Float& ds, const Float& stop_level, const Int& cap, Mask active) {
+  QdmWalk<V, Surface> walk(surface, ray, ds, stop_level, cap, active);
+  while (walk.step()) {
+  }
+  return walk.hit();
+}
+
+// Two walks to their ends, a step of each per round while both run.
+template <class V, class Surface>
+void qdm_pair(QdmWalk<V, Surface>& a, QdmWalk<V, Surface>& b) {
+  bool a_runs = true, b_runs = true;
+  while (a_runs && b_runs) {
+    a_runs = a.step();
+    b_runs = b.step();
+  }
+  while (a_runs && a.step()) {
+  }
+  while (b_runs && b.step()) {
+  }
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE::trace
