@@ -33,6 +33,7 @@ Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   Texture texture;
   if (request.purpose == TexturePurpose::Height) {
     texture = stored_height(request, request.reduce, stat).texture;
+    add_linear_copy(texture);
   } else {
     Image level0;
     if (request.desc.source == TextureSource::FromHeight) {

@@ -173,23 +173,28 @@ std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format) {
 }
 
 std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool srgb) {
-  if (format != TexelFormat::RGBA8 || !srgb) return 0;
-  const std::uint64_t bytes = mip_chain_bytes(width, height, format) * sizeof(float);
+  const bool decoded = format == TexelFormat::RGBA8 ? srgb : format == TexelFormat::R16 || (format == TexelFormat::R8 && !srgb);
+  if (!decoded) return 0;
+  const std::uint64_t bytes = mip_chain_bytes(width, height, format) / bytes_per_texel(format) *
+                              std::uint64_t(channel_count(format)) * sizeof(float);
   return bytes <= kLinearCopyMaxBytes ? bytes : 0;
 }
 
 void add_linear_copy(Texture& texture) {
   if (texture.levels.empty() || linear_copy_bytes(texture.width(), texture.height(), texture.format, texture.srgb) == 0)
     return;
-  texture.linear.assign(texture.storage.size(), 0.0f);
+  const std::size_t texel_bytes = bytes_per_texel(texture.format);
+  const std::size_t channels = std::size_t(texture.channels());
+  texture.linear.assign(texture.storage.size() / texel_bytes * channels, 0.0f);
   const Codec codec{texture.format, texture.srgb};
   for (int k = 0; k < texture.level_count(); ++k) {
     const TextureLevel& l = texture.levels[std::size_t(k)];
-    for_rows(l.height, std::size_t(l.width) * 16, [&](int y0, int y1) {
+    for_rows(l.height, std::size_t(l.width) * 4 * channels, [&](int y0, int y1) {
       for (int y = y0; y < y1; ++y)
         for (int x = 0; x < l.width; ++x) {
-          const std::size_t at = l.offset + (std::size_t(y) * std::size_t(l.width) + std::size_t(x)) * 4;
-          for (int c = 0; c < 4; ++c) texture.linear[at + std::size_t(c)] = codec.decode(texture.storage.data() + at, c);
+          const std::size_t texel = l.offset / texel_bytes + std::size_t(y) * std::size_t(l.width) + std::size_t(x);
+          for (std::size_t c = 0; c < channels; ++c)
+            texture.linear[texel * channels + c] = codec.decode(texture.storage.data() + texel * texel_bytes, int(c));
         }
     });
   }

@@ -89,11 +89,25 @@ QDMR_SAMPLER_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out)
   }
 }
 
+// A one-channel texture (heights) with its decoded copy: Texture::linear holds float i for texel i of `storage`.
+QDMR_SAMPLER_INLINE bool decoded_one_channel(const SamplerKey& k, const Texture& t) {
+  return (k.format == TexelFormat::R16 || (k.format == TexelFormat::R8 && !k.srgb)) && !t.linear.empty();
+}
+
+// The index of texel (x, y) of `level` in the decoded copy of a one-channel texture.
+QDMR_SAMPLER_INLINE Int decoded_index(const SamplerKey& k, const LevelInfo& level, const Int& x, const Int& y) {
+  return (k.format == TexelFormat::R16 ? level.offset >> 1 : level.offset) + y * level.width + x;
+}
+
 QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& x, const Int& y,
                        Float* out) {
   const Texture& t = view.texture();
-  const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(k.format));
   trace_fetch(t, level.offset, x, y);
+  if (decoded_one_channel(k, t)) {
+    out[0] = simd::load_f32(t.linear.data(), decoded_index(k, level, x, y), k.fetch);
+    return;
+  }
+  const Int offset = level.offset + (y * level.width + x) * Int(bytes_per_texel(k.format));
   decode(k, simd::load_bytes4(t.storage.data(), offset, k.fetch), out);
 }
 
@@ -105,6 +119,14 @@ QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k
   const int bytes = bytes_per_texel(k.format);
   trace_fetch(t, level.offset, xa, y);
   trace_fetch(t, level.offset, xb, y);
+  if (decoded_one_channel(k, t)) {
+    Int first, second;
+    simd::load_bytes8(reinterpret_cast<const std::uint8_t*>(t.linear.data()),
+                      decoded_index(k, level, xa, y) * Int(int(sizeof(float))), k.fetch, first, second);
+    a[0] = xsimd::bitwise_cast<Float>(first);
+    b[0] = xsimd::bitwise_cast<Float>(second);
+    return;
+  }
   const Int offset = level.offset + (y * level.width + xa) * Int(bytes);
   if (bytes <= 2) {
     const Int raw = simd::load_bytes4(t.storage.data(), offset, k.fetch);

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -334,36 +335,62 @@ std::vector<SamplerState> every_sampler_state() {
 // An RGBA8 sRGB chain keeps a decoded copy (Texture::linear) that the sampler reads whole texels from; sampling
 // with it must give the bits of the per-channel table decode, for every filter, address mode, precision, math mode
 // and fetch path, specialised and generic, with non-finite coordinates and lanes at the wrap and clamp edges.
-TEST(TextureSampler, TheDecodedCopyOfAnSrgbTextureGivesTheTableDecodesBits) {
+// The decoded copy (Texture::linear) of an sRGB colour texture and of R16 and R8 heights gives the bits of the
+// per-fetch decode, through every sampler, the generic sampler and texel loads on every level.
+TEST(TextureSampler, TheDecodedCopyGivesThePerFetchDecodesBits) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-3.0f, 4.0f), lod(-1.0f, 9.0f);
-  Image img(64, 32, 4);
-  for (float& t : img.texels) t = unit(rng);
-  const Texture table_decoded = make_mip_texture(img, TexelFormat::RGBA8, true, MipReduce::Box);
-  Texture copied = table_decoded;
-  add_linear_copy(copied);
-  ASSERT_EQ(copied.linear.size(), copied.storage.size());
-  EXPECT_EQ(copied.bytes(), linear_copy_bytes(64, 32, TexelFormat::RGBA8, true) + copied.storage.size());
+  std::uniform_int_distribution<int> index(-70, 70);
   EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::RGBA8, false), 0u);
+  EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::R8, true), 0u);
+  EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::RG8, false), 0u);
+  EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::R32F, false), 0u);
   EXPECT_EQ(linear_copy_bytes(8192, 8192, TexelFormat::RGBA8, true), 0u) << "above kLinearCopyMaxBytes";
-  for (const SamplerState& state : every_sampler_state()) {
-    const Filter f = state.filter;
-    const TextureSampler with_table(table_decoded, state), with_copy(copied, state);
-    for (int round = 0; round < 16; ++round) {
-      Lanes u, v, l;
-      for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
-      if (round == 0) u[1] = kNaN, v[2] = -kInf, l[3] = kNaN;
-      if (round % 2 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
-        for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
-      Float a[4], b[4], c[4];
-      with_table.sample(load(u), load(v), load(l), a);
-      with_copy.sample(load(u), load(v), load(l), b);
-      sample(with_copy.view(), state, load(u), load(v), load(l), c);
-      for (int ch = 0; ch < 4; ++ch)
-        for (int i = 0; i < kLanes; ++i) {
-          ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(b[ch])[i])) << filter_name(f) << " channel " << ch;
-          ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(c[ch])[i])) << filter_name(f) << " generic";
-        }
+  EXPECT_EQ(linear_copy_bytes(16384, 16384, TexelFormat::R16, false), 0u) << "above kLinearCopyMaxBytes";
+  EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::R16, false), 2 * mip_chain_bytes(64, 32, TexelFormat::R16));
+  EXPECT_EQ(linear_copy_bytes(64, 32, TexelFormat::R8, false), 4 * mip_chain_bytes(64, 32, TexelFormat::R8));
+  struct Case {
+    TexelFormat format;
+    bool srgb;
+  };
+  for (const Case& format : {Case{TexelFormat::RGBA8, true}, Case{TexelFormat::R16, false}, Case{TexelFormat::R8, false}}) {
+    const std::string name = format_name(format.format);
+    Image img(64, 32, channel_count(format.format));
+    for (float& t : img.texels) t = unit(rng);
+    const Texture decoded_per_fetch = make_mip_texture(img, format.format, format.srgb, MipReduce::Max);
+    Texture copied = decoded_per_fetch;
+    add_linear_copy(copied);
+    ASSERT_EQ(copied.linear.size(),
+              copied.storage.size() / bytes_per_texel(format.format) * std::size_t(copied.channels())) << name;
+    EXPECT_EQ(copied.bytes(), linear_copy_bytes(64, 32, format.format, format.srgb) + copied.storage.size()) << name;
+    for (const SamplerState& state : every_sampler_state()) {
+      const Filter f = state.filter;
+      const TextureSampler with_decode(decoded_per_fetch, state), with_copy(copied, state);
+      for (int round = 0; round < 16; ++round) {
+        Lanes u, v, l;
+        for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+        if (round == 0) u[1] = kNaN, v[2] = -kInf, l[3] = kNaN;
+        if (round % 2 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
+          for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
+        Float a[4], b[4], c[4];
+        with_decode.sample(load(u), load(v), load(l), a);
+        with_copy.sample(load(u), load(v), load(l), b);
+        sample(with_copy.view(), state, load(u), load(v), load(l), c);
+        for (int ch = 0; ch < copied.channels(); ++ch)
+          for (int i = 0; i < kLanes; ++i) {
+            ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(b[ch])[i])) << name << " " << filter_name(f) << " channel " << ch;
+            ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(c[ch])[i])) << name << " " << filter_name(f) << " generic";
+          }
+        // Texel loads (QDM's max-chain reads), wrapped into every level, on both fetch paths.
+        alignas(64) std::int32_t level[kLanes], x[kLanes], y[kLanes];
+        for (int i = 0; i < kLanes; ++i) level[i] = index(rng) % 8, x[i] = index(rng), y[i] = index(rng);
+        const simd::Int li = simd::Int::load_aligned(level), xi = simd::Int::load_aligned(x), yi = simd::Int::load_aligned(y);
+        with_decode.load_wrapped(li, xi, yi, a);
+        with_copy.load_wrapped(li, xi, yi, b);
+        for (int ch = 0; ch < copied.channels(); ++ch)
+          for (int i = 0; i < kLanes; ++i)
+            ASSERT_EQ(bits(lanes(a[ch])[i]), bits(lanes(b[ch])[i])) << name << " load, level " << level[i];
+      }
     }
   }
 }

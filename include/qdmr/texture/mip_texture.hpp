@@ -32,9 +32,11 @@ public:
   bool srgb = false;  // RGBA8/RG8/R8 colour: the rgb channels are sRGB-encoded
   std::vector<TextureLevel> levels;
   std::vector<std::uint8_t> storage;
-  // RGBA8 sRGB only, and only where add_linear_copy kept it: every texel decoded as texel() decodes it (rgb
-  // through the sRGB table, alpha / 255), 4 floats per texel, float i for byte i of `storage`. The sampler reads
-  // whole texels from it instead of looking each channel up in a table (the same bits, fewer loads).
+  // The decoded copy, where add_linear_copy kept one: every texel decoded as texel() decodes it, one float per
+  // channel, float i * channels + c for channel c of texel i of `storage`. RGBA8 sRGB (rgb through the sRGB
+  // table, alpha / 255: the sampler reads whole texels instead of looking each channel up in a table) and the
+  // one-channel height formats R16 and R8 (code / 65535 or / 255: a height fetch, on the critical path of every
+  // tracing step, skips the division). The same bits, fewer instructions per fetch.
   std::vector<float> linear;
 
   int width() const { return levels.empty() ? 0 : levels[0].width; }
@@ -56,9 +58,9 @@ public:
 // The storage bytes of the chain allocate_texture makes (for memory plans).
 std::uint64_t mip_chain_bytes(int width, int height, TexelFormat format);
 
-// The bytes of Texture::linear that add_linear_copy keeps for such a chain: 4 floats per storage byte for RGBA8
-// sRGB chains of up to kLinearCopyMaxBytes, else 0 (larger chains are decoded per channel: 4x the memory is too
-// dear there).
+// The bytes of Texture::linear that add_linear_copy keeps for such a chain: 4 bytes per channel of every texel
+// (4x the storage for RGBA8 sRGB colour and R8 heights, 2x for R16 heights) for copies of up to kLinearCopyMaxBytes,
+// else 0 (larger chains are decoded per fetch: the memory is too dear there).
 inline constexpr std::uint64_t kLinearCopyMaxBytes = std::uint64_t(256) << 20;
 std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool srgb);
 
