@@ -397,10 +397,9 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
       const Setup setup_a = setup_for(a), setup_b = setup_for(b);
       const SingleLayerSurface surface = layer_surface(0);
       const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
-      trace::QdmWalk<V, SingleLayerSurface> walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap,
-                                                   setup_a.active);
-      trace::QdmWalk<V, SingleLayerSurface> walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap,
-                                                   setup_b.active);
+      using Walk = trace::QdmWalk<V, SingleLayerSurface, false>;  // no recorder listens to paired batches
+      Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
+      Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
       trace::qdm_pair(walk_a, walk_b);
       const auto refined = [&](const Setup& setup, Hit hit) {
         hit.box_s = hit.s;

@@ -83,16 +83,18 @@ public:
     return h[0];
   }
 
-  // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes).
+  // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes). Recorded
+  // false: the caller knows the texture-cache recorder does not listen (sampling_code::fetch).
+  template <bool Recorded = true>
   [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
     const TextureSampler& t = textures_->tree;
     simd::Float texel[4];
     switch (textures_->inline_max_chain) {
       case InlineMaxChain::R16:
-        sampling_code::load_with(inline_height_key(TexelFormat::R16), true, t.view(), level, cx, cy, texel);
+        sampling_code::load_with(inline_height_key(TexelFormat::R16), true, t.view(), level, cx, cy, texel, Recorded);
         return texel[0];
       case InlineMaxChain::R8:
-        sampling_code::load_with(inline_height_key(TexelFormat::R8), true, t.view(), level, cx, cy, texel);
+        sampling_code::load_with(inline_height_key(TexelFormat::R8), true, t.view(), level, cx, cy, texel, Recorded);
         return texel[0];
       case InlineMaxChain::None: break;
     }

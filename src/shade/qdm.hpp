@@ -15,8 +15,9 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 //
 // One walk is one batch of rays, advanced one iteration per step(). Each step waits on the max-chain fetch of
 // the step before, so one walk per thread leaves the core idle most of the time: qdm_pair() advances two walks in
-// one loop, whose independent steps the core overlaps. Every lane's result is the same either way.
-template <class V, class Surface>
+// one loop, whose independent steps the core overlaps. Every lane's result is the same either way. Recorded
+// false: no texture-cache recorder listens (the rasterizer pairs batches only then), so the steps do not ask it.
+template <class V, class Surface, bool Recorded = true>
 class QdmWalk {
 public:
   QdmWalk(const Surface& surface, const Ray& ray, const Float& ds, const Float& stop_level, const Int& cap,
@@ -39,8 +40,10 @@ public:
     Float hmax;
     if constexpr (V::filtered_max)
       hmax = surface_.cell_max_filtered(ray_.u0 + ray_.du * s_, ray_.v0 + ray_.dv * s_, xsimd::to_float(level_));
-    else
+    else if constexpr (Recorded)
       hmax = surface_.cell_max(level_, cx_, cy_);
+    else
+      hmax = surface_.template cell_max<false>(level_, cx_, cy_);
     const Float top_depth = ds_ * (Float(1.0f) - hmax);
     const Mask below = active_ & (s_ >= top_depth);
     const IntMask at_stop = level_ <= stop_;
@@ -109,7 +112,7 @@ private:
   const Int stop_;
   Float s_ = Float(0.0f);
   Mask active_;
-  CappedLoop loop_;
+  CappedLoop<Recorded> loop_;
 };
 
 template <class V, class Surface>
@@ -122,7 +125,7 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds, const Float& st
 
 // Two walks to their ends, a step of each per round while both run.
 template <class V, class Surface>
-void qdm_pair(QdmWalk<V, Surface>& a, QdmWalk<V, Surface>& b) {
+void qdm_pair(QdmWalk<V, Surface, false>& a, QdmWalk<V, Surface, false>& b) {
   bool a_runs = true, b_runs = true;
   while (a_runs && b_runs) {
     a_runs = a.step();

@@ -3,6 +3,7 @@
 // budget of a capped loop, the range texel coordinates are clamped to before they become indices, and the cell
 // stepping: descending into a child, the distance to a cell's exit walls, climbing after a crossing.
 #include <limits>
+#include <type_traits>
 
 #include "core/simd.hpp"
 #include "texture/fetch_trace.hpp"
@@ -13,9 +14,16 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 // meaningless anyway, and indices (plus at most 2^20 capped steps) stay exact in fp32.
 inline constexpr float kMaxTexelCoordinate = 4194304.0f;
 
+// FetchLanes where the caller knows no texture-cache recorder listens: nothing to tell it.
+struct UnrecordedLanes {
+  explicit UnrecordedLanes(FetchPhase) {}
+  void narrow(const simd::Mask&) {}
+};
+
 // The iteration budget of a capped SIMD loop, as a GPU wave runs it: a lane stops when it is done or when
 // its own count reaches the cap; the loop ends when no lane is left. Only the running lanes fetch (`phase`: for
-// the texture-cache recorder).
+// the texture-cache recorder, unless Recorded is false).
+template <bool Recorded = true>
 class CappedLoop {
 public:
   CappedLoop(const simd::Int& cap, FetchPhase phase) : cap_(cap), lanes_(phase) {}
@@ -34,7 +42,7 @@ public:
 private:
   simd::Int cap_;
   simd::Int done_ = simd::Int(0);
-  FetchLanes lanes_;
+  std::conditional_t<Recorded, FetchLanes, UnrecordedLanes> lanes_;
 };
 
 // Where the ray x(t) = origin + dir t crosses the line x = wall, per lane: (wall - origin) / dir in fp32 (two

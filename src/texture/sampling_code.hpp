@@ -99,10 +99,12 @@ QDMR_SAMPLER_INLINE Int decoded_index(const SamplerKey& k, const LevelInfo& leve
   return (k.format == TexelFormat::R16 ? level.offset >> 1 : level.offset) + y * level.width + x;
 }
 
+// record false: the caller knows no texture-cache recorder listens (the recorder's test in the loop would make the
+// compiler keep every vector register in memory around the call it guards).
 QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& x, const Int& y,
-                       Float* out) {
+                       Float* out, bool record = true) {
   const Texture& t = view.texture();
-  trace_fetch(t, level.offset, x, y);
+  if (record) trace_fetch(t, level.offset, x, y);
   if (decoded_one_channel(k, t)) {
     out[0] = simd::load_f32(t.linear.data(), decoded_index(k, level, x, y), k.fetch);
     return;
@@ -269,16 +271,16 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
 
 // wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.
 QDMR_SAMPLER_INLINE void load_with(const SamplerKey& k, bool wrap, const TextureView& view, const Int& level, const Int& x,
-                           const Int& y, Float* out) {
+                           const Int& y, Float* out, bool record = true) {
   const Int l = xsimd::min(xsimd::max(level, Int(0)), Int(view.levels() - 1));
   const LevelInfo info = level_info(view, l);
   if (wrap) {
-    fetch(view, k, info, x & (info.width - Int(1)), y & (info.height - Int(1)), out);
+    fetch(view, k, info, x & (info.width - Int(1)), y & (info.height - Int(1)), out, record);
     return;
   }
   const Int cx = xsimd::min(xsimd::max(x, Int(0)), info.width - Int(1));
   const Int cy = xsimd::min(xsimd::max(y, Int(0)), info.height - Int(1));
-  fetch(view, k, info, cx, cy, out);
+  fetch(view, k, info, cx, cy, out, record);
 }
 
 // Channel 0 of sample_with() for a key fixed at compile time, inlined into the caller's loop.
