@@ -88,11 +88,27 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
   }
 }
 
+// Also what the batch pairing does: with the cache on, the rasterizer hands QDM one batch at a time; off, two
+// (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs, loop
+// statistics. objects_displaced has single-layer QDM (paired) beside POM and relief (not paired).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   const SceneDesc off = small_scene("objects_displaced");
   const SceneDesc on = small_scene("objects_displaced", {{"/texture_cache/layout", "\"morton\""}});
   ASSERT_TRUE(on.texture_cache.enabled);
-  EXPECT_TRUE(same_bits(render_frame(off, RenderOptions{}).color, render_frame(on, RenderOptions{}).color));
+  RenderOptions options;
+  options.aovs = {Aov::Depth, Aov::Normal, Aov::Iterations, Aov::HitUV, Aov::HitDepth};
+  const Frame a = render_frame(off, options), b = render_frame(on, options);
+  EXPECT_TRUE(same_bits(a.color, b.color));
+  ASSERT_EQ(a.aovs.size(), b.aovs.size());
+  for (std::size_t i = 0; i < a.aovs.size(); ++i)
+    EXPECT_TRUE(same_bits(a.aovs[i].pixels, b.aovs[i].pixels)) << aov_name(a.aovs[i].aov);
+  EXPECT_GT(a.stats.iterations_mean, 0.0);
+  EXPECT_EQ(a.stats.iterations_mean, b.stats.iterations_mean);
+  EXPECT_EQ(a.stats.iterations_max, b.stats.iterations_max);
+  EXPECT_EQ(a.stats.lane_utilisation, b.stats.lane_utilisation);
+  EXPECT_EQ(a.stats.batches, b.stats.batches);
+  EXPECT_EQ(a.stats.pixels_shaded, b.stats.pixels_shaded);
+  EXPECT_EQ(a.stats.pixels_depth_failed, b.stats.pixels_depth_failed);
 }
 
 TEST(TextureCache, LayoutsChangeTheMissesNotTheReads) {
