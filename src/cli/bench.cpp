@@ -137,8 +137,18 @@ int run_bench(const BenchArgs& args) {
   j["peak_rss_bytes"] = peak_rss_bytes();
   j["load_average_1min"] = load_average();
   j["pixels_shaded"] = last.pixels_shaded;
+  // The trace's cost per unit of SIMD work: lane-iterations executed (useful ones / lane utilisation, so the idle
+  // lanes of a batch count), against the median raster+shade time of all threads. That time includes everything
+  // else a pixel costs, so this is an upper bound on what one iteration of the tracing loop costs.
+  const double lane_iterations =
+      last.lane_utilisation > 0 ? last.iterations_mean * double(last.pixels_shaded) / last.lane_utilisation : 0.0;
+  const double raster_median_ms = j["raster_shade_ms"]["median"].get<double>();
+  const bool traced = lane_iterations > 0;
+  const double ns_per_lane_iteration =
+      traced ? raster_median_ms * 1e6 * double(renderer.threads()) / lane_iterations : 0.0;
   j["iterations"] = {{"mean", last.iterations_mean}, {"p99", last.iterations_p99}, {"max", last.iterations_max},
-                     {"lane_utilisation", last.lane_utilisation}};
+                     {"lane_utilisation", last.lane_utilisation}, {"lane_iterations_executed", lane_iterations},
+                     {"ns_per_lane_iteration", traced ? nlohmann::json(ns_per_lane_iteration) : nlohmann::json(nullptr)}};
   j["materials"] = nlohmann::json::array();
   for (const MaterialStat& m : last.materials) j["materials"].push_back({{"name", m.name}, {"variant", m.variant}});
 
@@ -149,6 +159,11 @@ int run_bench(const BenchArgs& args) {
               write_ms, image.extension().string().c_str());
   std::printf("  draw: median %.2f ms, min %.2f, p10 %.2f, p90 %.2f\n", d["median"].get<double>(), d["min"].get<double>(),
               d["p10"].get<double>(), d["p90"].get<double>());
+  if (traced)
+    std::printf("  trace: %.2f iterations per pixel (p99 %.0f, max %.0f), lane utilisation %.3f, %.2f ns per executed "
+                "lane-iteration (raster+shade time of all threads / %.3g lane-iterations: an upper bound)\n",
+                last.iterations_mean, last.iterations_p99, last.iterations_max, last.lane_utilisation,
+                ns_per_lane_iteration, lane_iterations);
   std::printf("  peak RSS %.1f MiB, load average %.2f\n", double(peak_rss_bytes()) / (1024.0 * 1024.0), load_average());
   if (!args.json.empty()) write_json(j, args.json);
   return 0;

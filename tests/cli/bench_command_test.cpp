@@ -1,0 +1,53 @@
+// qdmr bench's trace report: iterations, lane utilisation and the cost per executed lane-iteration, printed and in
+// the JSON for a frame that traces, absent for one that does not.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_test_util.hpp"
+
+namespace qdmr::test {
+namespace {
+
+nlohmann::json bench(const TempDir& dir, const std::string& technique, std::string& output) {
+  const std::string scene = (source_dir() / "bench" / "llvmpipe" / "canonical.json").string();
+  const std::string json = (dir / (technique + ".json")).string();
+  const CommandResult r = run(cli(), {"bench", scene, "--width", "96", "--height", "54", "--frames", "2", "--warmup",
+                                      "0", "--threads", "2", "--set", "/materials/cobbles/technique/name=\"" + technique + "\"",
+                                      "--json", json, "--image", (dir / (technique + ".png")).string()});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  output = r.output;
+  std::ifstream in(json);
+  return nlohmann::json::parse(in);
+}
+
+TEST(BenchCommand, ReportsTheTracesCostPerLaneIteration) {
+  TempDir dir;
+  std::string output;
+  const nlohmann::json qdm = bench(dir, "qdm", output);
+  const nlohmann::json& it = qdm.at("iterations");
+  const double mean = it.at("mean").get<double>(), utilisation = it.at("lane_utilisation").get<double>();
+  EXPECT_GT(mean, 1.0);
+  EXPECT_GT(utilisation, 0.0);
+  EXPECT_LE(utilisation, 1.0);
+  // Executed lane-iterations: the useful ones (mean x pixels) over the utilisation, so at least the useful ones.
+  const double executed = it.at("lane_iterations_executed").get<double>();
+  EXPECT_DOUBLE_EQ(executed, mean * qdm.at("pixels_shaded").get<double>() / utilisation);
+  EXPECT_GE(executed, mean * qdm.at("pixels_shaded").get<double>());
+  const double ns = it.at("ns_per_lane_iteration").get<double>();
+  EXPECT_DOUBLE_EQ(ns, qdm.at("raster_shade_ms").at("median").get<double>() * 1e6 * 2 / executed);
+  EXPECT_NE(output.find("ns per executed lane-iteration"), std::string::npos) << output;
+  EXPECT_NE(output.find("iterations per pixel"), std::string::npos) << output;
+
+  // Normal mapping traces nothing: no cost per iteration, no trace line.
+  const nlohmann::json normal = bench(dir, "normal", output);
+  EXPECT_EQ(normal.at("iterations").at("mean").get<double>(), 0.0);
+  EXPECT_TRUE(normal.at("iterations").at("ns_per_lane_iteration").is_null());
+  EXPECT_EQ(output.find("lane-iteration"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace qdmr::test
