@@ -36,10 +36,15 @@ using simd::int_mask;
 
 DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
                                          const LightRig& lights)
-    : ShadingProgram(program_variant(material, select(trace_options(material)).options), inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
+    : DisplacementProgram(inputs, material, lights, select(trace_options(material))) {}
+
+DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
+                                         const LightRig& lights, const Variant& variant)
+    : ShadingProgram(program_variant(material, variant.options),
+                     inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      shade_(select(trace_options(material)).shade), shade_pair_(select(trace_options(material)).shade_pair), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
+      shade_(variant.shade), shade_pair_(variant.shade_pair), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
@@ -196,10 +201,15 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
     hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {
     const QdmBudget budget = qdm_budget(setup);
-    hit = trace::qdm<V>(surface, ray, ds, budget.stop_level, budget.cap, active);
-    hit.box_s = hit.s;
-    hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
+    hit = refine_qdm_hit(surface, setup, trace::qdm<V>(surface, ray, ds, budget.stop_level, budget.cap, active));
   }
+  return hit;
+}
+
+template <class Surface>
+DisplacementProgram::Hit DisplacementProgram::refine_qdm_hit(const Surface& surface, const Setup& setup, Hit hit) const {
+  hit.box_s = hit.s;
+  hit.s = trace::refine(surface, setup.ray, setup.ds, hit.s, hit.iterations, setup.active, technique_, surface_);
   return hit;
 }
 
@@ -401,13 +411,8 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
       Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
       Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
       trace::qdm_pair(walk_a, walk_b);
-      const auto refined = [&](const Setup& setup, Hit hit) {
-        hit.box_s = hit.s;
-        hit.s = trace::refine(surface, setup.ray, setup.ds, hit.s, hit.iterations, setup.active, technique_, surface_);
-        return hit;
-      };
-      shade_hit<V>(a, setup_a, surface, refined(setup_a, walk_a.hit()), setup_a.ds, out_a);
-      shade_hit<V>(b, setup_b, surface, refined(setup_b, walk_b.hit()), setup_b.ds, out_b);
+      shade_hit<V>(a, setup_a, surface, refine_qdm_hit(surface, setup_a, walk_a.hit()), setup_a.ds, out_a);
+      shade_hit<V>(b, setup_b, surface, refine_qdm_hit(surface, setup_b, walk_b.hit()), setup_b.ds, out_b);
       return;
     }
   }

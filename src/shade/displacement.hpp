@@ -68,6 +68,8 @@ private:
   static Variant select(const TraceOptions& options);
   template <class V>
   static Variant variant();
+  DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material, const LightRig& lights,
+                      const Variant& variant);
 
   SingleLayerSurface layer_surface(int i) const;
   Setup setup_for(const Fragments& in) const;
@@ -84,6 +86,9 @@ private:
   QdmBudget qdm_budget(const Setup& setup) const;
   template <class V, class Surface>
   Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
+  // A QDM walk's hit on the box surface, refined on the filtered one as the technique asks.
+  template <class Surface>
+  Hit refine_qdm_hit(const Surface& surface, const Setup& setup, Hit hit) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
                        const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
   template <class Surface>
