@@ -6,8 +6,9 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
-// Interpolated inputs of one batch. Every lane carries values, including helper lanes outside the triangle
-// (extrapolated, as on a GPU), so quad derivatives are defined; only `covered` lanes are written.
+// Interpolated inputs of one batch of whole quads; the quads may come from different triangles of one program
+// (no two of them write the same pixel). Every lane carries values, including helper lanes outside their quad's
+// triangle (extrapolated, as on a GPU), so quad derivatives are defined; only `covered` lanes are written.
 struct Fragments {
   simd::Float pixel_x, pixel_y;  // pixel centres
   simd::Float varyings[kVaryingCount];
@@ -33,7 +34,7 @@ class ShadingProgram : public Program {
 public:
   using Program::Program;
   virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
-  // Two batches of one triangle (no pixel in common) at once, with the same results as shade() of each. A
+  // Two batches that write no pixel in common, at once, with the same results as shade() of each. A
   // program whose loops wait on their own fetches interleaves the two and says so in pairs_batches(); the
   // rasterizer then hands it batches in pairs, except while the texture-cache recorder listens (it attributes
   // fetches to the batch in flight).

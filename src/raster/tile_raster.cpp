@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
+#include <type_traits>
 
 #include "program/batch.hpp"
 #include "qdmr/core/limits.hpp"
@@ -80,7 +82,8 @@ public:
     program_ = static_cast<const ShadingProgram*>(ctx_.programs[s.material]);
     for (int v = 0; v < 3; ++v) vertex_[v] = &ctx_.geometry->vertices[s.vertex[v]];
 
-    pair_batches_ = recorder_ == nullptr && program_->pairs_batches();
+    // Quads of different triangles share a batch only among triangles of one program.
+    if (packed_quads_ > 0 && slots_[packing_].program != program_) flush_packed();
     for (int by = r.y0 - r.y0 % kBlock; by <= r.y1; by += kBlock) {
       for (int bx = r.x0 - r.x0 % kBlock; bx <= r.x1; bx += kBlock) {
         const int kind = classify_block(s, bx, by);
@@ -95,39 +98,132 @@ public:
           for (int x = x_begin; x <= x_end; x += kBatchWidth) batch(x, y, kind == 2);
       }
     }
-    if (waiting_) {  // the triangle's last batch had no partner
-      waiting_ = false;
-      ShadeOutput out;
-      program_->shade(pending_[0].in, out);
-      finish(pending_[0], out);
-    }
+    if (waiting_ >= 0) shade_waiting();  // the triangle's last batch had no partner
+  }
+
+  // Shades what is still held back: call once after the tile's last triangle.
+  void flush() {
+    flush_packed();
+    if (waiting_ >= 0) shade_waiting();
   }
 
 private:
-  // A batch that passed the early depth test, with what its shading needs and what its writing needs.
+  // A batch that passed the early depth test, with what its shading needs and what its writing needs. Its quads
+  // may lie anywhere in the tile (a packed batch: quads of different triangles of one program).
   struct PendingBatch {
-    int x = 0, y = 0;
+    int quad_x[simd::kQuadsPerBatch] = {}, quad_y[simd::kQuadsPerBatch] = {};  // each quad's top-left pixel
     std::uint32_t pass = 0;  // lanes to write
     Float z;                 // the polygon's window depth
     alignas(64) float stored_depth[kLanes];
     Fragments in;
+    const ShadingProgram* program = nullptr;
   };
 
+  // The slot neither waiting for a partner, nor packing, nor `busy`.
+  int free_slot(int busy) const {
+    int slot = 0;
+    while (slot == waiting_ || slot == packing_ || slot == busy) ++slot;
+    return slot;
+  }
+
   void batch(int x, int y, bool full) {
-    PendingBatch& p = pending_[waiting_ ? 1 : 0];
-    if (!prepare(x, y, full, p)) return;
-    if (pair_batches_) {
-      // Batches of one triangle share no pixel, so the second one's early depth test may run before the first
-      // one's write.
-      if (!waiting_) {
-        waiting_ = true;
+    const int slot = free_slot(-1);
+    PendingBatch& p = slots_[slot];
+    if (!prepare(x, y, full, slot)) return;
+    if (packs_quads_ && live_quads(p.pass) < simd::kQuadsPerBatch) {
+      pack(slot);
+      return;
+    }
+    ready(slot);
+  }
+
+  static int live_quads(std::uint32_t pass) {
+    int n = 0;
+    for (int q = 0; q < simd::kQuadsPerBatch; ++q) n += ((pass >> (4 * q)) & 0xFu) != 0;
+    return n;
+  }
+
+  // Whether held-back batch p will write a pixel of the batch at (x, y) that has its lane in `inside`.
+  static bool writes_any_of(const PendingBatch& p, int x, int y, std::uint32_t inside) {
+    for (int k = 0; k < simd::kQuadsPerBatch; ++k) {
+      const std::uint32_t held = (p.pass >> (4 * k)) & 0xFu;
+      const int q = (p.quad_x[k] - x) / 2;
+      if (held != 0 && p.quad_y[k] == y && p.quad_x[k] >= x && q < simd::kQuadsPerBatch &&
+          (held & (inside >> (4 * q))) != 0)
+        return true;
+    }
+    return false;
+  }
+
+  // Moves the live quads of slots_[slot] into the packing batch, which is shaded whenever it is full.
+  void pack(int slot) {
+    const PendingBatch& from = slots_[slot];
+    for (int q = 0; q < simd::kQuadsPerBatch; ++q) {
+      if (((from.pass >> (4 * q)) & 0xFu) == 0) continue;
+      PendingBatch& to = slots_[packing_];
+      copy_quad(from, q, to, packed_quads_);
+      ++packed_quads_;
+      if (packed_quads_ == simd::kQuadsPerBatch) flush_packed(slot);
+    }
+  }
+
+  // Quad q of `from` becomes quad k of `to`: every lane value, its position and its lanes to write.
+  void copy_quad(const PendingBatch& from, int q, PendingBatch& to, int k) const {
+    // Four lanes' bytes at once: a round trip through an array (store, copy, load) stalls on store forwarding.
+    static_assert(sizeof(Float) == kLanes * sizeof(float) && std::is_trivially_copyable_v<Float>);
+    const auto lanes = [&](const Float& source, Float& target) {
+      std::memcpy(reinterpret_cast<char*>(&target) + 4 * k * sizeof(float),
+                  reinterpret_cast<const char*>(&source) + 4 * q * sizeof(float), 4 * sizeof(float));
+    };
+    lanes(from.in.pixel_x, to.in.pixel_x);
+    lanes(from.in.pixel_y, to.in.pixel_y);
+    for (int v = 0; v < from.program->varying_count(); ++v) lanes(from.in.varyings[v], to.in.varyings[v]);
+    lanes(from.in.view_depth, to.in.view_depth);
+    lanes(from.z, to.z);
+    std::copy(from.stored_depth + 4 * q, from.stored_depth + 4 * q + 4, to.stored_depth + 4 * k);
+    to.quad_x[k] = from.quad_x[q];
+    to.quad_y[k] = from.quad_y[q];
+    const std::uint32_t quad_mask = 0xFu << (4 * k);
+    to.pass = (to.pass & ~quad_mask) | (((from.pass >> (4 * q)) & 0xFu) << (4 * k));
+    to.program = from.program;
+  }
+
+  // Shades the packing batch, its empty quads filled with copies of its first quad (helper lanes, never
+  // written); `busy` is a slot the caller still reads.
+  void flush_packed(int busy = -1) {
+    if (packed_quads_ == 0) return;
+    PendingBatch& p = slots_[packing_];
+    for (int k = packed_quads_; k < simd::kQuadsPerBatch; ++k) {
+      const std::uint32_t pass = p.pass;
+      copy_quad(p, 0, p, k);
+      p.pass = pass & ~(0xFu << (4 * k));
+    }
+    p.in.covered = simd::from_bits(p.pass);
+    const int slot = packing_;
+    packed_quads_ = 0;
+    packing_ = -1;
+    ready(slot);
+    packing_ = free_slot(busy);
+    slots_[packing_].pass = 0;
+  }
+
+  // A batch ready to shade: now, or paired with the next one when the program interleaves two.
+  void ready(int slot) {
+    PendingBatch& p = slots_[slot];
+    if (recorder_ == nullptr && p.program->pairs_batches()) {
+      // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one
+      // of its pixels is tested), so the second one's early depth test may run before the first one's write.
+      if (waiting_ >= 0 && slots_[waiting_].program != p.program) shade_waiting();
+      if (waiting_ < 0) {
+        waiting_ = slot;
         return;
       }
-      waiting_ = false;
+      PendingBatch& first = slots_[waiting_];
+      waiting_ = -1;
       ShadeOutput out[2];
-      program_->shade_pair(pending_[0].in, out[0], pending_[1].in, out[1]);
-      finish(pending_[0], out[0]);
-      finish(pending_[1], out[1]);
+      p.program->shade_pair(first.in, out[0], p.in, out[1]);
+      finish(first, out[0]);
+      finish(p, out[1]);
       return;
     }
     ShadeOutput out;
@@ -138,20 +234,30 @@ private:
         if ((p.pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
       int lane_x[kLanes], lane_y[kLanes];
       for (int l = 0; l < kLanes; ++l) {
-        lane_x[l] = x + lane_dx(l);
-        lane_y[l] = y + lane_dy(l);
+        lane_x[l] = p.quad_x[l / 4] + l % 2;
+        lane_y[l] = p.quad_y[l / 4] + lane_dy(l);
       }
       recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
-      program_->shade(p.in, out);
+      p.program->shade(p.in, out);
       recorder_->end_batch();
     } else {
-      program_->shade(p.in, out);
+      p.program->shade(p.in, out);
     }
     finish(p, out);
   }
 
-  // Coverage, early depth test and interpolation of the batch at (x, y) into p; false when no lane passes.
-  bool prepare(int x, int y, bool full, PendingBatch& p) {
+  void shade_waiting() {
+    PendingBatch& p = slots_[waiting_];
+    waiting_ = -1;
+    ShadeOutput out;
+    p.program->shade(p.in, out);
+    finish(p, out);
+  }
+
+  // Coverage, early depth test and interpolation of the batch at (x, y) into slots_[slot]; false when no lane
+  // passes.
+  bool prepare(int x, int y, bool full, int slot) {
+    PendingBatch& p = slots_[slot];
     const TriangleSetup& s = *setup_;
     const std::int64_t X = pixel_centre_fixed(x), Y = pixel_centre_fixed(y);
     alignas(64) std::int64_t w[3][kLanes];
@@ -173,6 +279,10 @@ private:
       }
       if (inside == 0) return false;
     }
+    // A held-back batch that will write one of these pixels writes it before the early depth test reads it.
+    // Quads at the same place with no pixel in common (two triangles sharing a quad) stay held back together.
+    if (packed_quads_ > 0 && writes_any_of(slots_[packing_], x, y, inside)) flush_packed(slot);
+    if (waiting_ >= 0 && writes_any_of(slots_[waiting_], x, y, inside)) shade_waiting();
 
     alignas(64) float e[3][kLanes];
     float* stored_depth = p.stored_depth;
@@ -211,10 +321,13 @@ private:
                        b2 * Float(vertex_[2]->varyings[k]);
     in.view_depth = Float(float(s.area2)) * inv_sum;
     in.covered = simd::from_bits(pass);
-    p.x = x;
-    p.y = y;
+    for (int q = 0; q < simd::kQuadsPerBatch; ++q) {
+      p.quad_x[q] = x + 2 * q;
+      p.quad_y[q] = y;
+    }
     p.pass = pass;
     p.z = z;
+    p.program = program_;
     return true;
   }
 
@@ -225,28 +338,34 @@ private:
       counters_.pixels_depth_failed += std::popcount(p.pass) - std::popcount(late);
       if (late == 0) return;
       p.in.view_depth = out.view_depth;
-      write(p.x, p.y, late, out.depth, p.in, out);
+      write(p, late, out.depth, out);
       return;
     }
-    write(p.x, p.y, p.pass, p.z, p.in, out);
+    write(p, p.pass, p.z, out);
   }
 
-  void write(int x, int y, std::uint32_t pass, const Float& z, const Fragments& in, const ShadeOutput& out) {
+  // The framebuffer index of each lane's pixel.
+  void lane_pixels(const PendingBatch& p, std::size_t* index) const {
+    for (int l = 0; l < kLanes; ++l) index[l] = fb_.index(p.quad_x[l / 4] + l % 2, p.quad_y[l / 4] + lane_dy(l));
+  }
+
+  void write(const PendingBatch& p, std::uint32_t pass, const Float& z, const ShadeOutput& out) {
     alignas(64) float zs[kLanes], color[3][kLanes];
     z.store_aligned(zs);
     for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
-    const std::size_t origin = fb_.index(x, y);
+    std::size_t index[kLanes];
+    lane_pixels(p, index);
     for (int l = 0; l < kLanes; ++l) {
       if (!((pass >> l) & 1u)) continue;
-      const std::size_t i = origin + std::size_t(lane_dy(l) * fb_.width + lane_dx(l));
+      const std::size_t i = index[l];
       fb_.depth[i] = zs[l];
       for (int c = 0; c < 3; ++c) fb_.color[3 * i + c] = color[c][l];
     }
-    if (any_aov_) write_aovs(x, y, pass, in, out);
+    if (any_aov_) write_aovs(index, pass, p.in, out);
     count(pass, out);
   }
 
-  void write_aovs(int x, int y, std::uint32_t pass, const Fragments& in, const ShadeOutput& out) {
+  void write_aovs(const std::size_t* index, std::uint32_t pass, const Fragments& in, const ShadeOutput& out) {
     // AOVs: each requested plane gets its channels, in the order aov_channels() documents.
     const Float* sources[kAovCount][3] = {
         {&in.view_depth},
@@ -268,7 +387,7 @@ private:
       for (int c = 0; c < channels; ++c) sources[a][c]->store_aligned(values[c]);
       for (int l = 0; l < kLanes; ++l) {
         if (!((pass >> l) & 1u)) continue;
-        const std::size_t i = fb_.index(x + lane_dx(l), y + lane_dy(l));
+        const std::size_t i = index[l];
         for (int c = 0; c < channels; ++c) plane[std::size_t(channels) * i + std::size_t(c)] = values[c][l];
       }
     }
@@ -310,9 +429,16 @@ private:
   const ShadingProgram* program_ = nullptr;
   const ScreenVertex* vertex_[3] = {};
   FetchRecorder* recorder_;
-  bool pair_batches_ = false;  // the program shades batches in pairs (and no recorder listens)
-  bool waiting_ = false;       // pending_[0] waits for a partner
-  PendingBatch pending_[2];
+  // Batches with an empty quad give their live quads to a packing batch, shared by consecutive triangles of one
+  // program (only where a batch holds several quads; not while the recorder attributes fetches to triangles'
+  // batches as a GPU issues them).
+  const bool packs_quads_ = simd::kQuadsPerBatch > 1 && recorder_ == nullptr;
+  // Three slots: the batch being prepared, one waiting for a partner (-1: none), the packing batch with
+  // packed_quads_ quads so far.
+  PendingBatch slots_[3];
+  int waiting_ = -1;
+  int packing_ = 2;
+  int packed_quads_ = 0;
   bool any_aov_ = false;  // an AOV plane other than cache_misses (filled after the tile) is asked for
 };
 
@@ -326,6 +452,7 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   if (context.cache == nullptr) {
     TileRasterizer rasterizer(context, tile, counters, nullptr);
     bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+    rasterizer.flush();
     return;
   }
   // With the texture cache: record the tile's fetches, then replay them through the cache.
@@ -334,6 +461,7 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
     const FetchRecorder::Listening listening(recorder);
     TileRasterizer rasterizer(context, tile, counters, &recorder);
     bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+    rasterizer.flush();
   }
   TextureCache cache(*context.cache);
   CacheCounters cache_counters;

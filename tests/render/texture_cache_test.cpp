@@ -88,27 +88,41 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
   }
 }
 
-// Also what the batch pairing does: with the cache on, the rasterizer hands QDM one batch at a time; off, two
-// (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs, loop
-// statistics. objects_displaced has single-layer QDM (paired) beside POM and relief (not paired).
+// Also what the batch pairing and quad packing do: with the cache on, the rasterizer hands a program one batch at a
+// time, holding the quads of one triangle; off, it packs the quads of batches with an empty quad into shared
+// batches across triangles (where a batch holds several quads), and hands QDM two batches at a time
+// (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs, the loop
+// statistics per pixel; only the batch count may fall. objects_displaced has single-layer QDM (paired) beside POM
+// and relief (not paired) on meshes; terrain a 256x256 grid of small triangles under QDM over a 4-layer blend.
 TEST(TextureCache, LeavesTheImageAsItIs) {
-  const SceneDesc off = small_scene("objects_displaced");
-  const SceneDesc on = small_scene("objects_displaced", {{"/texture_cache/layout", "\"morton\""}});
-  ASSERT_TRUE(on.texture_cache.enabled);
-  RenderOptions options;
-  options.aovs = {Aov::Depth, Aov::Normal, Aov::Iterations, Aov::HitUV, Aov::HitDepth};
-  const Frame a = render_frame(off, options), b = render_frame(on, options);
-  EXPECT_TRUE(same_bits(a.color, b.color));
-  ASSERT_EQ(a.aovs.size(), b.aovs.size());
-  for (std::size_t i = 0; i < a.aovs.size(); ++i)
-    EXPECT_TRUE(same_bits(a.aovs[i].pixels, b.aovs[i].pixels)) << aov_name(a.aovs[i].aov);
-  EXPECT_GT(a.stats.iterations_mean, 0.0);
-  EXPECT_EQ(a.stats.iterations_mean, b.stats.iterations_mean);
-  EXPECT_EQ(a.stats.iterations_max, b.stats.iterations_max);
-  EXPECT_EQ(a.stats.lane_utilisation, b.stats.lane_utilisation);
-  EXPECT_EQ(a.stats.batches, b.stats.batches);
-  EXPECT_EQ(a.stats.pixels_shaded, b.stats.pixels_shaded);
-  EXPECT_EQ(a.stats.pixels_depth_failed, b.stats.pixels_depth_failed);
+  for (const char* name : {"objects_displaced", "terrain"}) {
+    for (Isa isa : usable_isas()) {
+      SCOPED_TRACE(std::string(name) + ", " + std::string(isa_name(isa)));
+      const SceneDesc off = small_scene(name);
+      const SceneDesc on = small_scene(name, {{"/texture_cache/layout", "\"morton\""}});
+      ASSERT_TRUE(on.texture_cache.enabled);
+      RenderOptions options;
+      options.isa = isa;
+      options.aovs = {Aov::Depth, Aov::Normal, Aov::Iterations, Aov::HitUV, Aov::HitDepth};
+      const Frame a = render_frame(off, options), b = render_frame(on, options);
+      EXPECT_TRUE(same_bits(a.color, b.color));
+      ASSERT_EQ(a.aovs.size(), b.aovs.size());
+      for (std::size_t i = 0; i < a.aovs.size(); ++i)
+        EXPECT_TRUE(same_bits(a.aovs[i].pixels, b.aovs[i].pixels)) << aov_name(a.aovs[i].aov);
+      EXPECT_GT(a.stats.iterations_mean, 0.0);
+      EXPECT_EQ(a.stats.iterations_mean, b.stats.iterations_mean);
+      EXPECT_EQ(a.stats.iterations_max, b.stats.iterations_max);
+      EXPECT_EQ(a.stats.quads, b.stats.quads);
+      EXPECT_EQ(a.stats.pixels_shaded, b.stats.pixels_shaded);
+      EXPECT_EQ(a.stats.pixels_depth_failed, b.stats.pixels_depth_failed);
+      if (isa == Isa::Sse42) {  // one quad per batch: nothing to pack
+        EXPECT_EQ(a.stats.batches, b.stats.batches);
+      } else {
+        EXPECT_LT(a.stats.batches, b.stats.batches);
+        EXPECT_GT(a.stats.lane_utilisation, b.stats.lane_utilisation);
+      }
+    }
+  }
 }
 
 TEST(TextureCache, LayoutsChangeTheMissesNotTheReads) {
