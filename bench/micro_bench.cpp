@@ -73,13 +73,22 @@ void report(benchmark::State& state, const Workload& w, int threads) {
   state.counters["threads"] = threads;
 }
 
+GeometryResult geometry_of(const Workload& w, tbb::task_arena& arena) {
+  GeometryScratch scratch;
+  GeometryResult geometry;
+  arena.execute([&] { run_geometry(w.draws, w.view, w.projection, w.viewport, scratch, geometry); });
+  return geometry;
+}
+
 void BM_Geometry(benchmark::State& state, int which) {
   const Workload& w = workload(which);
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
+  GeometryScratch scratch;  // kept between iterations, as the renderer keeps it between frames
+  GeometryResult geometry;
   for (auto _ : state) {
     arena.execute([&] {
-      GeometryResult geometry = run_geometry(w.draws, w.view, w.projection, w.viewport);
+      run_geometry(w.draws, w.view, w.projection, w.viewport, scratch, geometry);
       benchmark::DoNotOptimize(geometry.triangles.data());
     });
   }
@@ -92,12 +101,13 @@ void BM_SetupBinning(benchmark::State& state, int which) {
   const Workload& w = workload(which);
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
-  const GeometryResult geometry = arena.execute([&] { return run_geometry(w.draws, w.view, w.projection, w.viewport); });
+  const GeometryResult geometry = geometry_of(w, arena);
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
+  TileBins bins;
   for (auto _ : state) {
     arena.execute([&] {
       const TriangleSetups setups = setup_all(geometry, w.viewport);
-      TileBins bins = bin_triangles(setups, grid);
+      bin_triangles(setups, grid, bins);
       benchmark::DoNotOptimize(bins.bins.data());
     });
   }
@@ -110,10 +120,11 @@ void BM_RasterShade(benchmark::State& state, int which) {
   const Workload& w = workload(which);
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
-  const GeometryResult geometry = arena.execute([&] { return run_geometry(w.draws, w.view, w.projection, w.viewport); });
+  const GeometryResult geometry = geometry_of(w, arena);
   const TriangleSetups setups = arena.execute([&] { return setup_all(geometry, w.viewport); });
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
-  const TileBins bins = bin_triangles(setups, grid);
+  TileBins bins;
+  bin_triangles(setups, grid, bins);
   const std::size_t pixels = std::size_t(w.viewport.width) * std::size_t(w.viewport.height);
   std::uint64_t shaded = 0;
   for (auto _ : state) {

@@ -173,9 +173,20 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
   return programs;
 }
 
+std::uint64_t DrawScratch::bytes() const {
+  const auto capacity = [](const auto& v) { return std::uint64_t(v.capacity()) * sizeof(v[0]); };
+  const ItemVertices& item = geometry_scratch.item;
+  std::uint64_t total = capacity(item.clip) + capacity(item.frustum_code) + capacity(item.band_code) +
+                        capacity(item.projected) + capacity(geometry.vertices) + capacity(geometry.triangles) +
+                        capacity(setups);
+  for (const auto& chunk : bins.bins)
+    for (const auto& tile : chunk) total += capacity(tile);
+  return total;
+}
+
 void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
-          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, const DrawOptions& options,
-          RenderStats& stats) {
+          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, DrawScratch& scratch,
+          const DrawOptions& options, RenderStats& stats) {
   const SceneDesc& scene = plan.scene;
   auto start = Clock::now();
   const Viewport viewport{plan.width, plan.height};
@@ -188,7 +199,8 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   }
   const glm::mat4 view = LightRig::view_matrix(scene.camera);
   const glm::mat4 projection = LightRig::projection_matrix(scene.camera, scene.output);
-  const GeometryResult geometry = run_geometry(items, view, projection, viewport);
+  run_geometry(items, view, projection, viewport, scratch.geometry_scratch, scratch.geometry);
+  const GeometryResult& geometry = scratch.geometry;
   stats.geometry_ms = ms_since(start);
   stats.triangles_in = geometry.counters.triangles_in;
   stats.triangles_culled = geometry.counters.culled_backface + geometry.counters.culled_outside;
@@ -196,13 +208,15 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   stats.triangles_rasterized = geometry.counters.triangles_out;
 
   start = Clock::now();
-  TriangleSetups setups(geometry.triangles.size());
+  TriangleSetups& setups = scratch.setups;
+  setups.resize(geometry.triangles.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i)
       setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
   });
   const TileGrid grid(viewport.width, viewport.height, options.tile_size);
-  const TileBins bins = bin_triangles(setups, grid);
+  TileBins& bins = scratch.bins;
+  bin_triangles(setups, grid, bins);
   stats.binning_ms = ms_since(start);
   stats.tiles = std::uint64_t(grid.count());
   stats.tile_size = options.tile_size;

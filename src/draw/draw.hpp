@@ -9,7 +9,10 @@
 #include "draw/kernel.hpp"
 #include "prepare/assets.hpp"
 #include "qdmr/core/stats.hpp"
+#include "raster/binner.hpp"
 #include "raster/framebuffer.hpp"
+#include "raster/geometry.hpp"
+#include "raster/triangle_setup.hpp"
 
 namespace qdmr {
 
@@ -22,10 +25,23 @@ struct DrawOptions {
 // One program per plan material, made by `kernel` from the prepared assets.
 std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel);
 
+// The per-triangle arrays of a frame (screen vertices and triangles, setups, tile bins). Kept between draws (of
+// one scene or the next), their pages are reused: a frame of a million triangles otherwise faults in ~270 MB of
+// fresh pages.
+struct DrawScratch {
+  GeometryScratch geometry_scratch;
+  GeometryResult geometry;
+  TriangleSetups setups;
+  TileBins bins;
+
+  std::uint64_t bytes() const;  // the arrays' capacity
+};
+
 // Draws into `fb` (sized and its background set here; its memory is kept when large enough) and fills the draw
-// part of `stats` (timings, counters, the reference summary). Runs in the caller's task arena.
+// part of `stats` (timings, counters, the reference summary), with `scratch`'s arrays. Runs in the caller's task
+// arena.
 void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
-          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, const DrawOptions& options,
-          RenderStats& stats);
+          const std::vector<std::unique_ptr<Program>>& programs, Framebuffer& fb, DrawScratch& scratch,
+          const DrawOptions& options, RenderStats& stats);
 
 }  // namespace qdmr

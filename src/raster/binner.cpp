@@ -6,13 +6,13 @@
 
 namespace qdmr {
 
-TileBins bin_triangles(const TriangleSetups& setups, const TileGrid& grid) {
-  TileBins result;
+void bin_triangles(const TriangleSetups& setups, const TileGrid& grid, TileBins& result) {
   const std::size_t chunks = (setups.size() + TileBins::kTrianglesPerChunk - 1) / TileBins::kTrianglesPerChunk;
   result.bins.resize(chunks);
   tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
     auto& bins = result.bins[c];
     bins.resize(std::size_t(grid.count()));
+    for (auto& tile : bins) tile.clear();
     const std::size_t end = std::min(setups.size(), (c + 1) * TileBins::kTrianglesPerChunk);
     for (std::size_t i = c * TileBins::kTrianglesPerChunk; i < end; ++i) {
       const PixelRect& b = setups[i].bounds;
@@ -23,7 +23,6 @@ TileBins bin_triangles(const TriangleSetups& setups, const TileGrid& grid) {
         for (int tx = tx0; tx <= tx1; ++tx) bins[std::size_t(ty * grid.tiles_x + tx)].push_back(std::uint32_t(i));
     }
   });
-  return result;
 }
 
 }  // namespace qdmr

@@ -38,6 +38,8 @@ struct TileBins {
   }
 };
 
-TileBins bin_triangles(const TriangleSetups& setups, const TileGrid& grid);
+// Replaces the lists of `bins`; their memory is kept, so a caller that keeps `bins` between frames allocates
+// nothing in a warm frame.
+void bin_triangles(const TriangleSetups& setups, const TileGrid& grid, TileBins& bins);
 
 }  // namespace qdmr

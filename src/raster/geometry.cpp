@@ -65,11 +65,6 @@ unsigned outcode(const glm::vec4& c, float gx, float gy) {
   return code;
 }
 
-struct Projected {
-  ScreenVertex vertex;
-  std::int32_t x = 0, y = 0;  // fixed point
-};
-
 class Projection {
 public:
   Projection(const Viewport& viewport) : viewport_(viewport) {
@@ -90,12 +85,12 @@ public:
   float gy() const { return gy_; }
   const std::array<ClipPlane, 6>& planes() const { return planes_; }
 
-  Projected project(const ClipVertex& v) const {
+  ProjectedVertex project(const ClipVertex& v) const {
     const double inv_w = 1.0 / double(v.clip.w);
     const double ndc_x = v.clip.x * inv_w, ndc_y = v.clip.y * inv_w, ndc_z = v.clip.z * inv_w;
     const double sx = (ndc_x * 0.5 + 0.5) * viewport_.width;
     const double sy = (0.5 - ndc_y * 0.5) * viewport_.height;
-    Projected p;
+    ProjectedVertex p;
     p.vertex.inv_w = float(inv_w);
     p.vertex.z = float(ndc_z * 0.5 + 0.5);
     p.vertex.varyings = v.varyings;
@@ -110,20 +105,13 @@ private:
   std::array<ClipPlane, 6> planes_;
 };
 
-// The vertices of one draw item after the vertex stage.
-struct ItemVertices {
-  UninitVector<ClipVertex> clip;
-  UninitVector<unsigned> frustum_code, band_code;
-  UninitVector<Projected> projected;  // valid where band_code == 0
-};
-
-ItemVertices transform_vertices(const DrawItem& item, const glm::mat4& view_projection, const Projection& projection) {
+void transform_vertices(const DrawItem& item, const glm::mat4& view_projection, const Projection& projection,
+                        ItemVertices& out) {
   const MeshData& mesh = *item.mesh;
   const glm::mat3 linear(item.model);
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
   const bool mirrored = glm::determinant(linear) < 0.0f;
   const std::size_t n = mesh.vertex_count();
-  ItemVertices out;
   out.clip.resize(n);
   out.frustum_code.resize(n);
   out.band_code.resize(n);
@@ -144,7 +132,6 @@ ItemVertices transform_vertices(const DrawItem& item, const glm::mat4& view_proj
       if (out.band_code[i] == 0) out.projected[i] = projection.project(v);
     }
   });
-  return out;
 }
 
 // The triangles of one chunk, with the vertices its clipping made (numbered kLocalVertex | k).
@@ -172,7 +159,7 @@ public:
       return;
     }
     if ((vertices_.band_code[idx[0]] | vertices_.band_code[idx[1]] | vertices_.band_code[idx[2]]) == 0) {
-      const Projected* p[3] = {&vertices_.projected[idx[0]], &vertices_.projected[idx[1]], &vertices_.projected[idx[2]]};
+      const ProjectedVertex* p[3] = {&vertices_.projected[idx[0]], &vertices_.projected[idx[1]], &vertices_.projected[idx[2]]};
       emit({vertex_base_ + idx[0], vertex_base_ + idx[1], vertex_base_ + idx[2]}, {p[0]->x, p[1]->x, p[2]->x},
            {p[0]->y, p[1]->y, p[2]->y}, material);
       return;
@@ -192,7 +179,7 @@ public:
       ++chunk_.counters.culled_outside;
       return;
     }
-    Projected projected[kMaxPolygon];
+    ProjectedVertex projected[kMaxPolygon];
     std::uint32_t local[kMaxPolygon];
     for (int k = 0; k < count; ++k) {
       projected[k] = projection_.project(in[k]);
@@ -235,16 +222,19 @@ private:
 
 }  // namespace
 
-GeometryResult run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, const glm::mat4& projection_matrix,
-                            const Viewport& viewport) {
+void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, const glm::mat4& projection_matrix,
+                  const Viewport& viewport, GeometryScratch& scratch, GeometryResult& result) {
   const glm::mat4 view_projection = projection_matrix * view;
   const Projection projection(viewport);
-  GeometryResult result;
+  result.vertices.clear();
+  result.triangles.clear();
+  result.counters = GeometryCounters{};
 
   // Vertices of every item first (their global indices are fixed), then each chunk's clipped vertices.
   std::vector<Chunk> chunks;
   for (const DrawItem& item : items) {
-    const ItemVertices vertices = transform_vertices(item, view_projection, projection);
+    ItemVertices& vertices = scratch.item;
+    transform_vertices(item, view_projection, projection, vertices);
     const std::uint32_t base = std::uint32_t(result.vertices.size());
     result.vertices.resize(result.vertices.size() + vertices.projected.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.projected.size(), 8192), [&](const auto& range) {
@@ -285,7 +275,6 @@ GeometryResult run_geometry(const std::vector<DrawItem>& items, const glm::mat4&
       result.triangles[triangle_offset[c] + i] = t;
     }
   });
-  return result;
 }
 
 }  // namespace qdmr

@@ -79,13 +79,15 @@ struct Renderer::State {
   Assets assets;
   std::vector<std::unique_ptr<Program>> programs;
   Framebuffer fb;
+  DrawScratch scratch;  // the per-triangle arrays, kept between draws of one scene
   Frame frame;
   double pending_plan_ms = 0, pending_prepare_ms = 0;
   std::uint64_t pending_built = 0, pending_reused = 0;
 
-  // The memory of the framebuffer's planes, those lent to the last frame included.
+  // The memory of the framebuffer's planes, those lent to the last frame included, and of the draw's arrays.
   std::uint64_t frame_bytes() const {
-    std::uint64_t bytes = capacity_bytes(fb.color) + capacity_bytes(fb.depth) + capacity_bytes(frame.color);
+    std::uint64_t bytes = capacity_bytes(fb.color) + capacity_bytes(fb.depth) + capacity_bytes(frame.color) +
+                          scratch.bytes();
     for (const PixelBuffer& plane : fb.aov) bytes += capacity_bytes(plane);
     for (const AovImage& a : frame.aovs) bytes += capacity_bytes(a.pixels);
     return bytes;
@@ -139,6 +141,7 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
     s.assets = Assets{};
     s.plan.reset();
     s.fb = Framebuffer{};
+    s.scratch = DrawScratch{};
     s.frame = Frame{};
   }
   start = Clock::now();
@@ -182,7 +185,7 @@ const Frame& Renderer::draw() {
     const auto& report = s.options.progress;
     options.progress = [&report](double fraction) { report("raster", fraction); };
   }
-  s.arena.execute([&] { qdmr::draw(plan, s.assets, *s.kernel, s.programs, s.fb, options, stats); });
+  s.arena.execute([&] { qdmr::draw(plan, s.assets, *s.kernel, s.programs, s.fb, s.scratch, options, stats); });
   if (s.options.progress) s.options.progress("raster", 1.0);
 
   frame.width = s.fb.width;

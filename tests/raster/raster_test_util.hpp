@@ -74,7 +74,8 @@ struct ScreenScene {
     TriangleSetups setups;
     for (const ScreenTriangle& t : geometry.triangles) setups.push_back(setup_triangle(t, geometry, viewport));
     const TileGrid grid(width, height, tile_size);
-    const TileBins bins = bin_triangles(setups, grid);
+    TileBins bins;
+    bin_triangles(setups, grid, bins);
     Framebuffer fb;
     fb.width = width;
     fb.height = height;
