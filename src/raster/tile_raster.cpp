@@ -177,7 +177,8 @@ private:
     };
     lanes(from.in.pixel_x, to.in.pixel_x);
     lanes(from.in.pixel_y, to.in.pixel_y);
-    for (int v = 0; v < from.program->varying_count(); ++v) lanes(from.in.varyings[v], to.in.varyings[v]);
+    const int varyings = from.program->varying_count();  // read once: the copies might alias it
+    for (int v = 0; v < varyings; ++v) lanes(from.in.varyings[v], to.in.varyings[v]);
     lanes(from.in.view_depth, to.in.view_depth);
     lanes(from.z, to.z);
     std::copy(from.stored_depth + 4 * q, from.stored_depth + 4 * q + 4, to.stored_depth + 4 * k);
