@@ -179,6 +179,8 @@ std::uint64_t DrawScratch::bytes() const {
   std::uint64_t total = capacity(item.clip) + capacity(item.frustum_code) + capacity(item.band_code) +
                         capacity(item.projected) + capacity(geometry.vertices) + capacity(geometry.triangles) +
                         capacity(setups);
+  for (const GeometryChunk& chunk : geometry_scratch.chunks)
+    total += capacity(chunk.triangles) + capacity(chunk.clipped_vertices);
   for (const auto& chunk : bins.bins)
     for (const auto& tile : chunk) total += capacity(tile);
   return total;

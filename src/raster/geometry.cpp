@@ -134,17 +134,10 @@ void transform_vertices(const DrawItem& item, const glm::mat4& view_projection, 
   });
 }
 
-// The triangles of one chunk, with the vertices its clipping made (numbered kLocalVertex | k).
-struct Chunk {
-  std::vector<ScreenTriangle> triangles;
-  std::vector<ScreenVertex> clipped_vertices;
-  GeometryCounters counters;
-};
-
 class ChunkAssembler {
 public:
   ChunkAssembler(const DrawItem& item, const ItemVertices& vertices, const Projection& projection,
-                 std::uint32_t vertex_base, Chunk& chunk)
+                 std::uint32_t vertex_base, GeometryChunk& chunk)
       : item_(item), vertices_(vertices), projection_(projection), vertex_base_(vertex_base), chunk_(chunk),
         mirrored_(glm::determinant(glm::mat3(item.model)) < 0.0f) {}
 
@@ -216,7 +209,7 @@ private:
   const ItemVertices& vertices_;
   const Projection& projection_;
   std::uint32_t vertex_base_;
-  Chunk& chunk_;
+  GeometryChunk& chunk_;
   bool mirrored_;
 };
 
@@ -231,7 +224,8 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
   result.counters = GeometryCounters{};
 
   // Vertices of every item first (their global indices are fixed), then each chunk's clipped vertices.
-  std::vector<Chunk> chunks;
+  std::vector<GeometryChunk>& chunks = scratch.chunks;  // the first `used` are this frame's
+  std::size_t used = 0;
   for (const DrawItem& item : items) {
     ItemVertices& vertices = scratch.item;
     transform_vertices(item, view_projection, projection, vertices);
@@ -241,10 +235,15 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
       for (std::size_t i = range.begin(); i != range.end(); ++i) result.vertices[base + i] = vertices.projected[i].vertex;
     });
     const std::size_t triangles = item.mesh->triangle_count();
-    const std::size_t first_chunk = chunks.size();
-    chunks.resize(first_chunk + (triangles + kTrianglesPerChunk - 1) / kTrianglesPerChunk);
-    tbb::parallel_for(first_chunk, chunks.size(), [&](std::size_t c) {
-      ChunkAssembler assembler(item, vertices, projection, base, chunks[c]);
+    const std::size_t first_chunk = used;
+    used += (triangles + kTrianglesPerChunk - 1) / kTrianglesPerChunk;
+    if (chunks.size() < used) chunks.resize(used);
+    tbb::parallel_for(first_chunk, used, [&](std::size_t c) {
+      GeometryChunk& chunk = chunks[c];
+      chunk.triangles.clear();
+      chunk.clipped_vertices.clear();
+      chunk.counters = GeometryCounters{};
+      ChunkAssembler assembler(item, vertices, projection, base, chunk);
       const std::size_t begin = (c - first_chunk) * kTrianglesPerChunk;
       const std::size_t end = std::min(triangles, begin + kTrianglesPerChunk);
       for (std::size_t t = begin; t < end; ++t) assembler.triangle(t);
@@ -252,8 +251,8 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
   }
 
   // Merge the chunks in order: prefix sums, then parallel copies with local vertex numbers made global.
-  std::vector<std::size_t> triangle_offset(chunks.size() + 1, 0), vertex_offset(chunks.size() + 1, result.vertices.size());
-  for (std::size_t c = 0; c < chunks.size(); ++c) {
+  std::vector<std::size_t> triangle_offset(used + 1, 0), vertex_offset(used + 1, result.vertices.size());
+  for (std::size_t c = 0; c < used; ++c) {
     triangle_offset[c + 1] = triangle_offset[c] + chunks[c].triangles.size();
     vertex_offset[c + 1] = vertex_offset[c] + chunks[c].clipped_vertices.size();
     const GeometryCounters& k = chunks[c].counters;
@@ -265,8 +264,8 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
   }
   result.vertices.resize(vertex_offset.back());
   result.triangles.resize(triangle_offset.back());
-  tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
-    const Chunk& chunk = chunks[c];
+  tbb::parallel_for(std::size_t(0), used, [&](std::size_t c) {
+    const GeometryChunk& chunk = chunks[c];
     std::copy(chunk.clipped_vertices.begin(), chunk.clipped_vertices.end(), result.vertices.begin() + std::ptrdiff_t(vertex_offset[c]));
     for (std::size_t i = 0; i < chunk.triangles.size(); ++i) {
       ScreenTriangle t = chunk.triangles[i];

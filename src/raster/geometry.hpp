@@ -72,10 +72,18 @@ struct ItemVertices {
   UninitVector<ProjectedVertex> projected;  // valid where band_code == 0
 };
 
+// The triangles of one chunk of an item (assembled in parallel), with the vertices its clipping made.
+struct GeometryChunk {
+  std::vector<ScreenTriangle> triangles;
+  std::vector<ScreenVertex> clipped_vertices;  // numbered with a local bit until the chunks are merged
+  GeometryCounters counters;
+};
+
 // The stage's working arrays. A caller that keeps them (and the result) between frames lets a warm frame reuse
 // their pages instead of faulting in fresh ones: about 100 MB a frame for a million triangles.
 struct GeometryScratch {
   ItemVertices item;
+  std::vector<GeometryChunk> chunks;
 };
 
 struct Viewport {
