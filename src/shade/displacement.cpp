@@ -182,8 +182,12 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
   const Ray& ray = setup.ray;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
+  // Relief and POM loops without the texture-cache recorder's tests when none listens: their calls made the
+  // compiler keep the loop's vector values in memory.
+  const bool recorded = fetch_recorder_listens();
   if constexpr (V::technique == TechniqueKind::Relief) {
-    hit = trace::relief(surface, ray, ds, setup.height_lod, active, technique_);
+    hit = recorded ? trace::relief<true>(surface, ray, ds, setup.height_lod, active, technique_)
+                   : trace::relief<false>(surface, ray, ds, setup.height_lod, active, technique_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Pom) {
     const Float& lod = setup.height_lod;
@@ -192,7 +196,8 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
         xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
         Float(1.0f));
     ds = ds * (Float(1.0f) - fade);
-    hit = trace::pom(surface, ray, ds, lod, setup.view_tangent.z, active, technique_);
+    hit = recorded ? trace::pom<true>(surface, ray, ds, lod, setup.view_tangent.z, active, technique_)
+                   : trace::pom<false>(surface, ray, ds, lod, setup.view_tangent.z, active, technique_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
     const trace::ConeTexels texels{cones_, &layers_[0].height->height, sampler_.address, sampler_.fetch};

@@ -68,14 +68,15 @@ public:
   HeightFetch fetch() const { return textures_->fetch; }
 
   // The filtered surface: the nearest or bilinear level-0 texel (the surfaces the exact reference knows), or
-  // trilinear with `lod` (the talk's POM), which smooths heights with distance.
+  // trilinear with `lod` (the talk's POM), which smooths heights with distance. Recorded false: as for cell_max.
+  template <bool Recorded = true>
   [[gnu::always_inline]] simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const {
     const TextureSampler& t = textures_->height;
     switch (textures_->inline_height) {
       case InlineHeight::BilinearR16:
-        return sampling_code::sample_first<inline_height_key(TexelFormat::R16)>(t.view(), t.state(), u, v, lod);
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R16), Recorded>(t.view(), t.state(), u, v, lod);
       case InlineHeight::BilinearR8:
-        return sampling_code::sample_first<inline_height_key(TexelFormat::R8)>(t.view(), t.state(), u, v, lod);
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R8), Recorded>(t.view(), t.state(), u, v, lod);
       case InlineHeight::None: break;
     }
     simd::Float h[4];

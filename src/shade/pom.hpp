@@ -6,8 +6,8 @@
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
 // Parallax occlusion mapping (Tatarchuk 2006): step count lerped by the view angle, then the intersection of
-// the ray with the line through the last two height samples.
-template <class Surface>
+// the ray with the line through the last two height samples. Recorded false: no texture-cache recorder listens.
+template <bool Recorded, class Surface>
 Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
                                                  const Float& lod, const Float& cos_view, Mask active,
         const TechniqueDesc& technique) {
@@ -17,11 +17,11 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
                                Float(0.5f));
   const Float step = ds / n;
   Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
-  FetchLanes lanes(FetchPhase::Trace);
+  LoopLanes<Recorded> lanes(FetchPhase::Trace);
   lanes.narrow(active);
   // gap = surface depth - ray depth: > 0 while the ray is above the surface.
   {
-    const Float gap0 = ds * (Float(1.0f) - surface.height(ray.u0, ray.v0, lod));
+    const Float gap0 = ds * (Float(1.0f) - surface_height<Recorded>(surface, ray.u0, ray.v0, lod));
     iterations += count(active);
     const Mask at_top = active & (gap0 <= Float(0.0f));
     s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
@@ -33,7 +33,7 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
     const Mask in_range = active & (fi <= n);
     lanes.narrow(in_range);
     const Float s = step * fi;
-    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
+    const Float gap = ds * (Float(1.0f) - surface_height<Recorded>(surface, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
     iterations += count(in_range);
     const Mask found = in_range & (gap <= Float(0.0f));
     const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0

@@ -1,5 +1,7 @@
 #pragma once
 // What every technique shares: the view ray, the hit it reports, and texel arithmetic along the ray.
+#include <type_traits>
+
 #include "core/simd.hpp"
 #include "qdmr/core/sampling.hpp"
 #include "shade/traversal.hpp"
@@ -27,6 +29,21 @@ struct Hit {
   Float iterations;  // loop iterations per lane
   Float box_s;       // qdm, csm, rcsm: the hit on the level-0 box surface, before refinement; else s
 };
+
+// A loop's fetch lanes: FetchLanes, or nothing where the caller knows no texture-cache recorder listens.
+template <bool Recorded>
+using LoopLanes = std::conditional_t<Recorded, FetchLanes, UnrecordedLanes>;
+
+// surface.height(u, v, lod); with Recorded false, without the texture-cache recorder's test where the surface
+// offers that (its inline fetches): the caller knows none listens.
+template <bool Recorded, class Surface>
+[[gnu::always_inline]] inline Float surface_height(const Surface& surface, const Float& u, const Float& v,
+                                                   const Float& lod) {
+  if constexpr (requires { surface.template height<Recorded>(u, v, lod); })
+    return surface.template height<Recorded>(u, v, lod);
+  else
+    return surface.height(u, v, lod);
+}
 
 // Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
 inline Float texel_step(const Ray& ray, float width, float height) {

@@ -8,6 +8,9 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
+// Whether a texture-cache recorder listens on this thread (a program may then pick loops that never ask).
+inline bool fetch_recorder_listens() { return t_fetch_recorder != nullptr; }
+
 // Reports texel (x, y) of the level starting at byte `level_offset` of `texture`, per lane, to the recorder.
 inline void trace_fetch(const Texture& texture, const simd::Int& level_offset, const simd::Int& x, const simd::Int& y) {
   FetchRecorder* recorder = t_fetch_recorder;

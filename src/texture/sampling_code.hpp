@@ -116,11 +116,13 @@ QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, con
 // fetch() of texels (xa, y) and (xb, y) = (xa + 1, y), adjacent in memory, from one load per lane: 4 bytes for
 // texels of 1 or 2 bytes, 8 bytes for texels of 4.
 QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& xa,
-                            const Int& xb, const Int& y, Float* a, Float* b) {
+                            const Int& xb, const Int& y, Float* a, Float* b, bool record = true) {
   const Texture& t = view.texture();
   const int bytes = bytes_per_texel(k.format);
-  trace_fetch(t, level.offset, xa, y);
-  trace_fetch(t, level.offset, xb, y);
+  if (record) {
+    trace_fetch(t, level.offset, xa, y);
+    trace_fetch(t, level.offset, xb, y);
+  }
   if (decoded_one_channel(k, t)) {
     Int first, second;
     simd::load_bytes8(reinterpret_cast<const std::uint8_t*>(t.linear.data()),
@@ -144,10 +146,13 @@ QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k
 
 // fetch_pair() of an RGBA8 sRGB texture from its decoded copy (Texture::linear): whole texels, no table lookups.
 QDMR_SAMPLER_INLINE void fetch_linear_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level,
-                                           const Int& xa, const Int& xb, const Int& y, Float* a, Float* b) {
+                                           const Int& xa, const Int& xb, const Int& y, Float* a, Float* b,
+                                           bool record = true) {
   const Texture& t = view.texture();
-  trace_fetch(t, level.offset, xa, y);
-  trace_fetch(t, level.offset, xb, y);
+  if (record) {
+    trace_fetch(t, level.offset, xa, y);
+    trace_fetch(t, level.offset, xb, y);
+  }
   simd::load_f32x4_pair(t.linear.data(), level.offset + (y * level.width + xa) * Int(4), k.fetch, a, b);
 }
 
@@ -196,7 +201,7 @@ QDMR_SAMPLER_INLINE void split(const Float& u, const Float& n, bool n_power_of_t
 }
 
 QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
-                              const LevelInfo& info, bool linear, Float* out) {
+                              const LevelInfo& info, bool linear, Float* out, bool record = true) {
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
   const bool pow2 = view.power_of_two();
   if (!linear) {
@@ -204,7 +209,7 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
     Float unused;
     split(u, w, pow2, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
     split(v, h, pow2, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
-    fetch(view, k, info, address(x, info.width, k.address), address(y, info.height, k.address), out);
+    fetch(view, k, info, address(x, info.width, k.address), address(y, info.height, k.address), out, record);
     return;
   }
   Int x0, y0;
@@ -218,17 +223,17 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   // clamp edge) one load per row gives both texels.
   if (xsimd::all(xb == xa + Int(1))) {
     if (k.format == TexelFormat::RGBA8 && k.srgb && !view.texture().linear.empty()) {
-      fetch_linear_pair(view, k, info, xa, xb, ya, t00, t10);
-      fetch_linear_pair(view, k, info, xa, xb, yb, t01, t11);
+      fetch_linear_pair(view, k, info, xa, xb, ya, t00, t10, record);
+      fetch_linear_pair(view, k, info, xa, xb, yb, t01, t11, record);
     } else {
-      fetch_pair(view, k, info, xa, xb, ya, t00, t10);
-      fetch_pair(view, k, info, xa, xb, yb, t01, t11);
+      fetch_pair(view, k, info, xa, xb, ya, t00, t10, record);
+      fetch_pair(view, k, info, xa, xb, yb, t01, t11, record);
     }
   } else {
-    fetch(view, k, info, xa, ya, t00);
-    fetch(view, k, info, xb, ya, t10);
-    fetch(view, k, info, xa, yb, t01);
-    fetch(view, k, info, xb, yb, t11);
+    fetch(view, k, info, xa, ya, t00, record);
+    fetch(view, k, info, xb, ya, t10, record);
+    fetch(view, k, info, xa, yb, t01, record);
+    fetch(view, k, info, xb, yb, t11, record);
   }
   for (int c = 0; c < channel_count(k.format); ++c) {
     const Float top = t00[c] + (t10[c] - t00[c]) * wx;
@@ -237,15 +242,16 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   }
 }
 
+// record false: the caller knows no texture-cache recorder listens (see fetch()).
 QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const SamplerState& s, const Float& u,
-                             const Float& v, const Float& lod, Float* out) {
+                             const Float& v, const Float& lod, Float* out, bool record = true) {
   const Mask finite = is_finite(u) & is_finite(v);
   const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), k.address);
   const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), k.address);
   const bool linear = k.filter == Filter::Bilinear || k.filter == Filter::Trilinear || k.filter == Filter::LinearMipPoint;
   const int channels = channel_count(k.format);
   if (k.filter == Filter::Point || k.filter == Filter::Bilinear) {
-    sample_level(view, k, ru, rv, level_zero(view), linear, out);
+    sample_level(view, k, ru, rv, level_zero(view), linear, out, record);
   } else {
     const Float last(float(view.levels() - 1));
     Float l = lod + Float(s.lod_bias);
@@ -255,14 +261,15 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
     const int bits = k.fraction_bits;
     if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
     if (k.filter == Filter::PointMipPoint || k.filter == Filter::LinearMipPoint) {
-      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f)))), linear, out);
+      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f)))), linear, out,
+                   record);
     } else {  // trilinear, point-mip-linear
       const Float l0 = xsimd::floor(l), f = l - l0;
       const Int i0 = xsimd::to_int(l0);
       Float fine[4], coarse[4];
-      sample_level(view, k, ru, rv, level_info(view, i0), linear, fine);
+      sample_level(view, k, ru, rv, level_info(view, i0), linear, fine, record);
       sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear,
-                   coarse);
+                   coarse, record);
       for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
     }
   }
@@ -284,11 +291,11 @@ QDMR_SAMPLER_INLINE void load_with(const SamplerKey& k, bool wrap, const Texture
 }
 
 // Channel 0 of sample_with() for a key fixed at compile time, inlined into the caller's loop.
-template <SamplerKey K>
+template <SamplerKey K, bool Recorded = true>
 QDMR_SAMPLER_INLINE Float sample_first(const TextureView& view, const SamplerState& s, const Float& u, const Float& v,
                                        const Float& lod) {
   Float out[4];
-  sample_with(K, view, s, u, v, lod, out);
+  sample_with(K, view, s, u, v, lod, out, Recorded);
   return out[0];
 }
 
