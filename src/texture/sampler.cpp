@@ -24,10 +24,12 @@ constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
-template <SamplerKey K>
+// Recorded false: for callers that know no texture-cache recorder listens (without its tests, the compiler need
+// not keep the fetches' vector values in memory around the calls they guard).
+template <SamplerKey K, bool Recorded>
 void sample_fixed(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Float& lod,
                   Float* out) {
-  sample_with(K, view, s, u, v, lod, out);
+  sample_with(K, view, s, u, v, lod, out, Recorded);
 }
 
 template <SamplerKey K, bool Wrap>
@@ -65,12 +67,12 @@ constexpr SamplerKey common_key(std::size_t i) {
 
 struct SampleEntry {
   SamplerKey key;
-  SampleFunction function;
+  SampleFunction recorded, unrecorded;
 };
 
 template <std::size_t... I>
 constexpr std::array<SampleEntry, sizeof...(I)> common_samplers(std::index_sequence<I...>) {
-  return {{{common_key(I), &sample_fixed<common_key(I)>}...}};
+  return {{{common_key(I), &sample_fixed<common_key(I), true>, &sample_fixed<common_key(I), false>}...}};
 }
 constexpr std::array<SampleEntry, kCommonKeys> kCommonSamplers = common_samplers(std::make_index_sequence<kCommonKeys>());
 
@@ -160,16 +162,17 @@ void load(const TextureView& view, const Int& level, const Int& x, const Int& y,
   load_with(load_key(view.texture().format, view.texture().srgb, path), false, view, level, x, y, out);
 }
 
-SampleFunction sample_function(const SamplerKey& key) {
+SampleFunction sample_function(const SamplerKey& key, bool recorded) {
   for (const SampleEntry& e : kCommonSamplers)
-    if (e.key == key) return e.function;
+    if (e.key == key) return recorded ? e.recorded : e.unrecorded;
   return &sample;
 }
 
 bool is_specialised(const SamplerKey& key) { return sample_function(key) != &sample; }
 
 TextureSampler::TextureSampler(const Texture& texture, const SamplerState& state)
-    : view_(texture), state_(state), sample_(sample_function(sampler_key(view_, state_))) {
+    : view_(texture), state_(state), sample_(sample_function(sampler_key(view_, state_))),
+      sample_unrecorded_(sample_function(sampler_key(view_, state_), false)) {
   const LoadEntry* e = loader_for(view_, state_.fetch);
   load_ = e ? e->clamped : static_cast<LoadFunction>(&qdmr::QDMR_ISA::load);
   load_wrapped_ = e ? e->wrapped : &load_generic_wrapped;

@@ -95,8 +95,9 @@ using LoadFunction = void (*)(const TextureView&, const simd::Int& level, const 
                               simd::FetchPath fetch, simd::Float* out);
 
 // The sampling code for a key: an instantiation where sampler.cpp lists the key as common (docs/architecture.md,
-// "Specialised samplers"), the generic sampler otherwise. Both give the same bits.
-SampleFunction sample_function(const SamplerKey& key);
+// "Specialised samplers"), the generic sampler otherwise. Both give the same bits. recorded false: an
+// instantiation without the texture-cache recorder's tests, for when none listens.
+SampleFunction sample_function(const SamplerKey& key, bool recorded = true);
 bool is_specialised(const SamplerKey& key);
 
 // A texture bound to the sampler state a material fixes for it, with sampling and loading specialised for both:
@@ -112,7 +113,7 @@ public:
   SamplerKey key() const { return sampler_key(view_, state_); }
 
   void sample(const simd::Float& u, const simd::Float& v, const simd::Float& lod, simd::Float* out) const {
-    sample_(view_, state_, u, v, lod, out);
+    (fetch_recorder_listens() ? sample_ : sample_unrecorded_)(view_, state_, u, v, lod, out);
   }
   simd::Float lod(const simd::Float& dudx, const simd::Float& dvdx, const simd::Float& dudy, const simd::Float& dvdy) const {
     return lod_from_derivatives(view_, dudx, dvdx, dudy, dvdy);
@@ -133,7 +134,7 @@ public:
 private:
   TextureView view_;
   SamplerState state_;
-  SampleFunction sample_;
+  SampleFunction sample_, sample_unrecorded_;
   LoadFunction load_, load_wrapped_;
 };
 
