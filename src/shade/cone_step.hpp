@@ -4,23 +4,37 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/scene/scene.hpp"
+#include "shade/height_surface.hpp"
 #include "shade/trace_ray.hpp"
 #include "texture/sampler.hpp"
+#include "texture/sampling_code.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 
 // The level-0 texels cone stepping reads: a height and a cone ratio each, addressed like the height map.
+// The height is read inline for 8- and 16-bit height maps (a call per step would keep the loop's vector values
+// in memory); Recorded false: no texture-cache recorder listens.
 struct ConeTexels {
   const ConeMap* cones;
   const TextureSampler* height;
   AddressMode address;
   simd::FetchPath fetch;
+  InlineMaxChain inline_load = inline_load_for(height->key());
 
-  void at(const Int& x, const Int& y, Float& h, Float& ratio) const {
+  template <bool Recorded>
+  [[gnu::always_inline]] void at(const Int& x, const Int& y, Float& h, Float& ratio) const {
     const Int ax = address_texel(x, cones->width, address);
     const Int ay = address_texel(y, cones->height, address);
     Float texel[4];
-    height->load(Int(0), ax, ay, texel);
+    // The clamped load, as height->load() does (ax and ay are in range already).
+    if (inline_load == InlineMaxChain::R16)
+      sampling_code::load_with(inline_height_key(TexelFormat::R16), false, height->view(), Int(0), ax, ay, texel,
+                               Recorded);
+    else if (inline_load == InlineMaxChain::R8)
+      sampling_code::load_with(inline_height_key(TexelFormat::R8), false, height->view(), Int(0), ax, ay, texel,
+                               Recorded);
+    else
+      height->load(Int(0), ax, ay, texel);
     h = texel[0];
     ratio = simd::load_f32(cones->ratio.data(), ay * Int(cones->width) + ax, fetch);
   }
@@ -35,7 +49,7 @@ struct ConeTexels {
 // Conservative cones never let a step pass through the surface: the first texel top the ray is at or below is
 // the hit. Relaxed cones let a step enter the surface at most once and not leave it before the step's end: a
 // step that ends below the surface brackets the first hit, found by binary search on the box surface.
-template <bool relaxed>
+template <bool relaxed, bool Recorded>
 Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask active, const TechniqueDesc& technique) {
   const float width = float(texels.cones->width), height = float(texels.cones->height);
   const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
@@ -50,11 +64,11 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
   Mask search = zero != zero;  // rcsm: the last step entered the surface
   Float iterations;
   {  // the loop's fetch lanes end with it (the search below starts from all of them)
-    CappedLoop loop(Int(technique.max_iterations), FetchPhase::Trace);
+    CappedLoop<Recorded> loop(Int(technique.max_iterations), FetchPhase::Trace);
     while (loop.next(active)) {
 
       Float hp, r;
-      texels.at(cx, cy, hp, r);
+      texels.at<Recorded>(cx, cy, hp, r);
       const Float top = ds * (Float(1.0f) - hp);
       // At or below the top of the texel the ray is over: the hit (conservative, and any ray starting on or in
       // the surface), or a relaxed step that went in.
@@ -102,12 +116,12 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
   if constexpr (relaxed) {
     // The first hit lies in (s_prev, s]: below the surface is false before it and true after it up to s.
     Float lo = s_prev, hi = s;
-    FetchLanes lanes(FetchPhase::Refine);
+    LoopLanes<Recorded> lanes(FetchPhase::Refine);
     for (int i = 0; i < technique.binary_steps && xsimd::any(search); ++i) {
       lanes.narrow(search);
       const Float mid = (lo + hi) * Float(0.5f);
       Float h, unused;
-      texels.at(texel_ahead(x0 + dx * mid, zero), texel_ahead(y0 + dy * mid, zero), h, unused);
+      texels.at<Recorded>(texel_ahead(x0 + dx * mid, zero), texel_ahead(y0 + dy * mid, zero), h, unused);
       const Mask below = mid >= ds * (Float(1.0f) - h);
       iterations += count(search);
       hi = xsimd::select(search & below, mid, hi);

@@ -182,8 +182,8 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
   const Ray& ray = setup.ray;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
-  // Relief and POM loops without the texture-cache recorder's tests when none listens: their calls made the
-  // compiler keep the loop's vector values in memory.
+  // Relief, POM and cone-step loops without the texture-cache recorder's tests when none listens: their calls
+  // made the compiler keep the loop's vector values in memory.
   const bool recorded = fetch_recorder_listens();
   if constexpr (V::technique == TechniqueKind::Relief) {
     hit = recorded ? trace::relief<true>(surface, ray, ds, setup.height_lod, active, technique_)
@@ -201,7 +201,9 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
     const trace::ConeTexels texels{cones_, &layers_[0].height->height, sampler_.address, sampler_.fetch};
-    hit = trace::cone_step<V::technique == TechniqueKind::Rcsm>(texels, ray, ds, active, technique_);
+    constexpr bool relaxed = V::technique == TechniqueKind::Rcsm;
+    hit = recorded ? trace::cone_step<relaxed, true>(texels, ray, ds, active, technique_)
+                   : trace::cone_step<relaxed, false>(texels, ray, ds, active, technique_);
     hit.box_s = hit.s;
     hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {

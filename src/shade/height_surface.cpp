@@ -31,13 +31,6 @@ HeightLayerTextures::HeightLayerTextures(const Texture& height_texture, const Te
       inline_height(height.key() == inline_height_key(TexelFormat::R16)  ? InlineHeight::BilinearR16
                     : height.key() == inline_height_key(TexelFormat::R8) ? InlineHeight::BilinearR8
                                                                          : InlineHeight::None),
-      inline_max_chain(InlineMaxChain::None) {
-  // A texel load reads only the key's format, sRGB flag and fetch path.
-  const SamplerKey k = tree.key();
-  for (const auto& [format, chain] :
-       {std::pair{TexelFormat::R16, InlineMaxChain::R16}, std::pair{TexelFormat::R8, InlineMaxChain::R8}})
-    if (k.format == format && k.srgb == inline_height_key(format).srgb && k.fetch == inline_height_key(format).fetch)
-      inline_max_chain = chain;
-}
+      inline_max_chain(inline_load_for(tree.key())) {}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -37,6 +37,15 @@ constexpr SamplerKey inline_height_key(TexelFormat format) {
 // (max chains of 8- and 16-bit heights) fetched as inline_height_key's are; any other chain calls its sampler.
 enum class InlineMaxChain : std::uint8_t { None, R8, R16 };
 
+// Which inline texel load gives the bits of a sampler with key k's load() (it reads only the format, the sRGB
+// flag and the fetch path): also used for cone stepping's height reads.
+inline InlineMaxChain inline_load_for(const SamplerKey& k) {
+  for (const TexelFormat format : {TexelFormat::R16, TexelFormat::R8})
+    if (k.format == format && k.srgb == inline_height_key(format).srgb && k.fetch == inline_height_key(format).fetch)
+      return format == TexelFormat::R16 ? InlineMaxChain::R16 : InlineMaxChain::R8;
+  return InlineMaxChain::None;
+}
+
 // The textures of one height layer, bound once per program to the samplers its material fixes.
 struct HeightLayerTextures {
   // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material needs

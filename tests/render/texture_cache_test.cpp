@@ -92,14 +92,27 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // time, holding the quads of one triangle; off, it packs the quads of batches with an empty quad into shared
 // batches across triangles (where a batch holds several quads), and hands QDM two batches at a time
 // (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs, the loop
-// statistics per pixel; only the batch count may fall. objects_displaced has single-layer QDM (paired) beside POM
-// and relief (not paired) on meshes; terrain a 256x256 grid of small triangles under QDM over a 4-layer blend.
+// statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
+// when none listens. objects_displaced has single-layer QDM (paired) beside POM and relief (not paired) on meshes,
+// and again with CSM and RCSM for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
+// a 4-layer blend.
 TEST(TextureCache, LeavesTheImageAsItIs) {
-  for (const char* name : {"objects_displaced", "terrain"}) {
+  struct Case {
+    const char* scene;
+    std::vector<SceneOverride> overrides;
+  };
+  const Case cases[] = {{"objects_displaced", {}},
+                        {"objects_displaced",
+                         {{"/materials/floor/technique/name", "\"csm\""}, {"/materials/stone_box/technique/name", "\"rcsm\""}}},
+                        {"terrain", {}}};
+  for (const Case& c : cases) {
+    const char* name = c.scene;
     for (Isa isa : usable_isas()) {
-      SCOPED_TRACE(std::string(name) + ", " + std::string(isa_name(isa)));
-      const SceneDesc off = small_scene(name);
-      const SceneDesc on = small_scene(name, {{"/texture_cache/layout", "\"morton\""}});
+      SCOPED_TRACE(std::string(name) + (c.overrides.empty() ? "" : " with cones") + ", " + std::string(isa_name(isa)));
+      const SceneDesc off = small_scene(name, c.overrides);
+      auto cache_overrides = c.overrides;
+      cache_overrides.push_back({"/texture_cache/layout", "\"morton\""});
+      const SceneDesc on = small_scene(name, cache_overrides);
       ASSERT_TRUE(on.texture_cache.enabled);
       RenderOptions options;
       options.isa = isa;
