@@ -418,7 +418,7 @@ private:
     counters_.iterations_executed += std::uint64_t(longest) * kLanes;
     ++counters_.batches_shaded;
     counters_.pixels_shaded += std::popcount(pass);
-    for (int q = 0; q < simd::kQuadsPerBatch; ++q) counters_.quads_shaded += ((pass >> (4 * q)) & 0xFu) != 0;
+    counters_.quads_shaded += std::uint64_t(live_quads(pass));
   }
 
   const RasterContext& ctx_;
