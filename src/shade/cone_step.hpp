@@ -27,13 +27,7 @@ struct ConeTexels {
     const Int ay = address_texel(y, cones->height, address);
     Float texel[4];
     // The clamped load, as height->load() does (ax and ay are in range already).
-    if (inline_load == InlineMaxChain::R16)
-      sampling_code::load_with(inline_height_key(TexelFormat::R16), false, height->view(), Int(0), ax, ay, texel,
-                               Recorded);
-    else if (inline_load == InlineMaxChain::R8)
-      sampling_code::load_with(inline_height_key(TexelFormat::R8), false, height->view(), Int(0), ax, ay, texel,
-                               Recorded);
-    else
+    if (!load_inline<Recorded>(inline_load, false, height->view(), Int(0), ax, ay, texel))
       height->load(Int(0), ax, ay, texel);
     h = texel[0];
     ratio = simd::load_f32(cones->ratio.data(), ay * Int(cones->width) + ax, fetch);

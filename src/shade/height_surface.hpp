@@ -46,6 +46,21 @@ inline InlineMaxChain inline_load_for(const SamplerKey& k) {
   return InlineMaxChain::None;
 }
 
+// Texel (x, y) of `level` loaded inline as a sampler with inline_height_key(R16 or R8) loads it (wrap: indices
+// wrap, else they are clamped); false, with nothing loaded, for InlineMaxChain::None (the caller then calls its
+// sampler). Recorded false: no texture-cache recorder listens (sampling_code::fetch).
+template <bool Recorded>
+[[gnu::always_inline]] inline bool load_inline(InlineMaxChain chain, bool wrap, const TextureView& view,
+                                               const simd::Int& level, const simd::Int& x, const simd::Int& y,
+                                               simd::Float* texel) {
+  if (chain == InlineMaxChain::None) return false;
+  if (chain == InlineMaxChain::R16)
+    sampling_code::load_with(inline_height_key(TexelFormat::R16), wrap, view, level, x, y, texel, Recorded);
+  else
+    sampling_code::load_with(inline_height_key(TexelFormat::R8), wrap, view, level, x, y, texel, Recorded);
+  return true;
+}
+
 // The textures of one height layer, bound once per program to the samplers its material fixes.
 struct HeightLayerTextures {
   // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material needs
@@ -99,16 +114,8 @@ public:
   [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
     const TextureSampler& t = textures_->tree;
     simd::Float texel[4];
-    switch (textures_->inline_max_chain) {
-      case InlineMaxChain::R16:
-        sampling_code::load_with(inline_height_key(TexelFormat::R16), true, t.view(), level, cx, cy, texel, Recorded);
-        return texel[0];
-      case InlineMaxChain::R8:
-        sampling_code::load_with(inline_height_key(TexelFormat::R8), true, t.view(), level, cx, cy, texel, Recorded);
-        return texel[0];
-      case InlineMaxChain::None: break;
-    }
-    t.load_wrapped(level, cx, cy, texel);
+    if (!load_inline<Recorded>(textures_->inline_max_chain, true, t.view(), level, cx, cy, texel))
+      t.load_wrapped(level, cx, cy, texel);
     return texel[0];
   }
 
