@@ -13,7 +13,7 @@ QDM at depth scales 0.1 and 0.3 (issue #12's table).
 The load average is printed before and after.
 
     bench/llvmpipe_compare.py [-B BUILD_DIR] [--qdmr QDMR] [--rounds 5] [--frames 5] [--warmup 2]
-                              [--threads 2] [--check-only | --timing-only] [--keep DIR]
+                              [--threads 2] [--isa auto] [--check-only | --timing-only] [--keep DIR]
 
 Needs: qdmr and llvmpipe_bench built (cmake --build build/release --target qdmr_cli llvmpipe_bench), and a
 python3 with numpy and OpenImageIO's module (Debian's python3-openimageio: run it with the system python3).
@@ -49,6 +49,7 @@ def arguments():
     p.add_argument("--frames", type=int, default=5, help="timed frames per run, both renderers")
     p.add_argument("--warmup", type=int, default=2, help="qdmr bench's untimed frames (llvmpipe: always one)")
     p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--isa", default="auto", help="qdmr's kernel (qdmr bench --isa): auto, avx512, avx2, sse4.2")
     p.add_argument("--width", type=int, default=1920)
     p.add_argument("--height", type=int, default=1080)
     p.add_argument("--check-width", type=int, default=480)
@@ -166,7 +167,7 @@ def time_qdmr(qdmr, technique, depth, args, tmp):
     out = os.path.join(tmp, "qdmr_bench.json")
     result = run_json([qdmr, "bench", SCENE, "--frames", str(args.frames), "--warmup", str(args.warmup),
                        "--threads", str(args.threads), "--width", str(args.width), "--height", str(args.height),
-                       "--json", out] + technique_sets(technique, depth), json_file=out)
+                       "--isa", args.isa, "--json", out] + technique_sets(technique, depth), json_file=out)
     return result["draw_ms"]["median"], result
 
 
