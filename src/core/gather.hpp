@@ -49,12 +49,55 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   return Int::load_aligned(value);
 }
 
+#if defined(__AVX512F__)
+// The AVX-512 halves of load_bytes8 and load_f32x4_pair (functions, not lambdas: GCC outlined the lambdas).
+// 128-bit segment j of the result: the 8 bytes at base + o[lane + 4j], then those at base + o[lane + 4j + 1].
+[[gnu::always_inline]] inline __m128i avx512_pair(const std::uint8_t* base, const std::int32_t* o, int a) {
+  return _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[a])),
+                            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[a + 1])));
+}
+[[gnu::always_inline]] inline __m512 avx512_pairs(const std::uint8_t* base, const std::int32_t* o, int lane) {
+  __m512i v = _mm512_castsi128_si512(avx512_pair(base, o, lane));  // insert positions are immediates, even at -O0
+  v = _mm512_inserti32x4(v, avx512_pair(base, o, lane + 4), 1);
+  v = _mm512_inserti32x4(v, avx512_pair(base, o, lane + 8), 2);
+  return _mm512_castsi512_ps(_mm512_inserti32x4(v, avx512_pair(base, o, lane + 12), 3));
+}
+
+// Floats at..at+3 of each lane's texel (base + o[lane]), one vector per float: per 128-bit segment j, a 4x4
+// transpose of the texels of lanes 4j..4j+3.
+[[gnu::always_inline]] inline void avx512_transpose(const float* base, const std::int32_t* o, int at, Float* out) {
+  __m512 r[4];
+  for (int lane = 0; lane < 4; ++lane) {  // segment j of r[lane]: the texel of lane + 4j (immediate positions)
+    r[lane] = _mm512_castps128_ps512(_mm_loadu_ps(base + o[lane] + at));
+    r[lane] = _mm512_insertf32x4(r[lane], _mm_loadu_ps(base + o[lane + 4] + at), 1);
+    r[lane] = _mm512_insertf32x4(r[lane], _mm_loadu_ps(base + o[lane + 8] + at), 2);
+    r[lane] = _mm512_insertf32x4(r[lane], _mm_loadu_ps(base + o[lane + 12] + at), 3);
+  }
+  const __m512 t0 = _mm512_unpacklo_ps(r[0], r[1]), t1 = _mm512_unpackhi_ps(r[0], r[1]);
+  const __m512 t2 = _mm512_unpacklo_ps(r[2], r[3]), t3 = _mm512_unpackhi_ps(r[2], r[3]);
+  out[0] = Float(_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+  out[1] = Float(_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+  out[2] = Float(_mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+  out[3] = Float(_mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+}
+#endif
+
 // 8 bytes at base + byte_offset[lane] (unaligned): bytes 0-3 as `first`, bytes 4-7 as `second` (two adjacent
-// 4-byte texels from one load). AVX2 builds them from 64-bit loads by hand: measured on this project's machines, a
-// pair costs what one 8-lane vpgatherdd of single texels does, where two 4-lane vpgatherdq take 1.2-1.4x that.
+// 4-byte texels from one load). AVX2 and AVX-512 build them from 64-bit loads by hand: measured on this project's
+// machines, a pair costs what one 8-lane vpgatherdd of single texels does, where two 4-lane vpgatherdq take
+// 1.2-1.4x that.
 [[gnu::always_inline]] inline void load_bytes8(const std::uint8_t* base, const Int& byte_offset, FetchPath path,
                                                Int& first, Int& second) {
-#if defined(__AVX2__) && !defined(__AVX512F__)
+#if defined(__AVX512F__)
+  if (path == FetchPath::Gather) {
+    alignas(64) std::int32_t o[kLanes];
+    byte_offset.store_aligned(o);
+    const __m512 x = avx512_pairs(base, o, 0), y = avx512_pairs(base, o, 2);
+    first = Int(_mm512_castps_si512(_mm512_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0))));
+    second = Int(_mm512_castps_si512(_mm512_shuffle_ps(x, y, _MM_SHUFFLE(3, 1, 3, 1))));
+    return;
+  }
+#elif defined(__AVX2__)
   if (path == FetchPath::Gather) {
     alignas(32) std::int32_t o[kLanes];
     byte_offset.store_aligned(o);
@@ -81,10 +124,18 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
 }
 
 // Two texels of 4 floats at base + index[lane] (unaligned): floats 0-3 into first[0..3], floats 4-7 into
-// second[0..3], one vector per float. AVX2 transposes them from 128-bit loads.
+// second[0..3], one vector per float. AVX2 and AVX-512 transpose them from 128-bit loads (4x4 per 128-bit segment).
 [[gnu::always_inline]] inline void load_f32x4_pair(const float* base, const Int& index, FetchPath path, Float* first,
                                                    Float* second) {
-#if defined(__AVX2__) && !defined(__AVX512F__)
+#if defined(__AVX512F__)
+  if (path == FetchPath::Gather) {
+    alignas(64) std::int32_t o[kLanes];
+    index.store_aligned(o);
+    avx512_transpose(base, o, 0, first);
+    avx512_transpose(base, o, 4, second);
+    return;
+  }
+#elif defined(__AVX2__)
   if (path == FetchPath::Gather) {
     alignas(32) std::int32_t o[kLanes];
     index.store_aligned(o);
