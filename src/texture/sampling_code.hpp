@@ -242,6 +242,15 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   }
 }
 
+// Whether a mip-linear sample may skip its coarse level: no lane weighs it (f, the LOD's fraction, is 0 in every
+// lane: magnified, or at a whole LOD), and fine + (coarse - fine) * 0 is fine's bits. That holds for the unorm
+// formats, whose filtered texels are finite and never -0; an R32F texel may be infinite or NaN (then the product
+// is NaN) or -0 (then -0 + 0 is +0). A listening texture-cache recorder still sees both levels' fetches (its
+// statistics do not depend on this shortcut).
+QDMR_SAMPLER_INLINE bool coarse_level_weightless(const SamplerKey& k, const Float& f, bool record) {
+  return k.format != TexelFormat::R32F && (!record || !fetch_recorder_listens()) && xsimd::all(f == Float(0.0f));
+}
+
 // record false: the caller knows no texture-cache recorder listens (see fetch()).
 QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const SamplerState& s, const Float& u,
                              const Float& v, const Float& lod, Float* out, bool record = true) {
@@ -268,9 +277,13 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
       const Int i0 = xsimd::to_int(l0);
       Float fine[4], coarse[4];
       sample_level(view, k, ru, rv, level_info(view, i0), linear, fine, record);
-      sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear,
-                   coarse, record);
-      for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
+      if (coarse_level_weightless(k, f, record)) {
+        for (int c = 0; c < channels; ++c) out[c] = fine[c];
+      } else {
+        sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear,
+                     coarse, record);
+        for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
+      }
     }
   }
   for (int c = 0; c < channels; ++c) out[c] = xsimd::select(finite, out[c], Float(view.first_texel()[std::size_t(c)]));

@@ -268,6 +268,62 @@ TEST(TextureSampler, GatherAndPortableFetchGiveTheSameBits) {
   }
 }
 
+// Where no lane weighs a mip-linear sample's coarse level (every lane's LOD fraction 0: magnified, at a whole LOD,
+// or past the last level), the sampler skips that level for the unorm formats (sampling_code.hpp,
+// coarse_level_weightless). The skip must keep the bits: each batch is sampled once with every lane at such a LOD
+// and once more with lane 0 alone at a fractional LOD, which makes the batch fetch both levels; lanes 1.. must agree.
+// Every format (R32F never skips, and holds -0, infinities and NaN here), sRGB with and without the decoded copy,
+// every address mode, exact and 8-bit precision.
+TEST(TextureSampler, SkippingAWeightlessCoarseLevelKeepsTheBits) {
+  if (kLanes < 2) GTEST_SKIP() << "needs a second lane";
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-1.5f, 2.5f);
+  struct Case {
+    TexelFormat format;
+    bool srgb, decoded_copy;
+  };
+  const Case cases[] = {{TexelFormat::R8, false, false},   {TexelFormat::RG8, false, false},
+                        {TexelFormat::RGBA8, false, false}, {TexelFormat::RGBA8, true, false},
+                        {TexelFormat::RGBA8, true, true},   {TexelFormat::R16, false, false},
+                        {TexelFormat::R32F, false, false}};
+  const float whole_lods[] = {-3.0f, -0.25f, 0.0f, 1.0f, 2.0f, 5.0f, 40.0f};  // 40: past the last level (5)
+  for (const Case& c : cases) {
+    Image img(32, 32, channel_count(c.format));
+    for (float& t : img.texels) t = unit(rng);
+    if (c.format == TexelFormat::R32F) {  // values a skipped level could not reproduce if R32F skipped
+      img.texels[5] = -0.0f;
+      img.texels[40] = std::numeric_limits<float>::infinity();
+      img.texels[77] = std::numeric_limits<float>::quiet_NaN();
+    }
+    Texture texture = make_mip_texture(img, c.format, c.srgb, MipReduce::Box);
+    if (c.decoded_copy) add_linear_copy(texture);
+    const TextureView view(texture);
+    for (const Filter filter : {Filter::Trilinear, Filter::PointMipLinear})
+      for (const AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
+        for (const SamplePrecision precision : {SamplePrecision::Exact, SamplePrecision::Hw8})
+          for (int round = 0; round < 40; ++round) {
+            Lanes u, v, lod;
+            for (int i = 0; i < kLanes; ++i) {
+              u[i] = coord(rng);
+              v[i] = coord(rng);
+              lod[i] = whole_lods[std::size_t(round + i) % std::size(whole_lods)];
+            }
+            const SamplerState state = state_of(filter, address, 0.0f, precision);
+            Float skipped[4], both[4];
+            sample(view, state, load(u), load(v), load(lod), skipped);
+            lod[0] = 0.5f;
+            sample(view, state, load(u), load(v), load(lod), both);
+            for (int ch = 0; ch < texture.channels(); ++ch) {
+              const Lanes a = lanes(skipped[ch]), b = lanes(both[ch]);
+              for (int i = 1; i < kLanes; ++i)
+                ASSERT_EQ(bits(a[std::size_t(i)]), bits(b[std::size_t(i)]))
+                    << "format " << int(c.format) << " srgb " << c.srgb << " copy " << c.decoded_copy << " filter "
+                    << int(filter) << " lane " << i << " lod " << lod[std::size_t(i)];
+            }
+          }
+  }
+}
+
 // Bilinear taps come two per load where a row's pair is adjacent in memory (sampling_code.hpp, fetch_pair: 4 bytes
 // for texels of 1 or 2 bytes, 8 for texels of 4); they must give the bits of fp32 textures holding the same decoded
 // values, one per channel, which are fetched one texel at a time: at random points, with lanes at the wrap and
