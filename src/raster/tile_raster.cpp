@@ -5,6 +5,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "core/quad_rows.hpp"
 #include "program/batch.hpp"
 #include "qdmr/core/limits.hpp"
 #include "texture/fetch_recorder.hpp"
@@ -22,6 +23,7 @@ static_assert(kBlock % kBatchWidth == 0, "coarse blocks hold whole batches in ev
 // Lane layout: quad q covers pixels (2q, 0) .. (2q+1, 1) of the batch, lanes 0 1 / 2 3 inside the quad.
 constexpr int lane_dx(int lane) { return (lane / 4) * 2 + (lane % 2); }
 constexpr int lane_dy(int lane) { return (lane % 4) / 2; }
+constexpr std::uint32_t kAllLanes = (1u << kLanes) - 1u;  // kLanes <= 16
 
 struct EdgeSteps {
   std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
@@ -67,6 +69,13 @@ public:
   TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters, FetchRecorder* recorder)
       : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters), recorder_(recorder) {
     for (int a = 0; a < kAovCount; ++a) any_aov_ |= !fb_.aov[std::size_t(a)].empty() && Aov(a) != Aov::CacheMisses;
+    alignas(64) float cx[kLanes], cy[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      cx[l] = float(lane_dx(l)) + 0.5f;
+      cy[l] = float(lane_dy(l)) + 0.5f;
+    }
+    lane_centre_x_ = Float::load_aligned(cx);
+    lane_centre_y_ = Float::load_aligned(cy);
   }
 
   void triangle(const TriangleSetup& s) {
@@ -113,6 +122,7 @@ private:
   struct PendingBatch {
     int quad_x[simd::kQuadsPerBatch] = {}, quad_y[simd::kQuadsPerBatch] = {};  // each quad's top-left pixel
     std::uint32_t pass = 0;  // lanes to write
+    bool side_by_side = false;  // quad k at (quad_x[0] + 2k, quad_y[0]), as prepare() makes them (not packed)
     Float z;                 // the polygon's window depth
     alignas(64) float stored_depth[kLanes];
     Fragments in;
@@ -200,6 +210,7 @@ private:
       p.pass = pass & ~(0xFu << (4 * k));
     }
     p.in.covered = simd::from_bits(p.pass);
+    p.side_by_side = false;
     const int slot = packing_;
     packed_quads_ = 0;
     packing_ = -1;
@@ -270,7 +281,7 @@ private:
     const bool whole = x + kBatchWidth - 1 <= tile_.x1 && y + 1 <= tile_.y1;
     std::uint32_t inside = 0;
     if (full && whole) {
-      inside = (1u << kLanes) - 1u;
+      inside = kAllLanes;
     } else {
       for (int l = 0; l < kLanes; ++l) {
         const int px = x + lane_dx(l), py = y + lane_dy(l);
@@ -286,20 +297,22 @@ private:
     if (waiting_ >= 0 && writes_any_of(slots_[waiting_], x, y, inside)) shade_waiting();
 
     alignas(64) float e[3][kLanes];
-    float* stored_depth = p.stored_depth;
     for (int i = 0; i < 3; ++i)
       for (int l = 0; l < kLanes; ++l) e[i][l] = edge_to_float(w[i][l]);
+    Float stored;
     if (whole) {
       // Lanes outside the triangle read their pixel's depth too: harmless, every test below is masked by inside.
       const float* row = fb_.depth.data() + fb_.index(x, y);
-      for (int l = 0; l < kLanes; ++l) stored_depth[l] = row[lane_dy(l) * fb_.width + lane_dx(l)];
+      stored = simd::load_quad_rows(row, row + fb_.width);
+      stored.store_aligned(p.stored_depth);
     } else {
       for (int l = 0; l < kLanes; ++l)
-        stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+        p.stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+      stored = Float::load_aligned(p.stored_depth);
     }
     const Float e0 = Float::load_aligned(e[0]), e1 = Float::load_aligned(e[1]), e2 = Float::load_aligned(e[2]);
     const Float z = e0 * Float(s.z_over_area[0]) + e1 * Float(s.z_over_area[1]) + e2 * Float(s.z_over_area[2]);
-    const std::uint32_t pass = inside & simd::to_bits(z < Float::load_aligned(stored_depth));
+    const std::uint32_t pass = inside & simd::to_bits(z < stored);
     counters_.pixels_depth_failed += std::popcount(inside) - std::popcount(pass);
     if (pass == 0) return false;
 
@@ -310,13 +323,9 @@ private:
     const Float b0 = p0 * inv_sum, b1 = p1 * inv_sum, b2 = p2 * inv_sum;
 
     Fragments& in = p.in;
-    alignas(64) float px[kLanes], py[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      px[l] = float(x + lane_dx(l)) + 0.5f;
-      py[l] = float(y + lane_dy(l)) + 0.5f;
-    }
-    in.pixel_x = Float::load_aligned(px);
-    in.pixel_y = Float::load_aligned(py);
+    // float(x) + (dx + 0.5) is float(x + dx) + 0.5: every value is exact (pixel coordinates far below 2^23).
+    in.pixel_x = Float(float(x)) + lane_centre_x_;
+    in.pixel_y = Float(float(y)) + lane_centre_y_;
     for (int k = 0; k < program_->varying_count(); ++k)
       in.varyings[k] = b0 * Float(vertex_[0]->varyings[k]) + b1 * Float(vertex_[1]->varyings[k]) +
                        b2 * Float(vertex_[2]->varyings[k]);
@@ -327,6 +336,7 @@ private:
       p.quad_y[q] = y;
     }
     p.pass = pass;
+    p.side_by_side = true;
     p.z = z;
     p.program = program_;
     return true;
@@ -352,15 +362,23 @@ private:
 
   void write(const PendingBatch& p, std::uint32_t pass, const Float& z, const ShadeOutput& out) {
     alignas(64) float zs[kLanes], color[3][kLanes];
-    z.store_aligned(zs);
     for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
     std::size_t index[kLanes];
     lane_pixels(p, index);
-    for (int l = 0; l < kLanes; ++l) {
-      if (!((pass >> l) & 1u)) continue;
-      const std::size_t i = index[l];
-      fb_.depth[i] = zs[l];
-      for (int c = 0; c < 3; ++c) fb_.color[3 * i + c] = color[c][l];
+    float* const depth = fb_.depth.data();
+    float* const rgb = fb_.color.data();
+    if (pass == kAllLanes && p.side_by_side) {  // the usual batch inside a large triangle: no test per lane
+      simd::store_quad_rows(z, depth + index[0], depth + index[0] + fb_.width);
+      for (int l = 0; l < kLanes; ++l)
+        for (int c = 0; c < 3; ++c) rgb[3 * index[l] + std::size_t(c)] = color[c][l];
+    } else {
+      z.store_aligned(zs);
+      for (int l = 0; l < kLanes; ++l) {
+        if (!((pass >> l) & 1u)) continue;
+        const std::size_t i = index[l];
+        depth[i] = zs[l];
+        for (int c = 0; c < 3; ++c) rgb[3 * i + std::size_t(c)] = color[c][l];
+      }
     }
     if (any_aov_) write_aovs(index, pass, p.in, out);
     count(pass, out);
@@ -441,6 +459,7 @@ private:
   int packing_ = 2;
   int packed_quads_ = 0;
   bool any_aov_ = false;  // an AOV plane other than cache_misses (filled after the tile) is asked for
+  Float lane_centre_x_, lane_centre_y_;  // each lane's pixel centre from the batch origin (dx + 0.5, dy + 0.5)
 };
 
 }  // namespace

@@ -1,0 +1,57 @@
+#pragma once
+// A batch's lanes and the two framebuffer rows it covers. A batch holds kQuadsPerBatch 2x2 quads side by side:
+// lane 4q + 2r + c is pixel (2q + c, r), so each row's 2 * kQuadsPerBatch pixels are pairs of lanes. These move
+// a batch's lanes from and to two rows of floats with register shuffles (pixel pairs as 64-bit elements): a
+// round trip through an array of lanes (scalar stores, then a vector load) stalls on store forwarding.
+#include "core/simd.hpp"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace qdmr::QDMR_ISA_NAMESPACE::simd {
+
+// The lanes of pixels row0[0 .. 2 * kQuadsPerBatch) and row1[...] (unaligned).
+[[gnu::always_inline]] inline Float load_quad_rows(const float* row0, const float* row1) {
+#if defined(__AVX512F__)
+  const __m512i a = _mm512_castsi256_si512(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(row0)));
+  const __m512i b = _mm512_castsi256_si512(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(row1)));
+  return Float(_mm512_castsi512_ps(_mm512_permutex2var_epi64(a, _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11), b)));
+#elif defined(__AVX2__)
+  const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row0));
+  const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row1));
+  return Float(_mm256_castsi256_ps(_mm256_set_m128i(_mm_unpackhi_epi64(a, b), _mm_unpacklo_epi64(a, b))));
+#elif defined(__SSE2__)
+  const __m128i a = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(row0));
+  const __m128i b = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(row1));
+  return Float(_mm_castsi128_ps(_mm_unpacklo_epi64(a, b)));
+#else
+  alignas(64) float lanes[kLanes];
+  for (int l = 0; l < kLanes; ++l) lanes[l] = ((l % 4) / 2 == 0 ? row0 : row1)[(l / 4) * 2 + l % 2];
+  return Float::load_aligned(lanes);
+#endif
+}
+
+// The inverse: writes the lanes of v to their pixels of row0 and row1.
+[[gnu::always_inline]] inline void store_quad_rows(const Float& v, float* row0, float* row1) {
+#if defined(__AVX512F__)
+  const __m512i rows = _mm512_permutexvar_epi64(_mm512_setr_epi64(0, 2, 4, 6, 1, 3, 5, 7), _mm512_castps_si512(v));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(row0), _mm512_castsi512_si256(rows));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(row1), _mm512_extracti64x4_epi64(rows, 1));
+#elif defined(__AVX2__)
+  const __m256i lanes = _mm256_castps_si256(v);
+  const __m128i low = _mm256_castsi256_si128(lanes), high = _mm256_extracti128_si256(lanes, 1);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(row0), _mm_unpacklo_epi64(low, high));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(row1), _mm_unpackhi_epi64(low, high));
+#elif defined(__SSE2__)
+  const __m128i lanes = _mm_castps_si128(v);
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(row0), lanes);
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(row1), _mm_unpackhi_epi64(lanes, lanes));
+#else
+  alignas(64) float lanes[kLanes];
+  v.store_aligned(lanes);
+  for (int l = 0; l < kLanes; ++l) ((l % 4) / 2 == 0 ? row0 : row1)[(l / 4) * 2 + l % 2] = lanes[l];
+#endif
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::simd
