@@ -1,0 +1,56 @@
+// core/quad_rows.hpp: a batch's lanes to and from the two framebuffer rows it covers (lane 4q + 2r + c is pixel
+// (2q + c, r)), the shuffles of the build these tests are compiled for (the AVX2 kernel); the AVX-512 and SSE4.2
+// versions are covered by golden.shipped_scenes, which renders with every kernel the CPU runs.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "core/quad_rows.hpp"
+
+namespace qdmr {
+namespace {
+
+using simd::Float;
+using simd::kLanes;
+
+constexpr int kRowPixels = kLanes / 2;
+
+TEST(QuadRows, LoadGivesEachLaneItsPixel) {
+  // Rows inside a wider buffer at an odd offset: the loads are unaligned and read no pixel outside the batch.
+  std::vector<float> buffer(3 + 2 * 40, -1.0f);
+  float* row0 = buffer.data() + 3;
+  float* row1 = row0 + 40;
+  for (int x = 0; x < kRowPixels; ++x) {
+    row0[x] = float(100 + x);
+    row1[x] = float(200 + x);
+  }
+  alignas(64) float lanes[kLanes];
+  simd::load_quad_rows(row0, row1).store_aligned(lanes);
+  for (int l = 0; l < kLanes; ++l) {
+    const int q = l / 4, r = (l % 4) / 2, c = l % 2;
+    EXPECT_EQ(lanes[l], float((r == 0 ? 100 : 200) + 2 * q + c)) << "lane " << l;
+  }
+}
+
+TEST(QuadRows, StoreWritesEachLaneToItsPixelAndNothingElse) {
+  std::vector<float> buffer(3 + 2 * 40, -1.0f);
+  float* row0 = buffer.data() + 3;
+  float* row1 = row0 + 40;
+  alignas(64) float lanes[kLanes];
+  for (int l = 0; l < kLanes; ++l) lanes[l] = float(l);
+  simd::store_quad_rows(Float::load_aligned(lanes), row0, row1);
+  for (int l = 0; l < kLanes; ++l) {
+    const int q = l / 4, r = (l % 4) / 2, c = l % 2;
+    EXPECT_EQ((r == 0 ? row0 : row1)[2 * q + c], float(l)) << "lane " << l;
+  }
+  int untouched = 0;
+  for (float v : buffer) untouched += v == -1.0f;
+  EXPECT_EQ(untouched, int(buffer.size()) - kLanes);
+  // And back: the load of what was stored gives the lanes.
+  alignas(64) float again[kLanes];
+  simd::load_quad_rows(row0, row1).store_aligned(again);
+  for (int l = 0; l < kLanes; ++l) EXPECT_EQ(again[l], lanes[l]);
+}
+
+}  // namespace
+}  // namespace qdmr
