@@ -12,18 +12,22 @@ Float bilinear_patch(const Ray& ray, const Float& ds, const Float& s_start, Floa
                      const HeightField& surface, int max_iterations);
 
 // Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
-template <class Surface>
-Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit,
-                                  Float& iterations, Mask active,
-             const TechniqueDesc& technique, const HeightField* patches) {
+// Recorded false: no texture-cache recorder listens (refine() picks).
+template <bool Recorded, class Surface>
+Float refine_as(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
+                Mask active, const TechniqueDesc& technique, const HeightField* patches) {
   if (technique.refinement == QdmRefinement::None) return s_hit;
-  FetchLanes lanes(FetchPhase::Refine);
+  LoopLanes<Recorded> lanes(FetchPhase::Refine);
   lanes.narrow(active);
   const Float lod0(0.0f);
   const Float step = texel_step(ray, float(surface.width()), float(surface.height()));
   Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
-  const Float gap_lo = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * lo, ray.v0 + ray.dv * lo, lod0)) - lo;
-  const Float gap_hi = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * hi, ray.v0 + ray.dv * hi, lod0)) - hi;
+  // The surface's depth minus the ray's at s (positive: the ray is above the surface).
+  const auto gap_at = [&](const Float& s) __attribute__((always_inline)) {
+    return ds * (Float(1.0f) - surface_height<Recorded>(surface, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod0)) - s;
+  };
+  const Float gap_lo = gap_at(lo);
+  const Float gap_hi = gap_at(hi);
   iterations += count(active) * Float(2.0f);
   if (technique.refinement == QdmRefinement::Linear) {
     const Mask bracket = active & (gap_lo > Float(0.0f)) & (gap_hi <= Float(0.0f));
@@ -39,13 +43,23 @@ Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Floa
   for (int i = 0; i < steps && xsimd::any(searching); ++i) {
     lanes.narrow(searching);
     const Float mid = (lo + hi) * Float(0.5f);
-    const Float gap = ds * (Float(1.0f) - surface.height(ray.u0 + ray.du * mid, ray.v0 + ray.dv * mid, lod0)) - mid;
+    const Float gap = gap_at(mid);
     iterations += count(searching);
     const Mask below = gap <= Float(0.0f);
     hi = xsimd::select(searching & below, mid, hi);
     lo = xsimd::select(searching & !below, mid, lo);
   }
   return hi;
+}
+
+// refine_as without the texture-cache recorder's tests when none listens: their calls made the compiler keep the
+// refinement's vector values in memory (as in POM's and relief's loops).
+template <class Surface>
+Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
+             Mask active, const TechniqueDesc& technique, const HeightField* patches) {
+  return fetch_recorder_listens()
+             ? refine_as<true>(surface, ray, ds, s_hit, iterations, active, technique, patches)
+             : refine_as<false>(surface, ray, ds, s_hit, iterations, active, technique, patches);
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE::trace
