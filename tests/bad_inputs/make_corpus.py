@@ -100,6 +100,10 @@ images = [
     # libpng allocates and clears a chunk's declared length before reading it.
     ("png_chunk_past_end.png", png_header_only(64, 64) + struct.pack(">I", 7000000) + b"zTXt" + bytes(100) +
      png_chunk(b"IEND", b""), "truncated PNG (the chunk at byte 33 claims 7000000 bytes"),
+    # Found by fuzz_obj (as an MTL bump map): every chunk fits, but the file ends before IEND; OpenImageIO read
+    # past the end and leaked its error string. Refused by qdmr's chunk walk before the decoder opens it.
+    ("png_no_iend.png", png_header_only(64, 64) + png_chunk(b"tEXt", b"k\0v") + b"\x00",
+     "truncated PNG (it does not end with an IEND chunk)"),
     ("jpeg_truncated_half.jpg", jpg[: len(jpg) // 2], "truncated JPEG"),
     ("jpeg_truncated_end.jpg", jpg[:-2], "truncated JPEG"),
     ("jpeg_soi_only.jpg", jpg[:2], "cannot read"),
