@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "qdmr/core/pixel_buffer.hpp"
+
 namespace qdmr {
 namespace {
 
@@ -25,10 +27,12 @@ void on_warning(png_structp, png_const_charp) {}
 // The IDAT payload: every row with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
 // less zeros), as one zlib stream from libdeflate at `level`. Up is the fastest filter to apply; on the canonical
 // 1080p render it gives 1.67 MB at level 1, where libpng's per-row choice among all five with zlib level 3 gave
-// 1.71 MB (docs/performance.md). Empty on failure.
-std::vector<unsigned char> compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows,
+// 1.71 MB (docs/performance.md). Empty on failure. Its buffers are not zeroed first (every byte is written) and
+// take huge pages where they are large (DefaultInitAllocator): fresh pages cost a fault each otherwise.
+using Bytes = std::vector<unsigned char, DefaultInitAllocator<unsigned char>>;
+Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows,
                                            int level) {
-  std::vector<unsigned char> filtered((row_bytes + 1) * rows);
+  Bytes filtered((row_bytes + 1) * rows);
   for (std::size_t y = 0; y < rows; ++y) {
     unsigned char* out = filtered.data() + y * (row_bytes + 1);
     const unsigned char* row = data + y * row_bytes;
@@ -43,7 +47,7 @@ std::vector<unsigned char> compressed_rows(const unsigned char* data, std::size_
   const std::unique_ptr<libdeflate_compressor, decltype(&libdeflate_free_compressor)> compressor(
       libdeflate_alloc_compressor(level), libdeflate_free_compressor);
   if (!compressor) return {};
-  std::vector<unsigned char> out(libdeflate_zlib_compress_bound(compressor.get(), filtered.size()));
+  Bytes out(libdeflate_zlib_compress_bound(compressor.get(), filtered.size()));
   out.resize(libdeflate_zlib_compress(compressor.get(), filtered.data(), filtered.size(), out.data(), out.size()));
   return out;
 }
@@ -94,7 +98,7 @@ bool write_png(const std::string& path, const imageio::WriteSpec& spec, const vo
     return false;
   }
   const std::size_t row_bytes = std::size_t(spec.width) * std::size_t(spec.channels);
-  const std::vector<unsigned char> idat =
+  const Bytes idat =
       compressed_rows(static_cast<const unsigned char*>(data), row_bytes, std::size_t(spec.height), level);
   if (idat.empty()) {
     error = "libdeflate could not compress the pixels (out of memory)";

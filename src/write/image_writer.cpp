@@ -12,6 +12,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/png_writer.hpp"
+#include "qdmr/core/pixel_buffer.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/write/write.hpp"
@@ -31,10 +32,14 @@ Container container_of(const std::filesystem::path& file) {
   throw Error(file.string(), "unsupported image type '" + ext + "' (use .png, .tif or .exr)");
 }
 
+// Codes of an image, not zeroed before they are written, on huge pages where large (as the frame's planes).
+template <typename T>
+using Codes = std::vector<T, DefaultInitAllocator<T>>;
+
 // Pixels as codes of max_code steps (255 or 65535): sRGB-encoded or linear. Non-finite linear values give 0.
 template <typename T>
-std::vector<T> quantize(std::span<const float> values, float max_code, bool srgb) {
-  std::vector<T> out(values.size());
+Codes<T> quantize(std::span<const float> values, float max_code, bool srgb) {
+  Codes<T> out(values.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 16), [&](const auto& range) {
     if constexpr (sizeof(T) == 1)
       if (srgb) return srgb_codes8(values.data() + range.begin(), range.size(), out.data() + range.begin());
@@ -64,8 +69,8 @@ std::string local_time_now() {
 // floats otherwise.
 struct Encoded {
   imageio::PixelType format = imageio::PixelType::Float;
-  std::vector<std::uint8_t> bytes8;
-  std::vector<std::uint16_t> bytes16;
+  Codes<std::uint8_t> bytes8;
+  Codes<std::uint16_t> bytes16;
   std::vector<float> floats;
   const void* data() const {
     if (format == imageio::PixelType::UInt8) return bytes8.data();
