@@ -49,18 +49,23 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   return Int::load_aligned(value);
 }
 
-#if defined(__AVX512F__)
-// The AVX-512 halves of load_bytes8 and load_f32x4_pair (functions, not lambdas: GCC outlined the lambdas).
-// 128-bit segment j of the result: the 8 bytes at base + o[lane + 4j], then those at base + o[lane + 4j + 1].
-[[gnu::always_inline]] inline __m128i avx512_pair(const std::uint8_t* base, const std::int32_t* o, int a) {
+#if defined(__AVX2__)
+// The 8 bytes at base + o[a], then those at base + o[a + 1]: two lanes of load_bytes8 in one 128-bit register
+// (a function, not a lambda: GCC outlined such lambdas).
+[[gnu::always_inline]] inline __m128i load_two_pairs(const std::uint8_t* base, const std::int32_t* o, int a) {
   return _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[a])),
                             _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[a + 1])));
 }
+#endif
+
+#if defined(__AVX512F__)
+// The AVX-512 halves of load_bytes8 and load_f32x4_pair.
+// 128-bit segment j of the result: load_two_pairs(base, o, lane + 4j).
 [[gnu::always_inline]] inline __m512 avx512_pairs(const std::uint8_t* base, const std::int32_t* o, int lane) {
-  __m512i v = _mm512_castsi128_si512(avx512_pair(base, o, lane));  // insert positions are immediates, even at -O0
-  v = _mm512_inserti32x4(v, avx512_pair(base, o, lane + 4), 1);
-  v = _mm512_inserti32x4(v, avx512_pair(base, o, lane + 8), 2);
-  return _mm512_castsi512_ps(_mm512_inserti32x4(v, avx512_pair(base, o, lane + 12), 3));
+  __m512i v = _mm512_castsi128_si512(load_two_pairs(base, o, lane));  // insert positions: immediates, even at -O0
+  v = _mm512_inserti32x4(v, load_two_pairs(base, o, lane + 4), 1);
+  v = _mm512_inserti32x4(v, load_two_pairs(base, o, lane + 8), 2);
+  return _mm512_castsi512_ps(_mm512_inserti32x4(v, load_two_pairs(base, o, lane + 12), 3));
 }
 
 // Floats at..at+3 of each lane's texel (base + o[lane]), one vector per float: per 128-bit segment j, a 4x4
@@ -101,12 +106,11 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   if (path == FetchPath::Gather) {
     alignas(32) std::int32_t o[kLanes];
     byte_offset.store_aligned(o);
-    const auto pair = [&](int a, int b) {  // lanes a and b: [first a, second a, first b, second b]
-      return _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[a])),
-                                _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + o[b])));
+    const auto halves = [&](int lane) {  // low half: lanes lane, lane + 1; high half: lanes lane + 4, lane + 5
+      return _mm256_castsi256_ps(_mm256_inserti128_si256(_mm256_castsi128_si256(load_two_pairs(base, o, lane)),
+                                                         load_two_pairs(base, o, lane + 4), 1));
     };
-    const __m256 x = _mm256_castsi256_ps(_mm256_inserti128_si256(_mm256_castsi128_si256(pair(0, 1)), pair(4, 5), 1));
-    const __m256 y = _mm256_castsi256_ps(_mm256_inserti128_si256(_mm256_castsi128_si256(pair(2, 3)), pair(6, 7), 1));
+    const __m256 x = halves(0), y = halves(2);
     first = Int(_mm256_castps_si256(_mm256_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0))));
     second = Int(_mm256_castps_si256(_mm256_shuffle_ps(x, y, _MM_SHUFFLE(3, 1, 3, 1))));
     return;
