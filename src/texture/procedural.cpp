@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -101,34 +102,75 @@ struct Cobbles {
       }
   }
 
-  Texel operator()(double u, double v) const {
-    const double x = u * cells, y = v * cells;
-    const int ix = int(std::floor(x)), iy = int(std::floor(y));
-    double qx[9], qy[9];
-    std::size_t id[9];
-    int nearest = 0;
-    double best = 1e30;
-    for (int k = 0; k < 9; ++k) {
-      const int cx = ix + k % 3 - 1, cy = iy + k / 3 - 1;
-      id[k] = std::size_t(wrap(cy, cells)) * cells + std::size_t(wrap(cx, cells));
-      qx[k] = cx + px[id[k]];
-      qy[k] = cy + py[id[k]];
-      const double d2 = (qx[k] - x) * (qx[k] - x) + (qy[k] - y) * (qy[k] - y);
-      if (d2 < best) best = d2, nearest = k;
+  // What the texels of one cell (ix, iy) share: the nine candidate feature points around it and, once a texel
+  // finds candidate n nearest, the bisectors between n and the others. fill() evaluates a row's texels in order,
+  // so a Cursor computes them once per run of a cell's texels instead of once per texel; the operations are the
+  // per-texel formula's, in its order, so the bits are the same.
+  class Cursor {
+  public:
+    explicit Cursor(const Cobbles& cobbles) : c_(&cobbles) {}
+
+    Texel operator()(double u, double v) {
+      const double x = u * c_->cells, y = v * c_->cells;
+      const int ix = int(std::floor(x)), iy = int(std::floor(y));
+      if (!valid_ || ix != ix_ || iy != iy_) enter(ix, iy);
+      int nearest = 0;
+      double best = 1e30;
+      for (int k = 0; k < 9; ++k) {
+        const double d2 = (qx_[k] - x) * (qx_[k] - x) + (qy_[k] - y) * (qy_[k] - y);
+        if (d2 < best) best = d2, nearest = k;
+      }
+      const Bisectors& b = bisectors(nearest);
+      // Distance to the cell border: the nearest bisector between the nearest point and any other.
+      double edge = 1e30;
+      for (int k = 0; k < 9; ++k) {
+        if (k == nearest) continue;
+        const double mx = b.mid_x[k] - x, my = b.mid_y[k] - y;
+        edge = std::min(edge, (mx * b.dx[k] + my * b.dy[k]) / b.len[k]);
+      }
+      const double t = clamp01((edge - 0.5 * c_->mortar) / 0.3);
+      const double c = c_->value[id_[nearest]];
+      return {(0.8 + 0.2 * c) * std::sqrt(t * (2.0 - t)), c};
     }
-    // Distance to the cell border: the nearest bisector between the nearest point and any other.
-    double edge = 1e30;
-    for (int k = 0; k < 9; ++k) {
-      if (k == nearest) continue;
-      const double dx = qx[k] - qx[nearest], dy = qy[k] - qy[nearest];
-      const double len = std::sqrt(dx * dx + dy * dy);
-      const double mx = 0.5 * (qx[k] + qx[nearest]) - x, my = 0.5 * (qy[k] + qy[nearest]) - y;
-      edge = std::min(edge, (mx * dx + my * dy) / len);
+
+  private:
+    // From candidate n to each candidate k: direction, its length and the midpoint.
+    struct Bisectors {
+      double dx[9], dy[9], len[9], mid_x[9], mid_y[9];
+    };
+
+    void enter(int ix, int iy) {
+      valid_ = true, ix_ = ix, iy_ = iy, known_ = 0;
+      for (int k = 0; k < 9; ++k) {
+        const int cx = ix + k % 3 - 1, cy = iy + k / 3 - 1;
+        id_[k] = std::size_t(wrap(cy, c_->cells)) * c_->cells + std::size_t(wrap(cx, c_->cells));
+        qx_[k] = cx + c_->px[id_[k]];
+        qy_[k] = cy + c_->py[id_[k]];
+      }
     }
-    const double t = clamp01((edge - 0.5 * mortar) / 0.3);
-    const double c = value[id[nearest]];
-    return {(0.8 + 0.2 * c) * std::sqrt(t * (2.0 - t)), c};
-  }
+
+    const Bisectors& bisectors(int n) {
+      Bisectors& b = bisectors_[n];
+      if (known_ & (1u << n)) return b;
+      known_ |= 1u << n;
+      for (int k = 0; k < 9; ++k) {
+        b.dx[k] = qx_[k] - qx_[n], b.dy[k] = qy_[k] - qy_[n];
+        b.len[k] = std::sqrt(b.dx[k] * b.dx[k] + b.dy[k] * b.dy[k]);
+        b.mid_x[k] = 0.5 * (qx_[k] + qx_[n]), b.mid_y[k] = 0.5 * (qy_[k] + qy_[n]);
+      }
+      return b;
+    }
+
+    const Cobbles* c_;
+    bool valid_ = false;
+    int ix_ = 0, iy_ = 0;
+    unsigned known_ = 0;  // bit n: bisectors_[n] is computed for this cell
+    double qx_[9], qy_[9];
+    std::size_t id_[9];
+    Bisectors bisectors_[9];
+  };
+
+  Cursor cursor() const { return Cursor(*this); }
 };
 
 struct Sine {
@@ -229,10 +271,17 @@ template <class Pattern>
 Image fill(int size, bool with_cells, const Pattern& pattern) {
   Image out(size, size, with_cells ? 2 : 1);
   tbb::parallel_for(tbb::blocked_range<int>(0, size), [&](const tbb::blocked_range<int>& rows) {
+    // A pattern with a cursor evaluates a row's texels through it (it keeps what neighbouring texels share).
+    auto evaluate = [&] {
+      if constexpr (requires { pattern.cursor(); })
+        return pattern.cursor();
+      else
+        return std::cref(pattern);
+    }();
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const double v = (y + 0.5) / size;
       for (int x = 0; x < size; ++x) {
-        const Texel t = pattern((x + 0.5) / size, v);
+        const Texel t = evaluate((x + 0.5) / size, v);
         out.at(x, y, 0) = float(t.h);
         if (with_cells) out.at(x, y, 1) = float(t.cell);
       }

@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <vector>
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/texture.hpp"
@@ -89,6 +92,34 @@ TEST(TextureProcedural, Tileable) {
     const double interior_mean = interior_sum / (2.0 * n * (n - 1)), edge_mean = edge_sum / (2.0 * n);
     EXPECT_LE(edge_max, interior_max) << int(p);
     EXPECT_LE(edge_mean, 3.0 * interior_mean + 1e-6) << int(p);
+  }
+}
+
+// FNV-1a over the texels' bits.
+std::uint64_t digest(const std::vector<float>& texels) {
+  std::uint64_t h = 0xcbf29ce484222325u;
+  for (const float t : texels)
+    for (int byte = 0; byte < 4; ++byte) h = (h ^ ((std::bit_cast<std::uint32_t>(t) >> (8 * byte)) & 0xFFu)) * 0x100000001b3u;
+  return h;
+}
+
+// The generator shares each cell's candidate points and bisectors between the texels of the cell; these digests
+// were taken from the per-texel formula it replaced (every texel searching its nine neighbouring cells and
+// measuring its distance to every bisector; bench/llvmpipe/canonical.cpp keeps a copy of it), so they pin the
+// bits to that definition. Cell runs of 64, 12 or 13 texels (cells not dividing the size), 1, and cells smaller
+// than a texel.
+TEST(TextureProcedural, CobblesKeepTheBitsOfTheirPerTexelDefinition) {
+  struct Case {
+    int size, cells;
+    float mortar;
+    std::uint32_t seed;
+    std::uint64_t digest;
+  };
+  for (const Case& c : {Case{512, 8, 0.08f, 1, 11195767796147320576u}, Case{64, 5, 0.0f, 7, 5350268023807079165u},
+                        Case{32, 32, 0.3f, 3, 699436979478964970u}, Case{4, 16, 0.1f, 9, 479590760850544356u}}) {
+    ProceduralDesc d = desc(ProceduralPattern::Cobbles, c.size, c.seed, c.cells);
+    d.mortar = c.mortar;
+    EXPECT_EQ(digest(generate_procedural(d).texels), c.digest) << "size " << c.size << " cells " << c.cells;
   }
 }
 
