@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "program/variant.hpp"
+#include "raster/framebuffer.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
@@ -579,7 +580,7 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
     plan.derived_bytes += d.bytes;
     plan.working_bytes = std::max(plan.working_bytes, d.working_bytes);
   }
-  std::uint64_t per_pixel = 4;  // colour (3) and depth (1) floats
+  std::uint64_t per_pixel = keeps_depth_plane(plan.aovs) ? 4 : 3;  // colour (3) and depth (1) floats
   for (Aov aov : plan.aovs) per_pixel += std::uint64_t(aov_channels(aov));
   plan.framebuffer_bytes = std::uint64_t(plan.width) * std::uint64_t(plan.height) * per_pixel * sizeof(float);
   plan.image_module_bytes = reads_image_files(scene, plan) ? kImageModuleBytes : 0;

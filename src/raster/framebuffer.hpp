@@ -1,7 +1,9 @@
 #pragma once
-// The render targets of a frame: colour and depth always, AOV planes only when asked for. Kept by the renderer
-// from frame to frame (resize() keeps the memory when the size allows), so a warm frame touches no new pages.
-// Never cleared as a whole: each tile clears its own pixels before drawing (clear_rect), in parallel.
+// The render targets of a frame: colour always, AOV planes only when asked for, and a depth plane only where
+// something reads depth after its tile (keeps_depth_plane): the tiles test depth in a tile-sized plane of their
+// own, in cache, and copy it out only then. Kept by the renderer from frame to frame (resize() keeps the memory
+// when the size allows), so a warm frame touches no new pages. Never cleared as a whole: each tile clears its
+// own pixels before drawing (clear_rect), in parallel.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -14,11 +16,17 @@
 
 namespace qdmr {
 
+// Whether a frame with these AOVs keeps a frame-sized depth plane: the reference summary counts the covered
+// pixels (depth below the clear value), and the texture-cache replay adds misses at covered pixels only.
+inline bool keeps_depth_plane(const std::vector<Aov>& aovs) {
+  return std::any_of(aovs.begin(), aovs.end(), [](Aov a) { return is_reference_aov(a) || a == Aov::CacheMisses; });
+}
+
 struct Framebuffer {
   int width = 0, height = 0;
   glm::vec3 background{0.0f};
   PixelBuffer color;       // linear RGB, 3 per pixel, cleared to the background
-  PixelBuffer depth;       // window depth in [0, 1], cleared to 1
+  PixelBuffer depth;       // window depth in [0, 1] (1: uncovered), where keeps_depth_plane; else empty
   std::array<PixelBuffer, kAovCount> aov;  // indexed by Aov; aov_channels() per pixel; empty when not asked for
 
   // Sizes the planes for a frame. A plane keeps its memory when its size is unchanged; one larger than the frame
@@ -28,7 +36,7 @@ struct Framebuffer {
     height = h;
     const std::size_t pixels = std::size_t(w) * std::size_t(h);
     fit(color, pixels * 3);
-    fit(depth, pixels);
+    fit(depth, keeps_depth_plane(aovs) ? pixels : 0);
     std::array<bool, kAovCount> wanted{};
     for (Aov a : aovs) wanted[std::size_t(a)] = true;
     for (int a = 0; a < kAovCount; ++a)
@@ -51,7 +59,6 @@ struct Framebuffer {
         rgb[3 * i + 1] = background.y;
         rgb[3 * i + 2] = background.z;
       }
-      std::fill_n(depth.data() + first, n, 1.0f);
       for (int a = 0; a < kAovCount; ++a) {
         PixelBuffer& plane = aov[std::size_t(a)];
         if (plane.empty()) continue;

@@ -25,6 +25,15 @@ constexpr int lane_dx(int lane) { return (lane / 4) * 2 + (lane % 2); }
 constexpr int lane_dy(int lane) { return (lane % 4) / 2; }
 constexpr std::uint32_t kAllLanes = (1u << kLanes) - 1u;  // kLanes <= 16
 
+// The tile's depth plane: its pixels' window depths, tested and written while the tile is drawn, in cache (a
+// frame-sized plane would cost a fresh frame its first touch and every frame its memory traffic).
+struct TileDepth {
+  float* data;
+  int x0, y0;
+  std::size_t stride;  // floats per row: the tile's width rounded up to whole batches
+  float* at(int x, int y) const { return data + std::size_t(y - y0) * stride + std::size_t(x - x0); }
+};
+
 struct EdgeSteps {
   std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
 };
@@ -66,8 +75,9 @@ int classify_block(const TriangleSetup& s, int bx, int by) {
 
 class TileRasterizer {
 public:
-  TileRasterizer(const RasterContext& context, const PixelRect& tile, TileCounters& counters, FetchRecorder* recorder)
-      : ctx_(context), fb_(*context.framebuffer), tile_(tile), counters_(counters), recorder_(recorder) {
+  TileRasterizer(const RasterContext& context, const PixelRect& tile, const TileDepth& depth, TileCounters& counters,
+                 FetchRecorder* recorder)
+      : ctx_(context), fb_(*context.framebuffer), tile_(tile), depth_(depth), counters_(counters), recorder_(recorder) {
     for (int a = 0; a < kAovCount; ++a) any_aov_ |= !fb_.aov[std::size_t(a)].empty() && Aov(a) != Aov::CacheMisses;
     alignas(64) float cx[kLanes], cy[kLanes];
     for (int l = 0; l < kLanes; ++l) {
@@ -302,12 +312,12 @@ private:
     Float stored;
     if (whole) {
       // Lanes outside the triangle read their pixel's depth too: harmless, every test below is masked by inside.
-      const float* row = fb_.depth.data() + fb_.index(x, y);
-      stored = simd::load_quad_rows(row, row + fb_.width);
+      const float* row = depth_.at(x, y);
+      stored = simd::load_quad_rows(row, row + depth_.stride);
       stored.store_aligned(p.stored_depth);
     } else {
       for (int l = 0; l < kLanes; ++l)
-        p.stored_depth[l] = (inside >> l) & 1u ? fb_.depth[fb_.index(x + lane_dx(l), y + lane_dy(l))] : 0.0f;
+        p.stored_depth[l] = (inside >> l) & 1u ? *depth_.at(x + lane_dx(l), y + lane_dy(l)) : 0.0f;
       stored = Float::load_aligned(p.stored_depth);
     }
     const Float e0 = Float::load_aligned(e[0]), e1 = Float::load_aligned(e[1]), e2 = Float::load_aligned(e[2]);
@@ -365,10 +375,10 @@ private:
     for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
     std::size_t index[kLanes];
     lane_pixels(p, index);
-    float* const depth = fb_.depth.data();
     float* const rgb = fb_.color.data();
     if (pass == kAllLanes && p.side_by_side) {  // the usual batch inside a large triangle: no test per lane
-      simd::store_quad_rows(z, depth + index[0], depth + index[0] + fb_.width);
+      float* const depth = depth_.at(p.quad_x[0], p.quad_y[0]);
+      simd::store_quad_rows(z, depth, depth + depth_.stride);
       for (int l = 0; l < kLanes; ++l)
         for (int c = 0; c < 3; ++c) rgb[3 * index[l] + std::size_t(c)] = color[c][l];
     } else {
@@ -376,7 +386,7 @@ private:
       for (int l = 0; l < kLanes; ++l) {
         if (!((pass >> l) & 1u)) continue;
         const std::size_t i = index[l];
-        depth[i] = zs[l];
+        *depth_.at(p.quad_x[l / 4] + l % 2, p.quad_y[l / 4] + lane_dy(l)) = zs[l];
         for (int c = 0; c < 3; ++c) rgb[3 * i + std::size_t(c)] = color[c][l];
       }
     }
@@ -442,6 +452,7 @@ private:
   const RasterContext& ctx_;
   Framebuffer& fb_;
   PixelRect tile_;
+  TileDepth depth_;
   TileCounters& counters_;
   const TriangleSetup* setup_ = nullptr;
   EdgeSteps steps_{};
@@ -469,20 +480,36 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
                  TileCounters& counters) {
   Framebuffer& fb = *context.framebuffer;
   fb.clear_rect(tile.x0, tile.y0, tile.x1, tile.y1);
+  // Each worker thread's tile depth plane, cleared to 1 (uncovered) for each tile; rows of whole batches and an
+  // even number of rows, so a batch's lanes past the frame's edge (never tested or written) stay inside it.
+  thread_local PixelBuffer depth_plane;
+  const std::size_t stride = std::size_t((tile.x1 - tile.x0 + kBatchWidth) / kBatchWidth * kBatchWidth);
+  const std::size_t rows = std::size_t((tile.y1 - tile.y0 + 2) / 2 * 2);
+  if (depth_plane.size() < stride * rows) depth_plane.resize(stride * rows);
+  std::fill_n(depth_plane.data(), stride * rows, 1.0f);
+  const TileDepth depth{depth_plane.data(), tile.x0, tile.y0, stride};
+  // What reads depth after the tile (keeps_depth_plane) reads the frame's plane.
+  const auto copy_depth_out = [&] {
+    if (fb.depth.empty()) return;
+    for (int y = tile.y0; y <= tile.y1; ++y)
+      std::copy_n(depth.at(tile.x0, y), tile.x1 - tile.x0 + 1, fb.depth.data() + fb.index(tile.x0, y));
+  };
   if (context.cache == nullptr) {
-    TileRasterizer rasterizer(context, tile, counters, nullptr);
+    TileRasterizer rasterizer(context, tile, depth, counters, nullptr);
     bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
     rasterizer.flush();
+    copy_depth_out();
     return;
   }
   // With the texture cache: record the tile's fetches, then replay them through the cache.
   FetchRecorder recorder(*context.cache, *context.cache_addresses, tile.x0, tile.y0, tile.x1, tile.y1);
   {
     const FetchRecorder::Listening listening(recorder);
-    TileRasterizer rasterizer(context, tile, counters, &recorder);
+    TileRasterizer rasterizer(context, tile, depth, counters, &recorder);
     bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
     rasterizer.flush();
   }
+  copy_depth_out();
   TextureCache cache(*context.cache);
   CacheCounters cache_counters;
   PixelBuffer& misses = fb.aov[std::size_t(Aov::CacheMisses)];

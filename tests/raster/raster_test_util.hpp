@@ -80,7 +80,6 @@ struct ScreenScene {
     fb.width = width;
     fb.height = height;
     fb.color.resize(std::size_t(width) * height * 3);
-    fb.depth.resize(std::size_t(width) * height);
     CountingProgram program(width, height);
     RasterContext context;
     context.geometry = &geometry;
