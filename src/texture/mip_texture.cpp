@@ -34,6 +34,10 @@ struct Tables {
   std::array<float, 256> unorm8{};   // k / 255
   std::array<float, 256> srgb8{};    // the exact sRGB decode of k / 255, as texture.cpp decodes 8-bit albedo
   std::array<double, 255> srgb_mid{};  // decode((k + 0.5) / 255): linear values at or above it encode to k + 1
+  // srgb_first[b]: how many midpoints lie at or below b / kSrgbBuckets, where encode_srgb8's count of midpoints
+  // at or below v starts for v in [b, b + 1) / kSrgbBuckets (a bucket spans at most a code or two).
+  static constexpr int kSrgbBuckets = 4096;
+  std::array<std::uint8_t, kSrgbBuckets> srgb_first{};
 };
 
 double srgb_decode(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
@@ -46,6 +50,10 @@ const Tables& tables() {
       r.srgb8[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
     }
     for (int k = 0; k < 255; ++k) r.srgb_mid[std::size_t(k)] = srgb_decode((k + 0.5) / 255.0);
+    for (int b = 0, k = 0; b < Tables::kSrgbBuckets; ++b) {
+      while (k < 255 && r.srgb_mid[std::size_t(k)] <= double(b) / Tables::kSrgbBuckets) ++k;
+      r.srgb_first[std::size_t(b)] = std::uint8_t(k);
+    }
     return r;
   }();
   return t;
@@ -64,13 +72,16 @@ std::uint16_t quantise_unorm16(float v) {
   return std::uint16_t(std::floor(double(v) * 65535.0 + 0.5));
 }
 
-// round(encode(v) * 255) with the exact curve, found by comparing v with the decoded midpoints between codes:
-// no pow on the value itself, so the result does not depend on the machine's libm.
+// round(encode(v) * 255) with the exact curve: the number of decoded midpoints between codes at or below v (no
+// pow on the value itself, so the result does not depend on the machine's libm), counted from v's bucket on.
+// v * kSrgbBuckets is exact (a power of two), so v's bucket starts at or below v.
 std::uint8_t encode_srgb8(float v) {
   if (!(v > 0.0f)) return 0;
   if (v >= 1.0f) return 255;
-  const auto& mid = tables().srgb_mid;
-  return std::uint8_t(std::upper_bound(mid.begin(), mid.end(), double(v)) - mid.begin());
+  const Tables& t = tables();
+  int k = t.srgb_first[std::size_t(v * float(Tables::kSrgbBuckets))];
+  while (k < 255 && t.srgb_mid[std::size_t(k)] <= double(v)) ++k;
+  return std::uint8_t(k);
 }
 
 struct Codec {

@@ -169,6 +169,26 @@ TEST(MipTexture, SrgbEncodeRoundsInTheEncodedDomain) {
   }
 }
 
+// At every code boundary: the floats within 4 ulps of each decoded midpoint between two codes encode to the
+// number of midpoints at or below them (the definition of rounding in the encoded domain).
+TEST(MipTexture, SrgbEncodeIsExactAtEveryCodeBoundary) {
+  const auto decode = [](double e) { return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4); };
+  std::vector<double> mid(255);
+  for (int k = 0; k < 255; ++k) mid[std::size_t(k)] = decode((k + 0.5) / 255.0);
+  std::vector<float> values;
+  for (const double m : mid) {
+    float v = float(m);
+    for (int step = 0; step < 4; ++step) v = std::nextafter(v, 0.0f);
+    for (int step = 0; step < 9; ++step, v = std::nextafter(v, 1.0f)) values.push_back(v);
+  }
+  const Texture t = make_mip_texture(row_image(values), TexelFormat::R8, true, MipReduce::Max);
+  for (int i = 0; i < int(values.size()); ++i) {
+    const double v = values[std::size_t(i)];
+    const int expected = int(std::upper_bound(mid.begin(), mid.end(), v) - mid.begin());
+    ASSERT_EQ(byte_at(t, 0, i, 0), expected) << v;
+  }
+}
+
 TEST(MipTexture, SrgbAlphaIsLinear) {
   const Texture t = make_mip_texture(row_image({0.5f, 0.5f, 0.5f, 0.5f}, 4), TexelFormat::RGBA8, true, MipReduce::Box);
   EXPECT_EQ(byte_at(t, 0, 0, 0, 0), 188);  // encode(0.5) = 0.7354
