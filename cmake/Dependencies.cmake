@@ -14,6 +14,13 @@ find_package(PNG REQUIRED)  # io/png_writer.hpp: PNG output without the image mo
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 
+# The qdmr command's allocator (src/cli/allocator.cpp): jemalloc, which keeps freed memory for reuse and backs it
+# with transparent huge pages, so a one-shot render does not pay the first touch of every buffer it allocates
+# (docs/performance.md). Not in sanitizer builds, whose runtime replaces the allocator.
+if(NOT QDMR_SANITIZE AND NOT QDMR_FUZZ)
+  pkg_check_modules(JEMALLOC REQUIRED IMPORTED_TARGET jemalloc)
+endif()
+
 # OpenImageIO's target names /usr/include/opencv4, which exists only with libopencv-dev.
 foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
   get_target_property(_dirs OpenImageIO::OpenImageIO ${prop})
