@@ -156,9 +156,29 @@ TEST(Renderer, MemoryDoesNotGrowOverAThousandFrames) {
   const std::uint64_t before = resident_bytes();
   for (int i = 0; i < 1000; ++i) renderer.draw();
   const std::uint64_t after = resident_bytes();
-  // One frame's buffers are 96x54x(3+1+1+3) floats = 166 KB; a leak of even one small allocation per frame
+  // One frame's buffers are 96x54x(3+1+3) floats = 145 KB; a leak of even one small allocation per frame
   // would add 1000 of them. 512 KiB of slack covers allocator and oneTBB bookkeeping noise.
   EXPECT_LT(after, before + 512 * 1024) << "resident set grew from " << before << " to " << after << " bytes";
+}
+
+// The tiles test depth in planes of their own; the framebuffer keeps a frame-sized depth plane only where
+// something reads depth after its tile (the reference summary's covered pixels), and the plan counts exactly
+// what the renderer holds: colour (3 floats a pixel), the AOVs asked for, and then depth (1).
+TEST(Renderer, FramebufferKeepsADepthPlaneOnlyWhereItIsRead) {
+  const SceneDesc scene = small_scene("terrain");
+  const std::uint64_t pixels = 96 * 54;
+  struct Case {
+    std::vector<Aov> aovs;
+    std::uint64_t floats_per_pixel;
+  };
+  for (const Case& c : {Case{{}, 3}, Case{{Aov::Depth}, 3 + 1}, Case{{Aov::ErrorTexels}, 3 + 1 + 1},
+                        Case{{Aov::Missed, Aov::Normal}, 3 + 1 + 3 + 1}}) {
+    const FramePlan plan = plan_frame(scene, PlanOptions{c.aovs});
+    EXPECT_EQ(plan.framebuffer_bytes, pixels * c.floats_per_pixel * sizeof(float)) << c.aovs.size() << " AOVs";
+    Renderer renderer;
+    renderer.set_scene(scene, c.aovs);
+    EXPECT_EQ(renderer.draw().stats.framebuffer_bytes, plan.framebuffer_bytes) << c.aovs.size() << " AOVs";
+  }
 }
 
 TEST(Renderer, RefusesAnIsaTheCpuOrBinaryLacks) {
