@@ -481,7 +481,8 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   Framebuffer& fb = *context.framebuffer;
   fb.clear_rect(tile.x0, tile.y0, tile.x1, tile.y1);
   // Each worker thread's tile depth plane, cleared to 1 (uncovered) for each tile; rows of whole batches and an
-  // even number of rows, so a batch's lanes past the frame's edge (never tested or written) stay inside it.
+  // even number of rows, so a batch's lanes past the frame's edge (never tested or written) stay inside it. It
+  // lives as long as the thread: 16 KiB at the default tile size, 4 MiB at the largest (limits::kMaxTileSize).
   thread_local PixelBuffer depth_plane;
   const std::size_t stride = std::size_t((tile.x1 - tile.x0 + kBatchWidth) / kBatchWidth * kBatchWidth);
   const std::size_t rows = std::size_t((tile.y1 - tile.y0 + 2) / 2 * 2);
