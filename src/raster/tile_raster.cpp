@@ -133,6 +133,8 @@ private:
     int quad_x[simd::kQuadsPerBatch] = {}, quad_y[simd::kQuadsPerBatch] = {};  // each quad's top-left pixel
     std::uint32_t pass = 0;  // lanes to write
     bool side_by_side = false;  // quad k at (quad_x[0] + 2k, quad_y[0]), as prepare() makes them (not packed)
+    int lane_pixel_x(int lane) const { return quad_x[lane / 4] + lane % 2; }  // each lane's pixel
+    int lane_pixel_y(int lane) const { return quad_y[lane / 4] + lane_dy(lane); }
     Float z;                 // the polygon's window depth
     alignas(64) float stored_depth[kLanes];
     Fragments in;
@@ -256,8 +258,8 @@ private:
         if ((p.pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
       int lane_x[kLanes], lane_y[kLanes];
       for (int l = 0; l < kLanes; ++l) {
-        lane_x[l] = p.quad_x[l / 4] + l % 2;
-        lane_y[l] = p.quad_y[l / 4] + lane_dy(l);
+        lane_x[l] = p.lane_pixel_x(l);
+        lane_y[l] = p.lane_pixel_y(l);
       }
       recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
       p.program->shade(p.in, out);
@@ -367,7 +369,7 @@ private:
 
   // The framebuffer index of each lane's pixel.
   void lane_pixels(const PendingBatch& p, std::size_t* index) const {
-    for (int l = 0; l < kLanes; ++l) index[l] = fb_.index(p.quad_x[l / 4] + l % 2, p.quad_y[l / 4] + lane_dy(l));
+    for (int l = 0; l < kLanes; ++l) index[l] = fb_.index(p.lane_pixel_x(l), p.lane_pixel_y(l));
   }
 
   void write(const PendingBatch& p, std::uint32_t pass, const Float& z, const ShadeOutput& out) {
@@ -386,7 +388,7 @@ private:
       for (int l = 0; l < kLanes; ++l) {
         if (!((pass >> l) & 1u)) continue;
         const std::size_t i = index[l];
-        *depth_.at(p.quad_x[l / 4] + l % 2, p.quad_y[l / 4] + lane_dy(l)) = zs[l];
+        *depth_.at(p.lane_pixel_x(l), p.lane_pixel_y(l)) = zs[l];
         for (int c = 0; c < 3; ++c) rgb[3 * i + std::size_t(c)] = color[c][l];
       }
     }
