@@ -35,7 +35,7 @@ struct Tables {
   std::array<float, 256> srgb8{};    // the exact sRGB decode of k / 255, as texture.cpp decodes 8-bit albedo
   std::array<double, 255> srgb_mid{};  // decode((k + 0.5) / 255): linear values at or above it encode to k + 1
   // srgb_first[b]: how many midpoints lie at or below b / kSrgbBuckets, where encode_srgb8's count of midpoints
-  // at or below v starts for v in [b, b + 1) / kSrgbBuckets (a bucket spans at most a code or two).
+  // at or below v starts for v in [b, b + 1) / kSrgbBuckets (no bucket holds more than one midpoint).
   static constexpr int kSrgbBuckets = 4096;
   std::array<std::uint8_t, kSrgbBuckets> srgb_first{};
 };
