@@ -277,7 +277,9 @@ template <class Work>
 
 // The checks of every estimate-against-peak test: printed with `what`, the peak growth covered by the estimate (a few
 // MiB above it allowed: the threads' stacks, the allocator's own) and not below `least` of it (the estimate is what
-// the code allocates, not a guess).
+// the code allocates, not a guess) less 1 MiB: the kernel keeps resident-memory counts per CPU and /proc reads an
+// approximation of their sum, off by up to a batch of pages per CPU in each of the two reads (a 4 MiB bake measured
+// 3.58 MiB once in CI, 3.7-3.9 MiB otherwise).
 [[maybe_unused]] void expect_estimate_covers(std::uint64_t growth, std::uint64_t estimate, double least,
                                              const std::string& what) {
   std::printf("%s: peak growth %.1f MiB, estimate %.1f MiB\n", what.c_str(), double(growth) / (1 << 20),
@@ -285,7 +287,7 @@ template <class Work>
   const std::string message =
       what + ": peak growth " + std::to_string(growth) + ", estimate " + std::to_string(estimate);
   EXPECT_LE(growth, estimate + (std::uint64_t(4) << 20)) << message;
-  EXPECT_GE(double(growth), least * double(estimate)) << message;
+  EXPECT_GE(double(growth), least * double(estimate) - double(1 << 20)) << message;
 }
 
 // cone_bake_bytes against what the baker really holds: the peak resident memory of this process while it bakes
