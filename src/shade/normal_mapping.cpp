@@ -7,31 +7,60 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 
 using namespace shading;
 
-void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
-  const Float& u = in.varyings[kU];
-  const Float& v = in.varyings[kV];
-  const UvDerivatives d = UvDerivatives::from(u, v, lod_mode_);
-  Float albedo[4];
-  const Float albedo_lod = albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
-  albedo_.sample(u, v, albedo_lod, albedo);
-  Float tangent_normal[4];
-  normal_.sample(u, v, normal_.same_lod_as(albedo_) ? albedo_lod : normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
-                 tangent_normal);
+// One batch's texture samples: albedo and the tangent-space normal at the batch's UVs.
+struct NormalMappingProgram::Samples {
+  Float albedo[4], tangent_normal[4];
+};
 
+Float NormalMappingProgram::albedo_lod(const Fragments& in) const {
+  const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
+  return albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+}
+
+Float NormalMappingProgram::normal_lod(const Fragments& in, const Float& albedo_lod) const {
+  if (normal_.same_lod_as(albedo_)) return albedo_lod;
+  const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
+  return normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+}
+
+void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOutput& out) const {
   const TangentFrame frame = TangentFrame::from(in);
-  const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f),
-                                                        tangent_normal[1] * Float(2.0f) - Float(1.0f),
-                                                        tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
+  const Vec3 shading_normal = normalize(frame.to_world({s.tangent_normal[0] * Float(2.0f) - Float(1.0f),
+                                                        s.tangent_normal[1] * Float(2.0f) - Float(1.0f),
+                                                        s.tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
   shade_lights(shading_normal, frame.n, view_vector(in, lights_),
-               SurfaceSample{albedo, specular_from_albedo(albedo, specular_, lighting_.specular), Float(1.0f)}, nullptr,
-               lighting_, lights_, out.color);
+               SurfaceSample{s.albedo, specular_from_albedo(s.albedo, specular_, lighting_.specular), Float(1.0f)},
+               nullptr, lighting_, lights_, out.color);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
   out.iterations = out.hit_depth = out.error_texels = out.missed = Float(0.0f);
   out.shadow = out.ao = Float(1.0f);  // no self-shadowing, no AO
-  out.hit_u = u;
-  out.hit_v = v;
+  out.hit_u = in.varyings[kU];
+  out.hit_v = in.varyings[kV];
+}
+
+void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
+  Samples s;
+  const Float lod = albedo_lod(in);
+  albedo_.sample(in.varyings[kU], in.varyings[kV], lod, s.albedo);
+  normal_.sample(in.varyings[kU], in.varyings[kV], normal_lod(in, lod), s.tangent_normal);
+  light(in, s, out);
+}
+
+// Stage by stage, a's and b's work side by side: each stage of one batch is a chain of dependent operations
+// (derivatives, LOD, the sample's addresses, its loads, the filter), and the other batch's same stage next to it
+// gives the core independent work to overlap with it.
+void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
+                                      ShadeOutput& out_b) const {
+  Samples sa, sb;
+  const Float lod_a = albedo_lod(a), lod_b = albedo_lod(b);
+  albedo_.sample(a.varyings[kU], a.varyings[kV], lod_a, sa.albedo);
+  albedo_.sample(b.varyings[kU], b.varyings[kV], lod_b, sb.albedo);
+  normal_.sample(a.varyings[kU], a.varyings[kV], normal_lod(a, lod_a), sa.tangent_normal);
+  normal_.sample(b.varyings[kU], b.varyings[kV], normal_lod(b, lod_b), sb.tangent_normal);
+  light(a, sa, out_a);
+  light(b, sb, out_b);
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

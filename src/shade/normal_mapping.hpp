@@ -15,8 +15,15 @@ public:
       : ShadingProgram(variant, kBaseVaryingCount), albedo_(albedo, SamplerState::from(sampling)), normal_(normal, SamplerState::from(sampling)), lod_mode_(sampling.lod),
         lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
+  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
+  bool pairs_batches() const override { return true; }
 
 private:
+  struct Samples;
+  simd::Float albedo_lod(const Fragments& in) const;
+  simd::Float normal_lod(const Fragments& in, const simd::Float& albedo_lod) const;
+  void light(const Fragments& in, const Samples& samples, ShadeOutput& out) const;
+
   TextureSampler albedo_, normal_;
   LodMode lod_mode_;
   LightingDesc lighting_;
