@@ -283,21 +283,41 @@ void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup,
   shade_hit<V>(in, setup, surface, hit, ds, out);
 }
 
+// The surface at the hit: where it is, its colour, normal, specular and baked AO.
+struct DisplacementProgram::SurfaceAtHit {
+  Hit hit;
+  Float hu, hv;
+  Float albedo[4], tangent_normal[3], specular = Float(0.0f), ao = Float(1.0f);
+};
+
 template <class V, class Surface>
-void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, Hit hit,
+void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
                                     const Float& ds, ShadeOutput& out) const {
+  SurfaceAtHit at;
+  surface_at_hit(setup, surface, hit, ds, at);
+  light_hit<V>(in, setup, surface, at, ds, out);
+}
+
+template <class Surface>
+void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surface, const Hit& traced, const Float& ds,
+                                         SurfaceAtHit& at) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
-  if (technique_.exact_hits) hit = exact_hit(ray, ds, hit, setup.active);
-
+  at.hit = technique_.exact_hits ? exact_hit(ray, ds, traced, setup.active) : traced;
+  const Hit& hit = at.hit;
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
+  at.hu = hu;
+  at.hv = hv;
   // Baked AO is read per layer and blended like the colours.
   const auto baked_ao = [&](const Layer& l) {
     Float a[4];
     l.ao->sample(hu, hv, Float(0.0f), a);
     return a[0];
   };
-  Float albedo[4], tangent_normal[3], specular(0.0f), ao(1.0f);
+  Float* const albedo = at.albedo;
+  Float* const tangent_normal = at.tangent_normal;
+  Float& specular = at.specular;
+  Float& ao = at.ao;
   FetchLanes surface_lanes(FetchPhase::Surface);
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
     const Layer& l = layers_[0];
@@ -335,15 +355,25 @@ void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, con
       if (l.ao) ao += f[i] * baked_ao(l);
     }
   }
+}
+
+// Everything after the surface: the shading normal, lighting, AOVs, errors against the reference, depth.
+template <class V, class Surface>
+void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, const Surface& surface,
+                                    const SurfaceAtHit& at, const Float& ds, ShadeOutput& out) const {
+  const UvDerivatives& d = setup.d;
+  const Ray& ray = setup.ray;
+  const Hit& hit = at.hit;
   const TangentFrame& frame = setup.frame;
-  const Vec3 shading_normal = normalize(frame.to_world({tangent_normal[0], tangent_normal[1], tangent_normal[2]}));
-  light(in, setup, surface, hit, ds, albedo, specular, ao, shading_normal, out);
+  const Vec3 shading_normal =
+      normalize(frame.to_world({at.tangent_normal[0], at.tangent_normal[1], at.tangent_normal[2]}));
+  light(in, setup, surface, hit, ds, at.albedo, at.specular, at.ao, shading_normal, out);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
   out.iterations = hit.iterations;
-  out.hit_u = hu;
-  out.hit_v = hv;
+  out.hit_u = at.hu;
+  out.hit_v = at.hv;
   out.hit_depth = hit.s;
   out.error_texels = out.missed = Float(0.0f);
   if constexpr (V::technique != TechniqueKind::Normal)
@@ -418,8 +448,14 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
       Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
       Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
       trace::qdm_pair(walk_a, walk_b);
-      shade_hit<V>(a, setup_a, surface, refine_qdm_hit(surface, setup_a, walk_a.hit()), setup_a.ds, out_a);
-      shade_hit<V>(b, setup_b, surface, refine_qdm_hit(surface, setup_b, walk_b.hit()), setup_b.ds, out_b);
+      // The rest stage by stage too, each batch's chains beside the other's.
+      const Hit hit_a = refine_qdm_hit(surface, setup_a, walk_a.hit());
+      const Hit hit_b = refine_qdm_hit(surface, setup_b, walk_b.hit());
+      SurfaceAtHit at_a, at_b;
+      surface_at_hit(setup_a, surface, hit_a, setup_a.ds, at_a);
+      surface_at_hit(setup_b, surface, hit_b, setup_b.ds, at_b);
+      light_hit<V>(a, setup_a, surface, at_a, setup_a.ds, out_a);
+      light_hit<V>(b, setup_b, surface, at_b, setup_b.ds, out_b);
       return;
     }
   }

@@ -79,10 +79,18 @@ private:
   void shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
-  // Everything after the trace: the surface's colour and normal at the hit, lighting, AOVs, depth.
+  // Everything after the trace: the surface's colour and normal at the hit, lighting, AOVs, depth; in two stages
+  // (a pair of batches runs each stage for both side by side).
+  struct SurfaceAtHit;
   template <class V, class Surface>
-  void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, Hit hit, const simd::Float& ds,
-                 ShadeOutput& out) const;
+  void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
+                 const simd::Float& ds, ShadeOutput& out) const;
+  template <class Surface>
+  void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
+                      SurfaceAtHit& at) const;
+  template <class V, class Surface>
+  void light_hit(const Fragments& in, const Setup& setup, const Surface& surface, const SurfaceAtHit& at,
+                 const simd::Float& ds, ShadeOutput& out) const;
   QdmBudget qdm_budget(const Setup& setup) const;
   template <class V, class Surface>
   Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
