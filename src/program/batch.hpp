@@ -34,10 +34,11 @@ class ShadingProgram : public Program {
 public:
   using Program::Program;
   virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
-  // Two batches that write no pixel in common, at once, with the same results as shade() of each. A
-  // program whose loops wait on their own fetches interleaves the two and says so in pairs_batches(); the
-  // rasterizer then hands it batches in pairs, except while the texture-cache recorder listens (it attributes
-  // fetches to the batch in flight).
+  // Two batches that write no pixel in common, at once, with the same results as shade() of each. A program
+  // that gains from interleaving the two (its loops wait on their own fetches, or its stages are chains of
+  // dependent operations the core can overlap with the other batch's) says so in pairs_batches(); the rasterizer
+  // then hands it batches in pairs, except while the texture-cache recorder listens (it attributes fetches to the
+  // batch in flight).
   virtual void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const {
     shade(a, out_a);
     shade(b, out_b);

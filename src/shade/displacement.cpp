@@ -434,37 +434,43 @@ void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, con
   (this->*shade_pair_)(a, out_a, b, out_b);
 }
 
-// Single-layer QDM: both batches set up, their walks interleaved, then each shaded at its hit. Any other
-// program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
+// Single-layer QDM, relief and POM: both batches set up and traced (QDM's walks interleaved), then the surface at
+// each hit and its lighting, stage by stage, each batch's chains of dependent operations beside the other's. Any
+// other program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
 template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
-  if constexpr (V::technique == TechniqueKind::Qdm) {
-    if (layers_.size() == 1) {
-      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
-      const SingleLayerSurface surface = layer_surface(0);
+  if (pairs_batches()) {
+    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+    const SingleLayerSurface surface = layer_surface(0);
+    Float ds_a = setup_a.ds, ds_b = setup_b.ds;
+    Hit hit_a, hit_b;
+    if constexpr (V::technique == TechniqueKind::Qdm) {
       const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
       using Walk = trace::QdmWalk<V, SingleLayerSurface, false>;  // no recorder listens to paired batches
-      Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
-      Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
+      Walk walk_a(surface, setup_a.ray, ds_a, budget_a.stop_level, budget_a.cap, setup_a.active);
+      Walk walk_b(surface, setup_b.ray, ds_b, budget_b.stop_level, budget_b.cap, setup_b.active);
       trace::qdm_pair(walk_a, walk_b);
-      // The rest stage by stage too, each batch's chains beside the other's.
-      const Hit hit_a = refine_qdm_hit(surface, setup_a, walk_a.hit());
-      const Hit hit_b = refine_qdm_hit(surface, setup_b, walk_b.hit());
-      SurfaceAtHit at_a, at_b;
-      surface_at_hit(setup_a, surface, hit_a, setup_a.ds, at_a);
-      surface_at_hit(setup_b, surface, hit_b, setup_b.ds, at_b);
-      light_hit<V>(a, setup_a, surface, at_a, setup_a.ds, out_a);
-      light_hit<V>(b, setup_b, surface, at_b, setup_b.ds, out_b);
-      return;
+      hit_a = refine_qdm_hit(surface, setup_a, walk_a.hit());
+      hit_b = refine_qdm_hit(surface, setup_b, walk_b.hit());
+    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
+      hit_a = trace<V>(surface, setup_a, ds_a);
+      hit_b = trace<V>(surface, setup_b, ds_b);
     }
+    SurfaceAtHit at_a, at_b;
+    surface_at_hit(setup_a, surface, hit_a, ds_a, at_a);
+    surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
+    light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
+    light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
+    return;
   }
   shade_variant<V>(a, out_a);
   shade_variant<V>(b, out_b);
 }
 
 bool DisplacementProgram::pairs_batches() const {
-  return technique_.kind == TechniqueKind::Qdm && layers_.size() == 1;
+  const TechniqueKind k = technique_.kind;
+  return (k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom) && layers_.size() == 1;
 }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {

@@ -90,11 +90,11 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 
 // Also what the batch pairing and quad packing do: with the cache on, the rasterizer hands a program one batch at a
 // time, holding the quads of one triangle; off, it packs the quads of batches with an empty quad into shared
-// batches across triangles (where a batch holds several quads), and hands QDM and normal mapping two batches at a
-// time (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs, the loop
-// statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
-// when none listens. objects_displaced has single-layer QDM (paired) beside POM and relief (not paired) on meshes,
-// and again with CSM and RCSM for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
+// batches across triangles (where a batch holds several quads), and hands QDM, relief, POM and normal mapping two
+// batches at a time (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs,
+// the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
+// when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
+// CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
 // a 4-layer blend; plane normal mapping (paired, no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
@@ -123,7 +123,10 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
       ASSERT_EQ(a.aovs.size(), b.aovs.size());
       for (std::size_t i = 0; i < a.aovs.size(); ++i)
         EXPECT_TRUE(same_bits(a.aovs[i].pixels, b.aovs[i].pixels)) << aov_name(a.aovs[i].aov);
-      if (std::string(name) != "plane") EXPECT_GT(a.stats.iterations_mean, 0.0);  // plane: no trace
+      const bool traces = std::string(name) != "plane";  // plane: normal mapping, no loop to count
+      if (traces) {
+        EXPECT_GT(a.stats.iterations_mean, 0.0);
+      }
       EXPECT_EQ(a.stats.iterations_mean, b.stats.iterations_mean);
       EXPECT_EQ(a.stats.iterations_max, b.stats.iterations_max);
       EXPECT_EQ(a.stats.quads, b.stats.quads);
@@ -133,7 +136,9 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
         EXPECT_EQ(a.stats.batches, b.stats.batches);
       } else {
         EXPECT_LT(a.stats.batches, b.stats.batches);
-        EXPECT_GT(a.stats.lane_utilisation, b.stats.lane_utilisation);
+        if (traces) {  // the utilisation of loop iterations
+          EXPECT_GT(a.stats.lane_utilisation, b.stats.lane_utilisation);
+        }
       }
     }
   }
