@@ -25,6 +25,7 @@ public:
       : surface_(surface), ray_(ray), ds_(ds), top_(surface.top_level()),
         x0_(ray.u0 * Float(float(surface.width()))), y0_(ray.v0 * Float(float(surface.height()))),
         dx_(ray.du * Float(float(surface.width()))), dy_(ray.dv * Float(float(surface.height()))),
+        inv_dx_(Float(1.0f) / dx_), inv_dy_(Float(1.0f) / dy_),
         step_x_pos_(int_mask(dx_ > Float(0.0f))), step_y_pos_(int_mask(dy_ > Float(0.0f))), level_(top_),
         cx_(xsimd::to_int(xsimd::floor(x0_)) >> top_), cy_(xsimd::to_int(xsimd::floor(y0_)) >> top_),
         stop_(xsimd::to_int(stop_level)), active_(active), loop_(cap, FetchPhase::Trace) {}
@@ -52,7 +53,7 @@ public:
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
     const Mask above = active_ & !below;
     Float tx, ty;
-    exit_walls<fp64>(level_, cx_, cy_, x0_, y0_, dx_, dy_, step_x_pos_, step_y_pos_, tx, ty);
+    exit_walls<fp64>(level_, cx_, cy_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, step_x_pos_, step_y_pos_, tx, ty);
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s_);
     const Mask to_plane = above & (top_depth <= t_wall);
     s_ = xsimd::select(to_plane, top_depth, s_);
@@ -67,7 +68,7 @@ public:
     }
     // No branch on whether any lane descends or crosses: a mispredicted one would also throw away the other
     // walk's steps in flight (qdm_pair).
-    descend_to_child<fp64>(int_mask(descend), s_, x0_, y0_, dx_, dy_, level_, cx_, cy_);
+    descend_to_child<fp64>(int_mask(descend), s_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, level_, cx_, cy_);
     const Mask cross = above & !to_plane;
     s_ = xsimd::select(cross, t_wall, s_);
     const IntMask cross_i = int_mask(cross);
@@ -107,6 +108,7 @@ private:
   const Float ds_;
   const int top_;
   const Float x0_, y0_, dx_, dy_;  // the ray in texels per unit of depth
+  const Float inv_dx_, inv_dy_;    // 1 / dx, 1 / dy (crossing)
   const IntMask step_x_pos_, step_y_pos_;
   Int level_, cx_, cy_;
   const Int stop_;

@@ -78,17 +78,20 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   const Float x0 = (p.u - xsimd::floor(p.u)) * width, y0 = (p.v - xsimd::floor(p.v)) * height;
   const RepeatOrigin origin(p, surface.width(), surface.height());
   const Float dx = p.du * width, dy = p.dv * height;  // texels per unit of depth climbed
+  const Float inv_dx = Float(1.0f) / dx, inv_dy = Float(1.0f) / dy;
   const IntMask step_x_pos = int_mask(dx > zero), step_y_pos = int_mask(dy > zero);
   const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
 
   // Along a wall the ray is never inside a column.
   const Mask along_wall = ((dx == zero) & (x0 == xsimd::floor(x0))) | ((dy == zero) & (y0 == xsimd::floor(y0)));
   // The start texel T0 (on a boundary the one behind along the light) and where the ray leaves it; each wall
-  // crossing is computed from its integer wall, (wall - x0) / dx, at every level alike.
+  // crossing is computed from its integer wall, (wall - x0) * inv_dx (crossing()), at every level alike.
   const Int t0x = xsimd::to_int(xsimd::select(dx > zero, xsimd::ceil(x0) - Float(1.0f), xsimd::floor(x0)));
   const Int t0y = xsimd::to_int(xsimd::select(dy > zero, xsimd::ceil(y0) - Float(1.0f), xsimd::floor(y0)));
-  const Float tx0 = xsimd::select(dx != zero, (xsimd::to_float(xsimd::select(step_x_pos, t0x + Int(1), t0x)) - x0) / dx, inf);
-  const Float ty0 = xsimd::select(dy != zero, (xsimd::to_float(xsimd::select(step_y_pos, t0y + Int(1), t0y)) - y0) / dy, inf);
+  const Float tx0 = xsimd::select(
+      dx != zero, crossing<false>(xsimd::to_float(xsimd::select(step_x_pos, t0x + Int(1), t0x)), x0, dx, inv_dx), inf);
+  const Float ty0 = xsimd::select(
+      dy != zero, crossing<false>(xsimd::to_float(xsimd::select(step_y_pos, t0y + Int(1), t0y)), y0, dy, inv_dy), inf);
   Float c = xsimd::min(tx0, ty0);
   const IntMask first_x = int_mask(tx0 <= ty0), first_y = int_mask(ty0 <= tx0);
   Int level(0);
@@ -113,12 +116,12 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     active = active & !hit;
     // Below the cell's maximum above level 0: descend into the child that holds the ray at c (QDM's rule).
     const IntMask descend = int_mask(below & !hit);
-    if (xsimd::any(descend)) descend_to_child(descend, c, x0, y0, dx, dy, level, cx, cy);
+    if (xsimd::any(descend)) descend_to_child(descend, c, x0, y0, dx, dy, inv_dx, inv_dy, level, cx, cy);
     // At or above the cell's maximum where it enters: above it all the way through; on to the next cell.
     const Mask advance = active & !below;
     if (!xsimd::any(advance)) continue;
     Float tx, ty;
-    exit_walls(level, cx, cy, x0, y0, dx, dy, step_x_pos, step_y_pos, tx, ty);
+    exit_walls(level, cx, cy, x0, y0, dx, dy, inv_dx, inv_dy, step_x_pos, step_y_pos, tx, ty);
     c = xsimd::select(advance, xsimd::max(xsimd::min(tx, ty), c), c);
     const IntMask moving = int_mask(advance);
     const IntMask cross_x = moving & int_mask(tx <= ty), cross_y = moving & int_mask(ty <= tx);
