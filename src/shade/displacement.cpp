@@ -440,32 +440,43 @@ void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, con
 template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
-  if (pairs_batches()) {
-    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
-    const SingleLayerSurface surface = layer_surface(0);
-    Float ds_a = setup_a.ds, ds_b = setup_b.ds;
-    Hit hit_a, hit_b;
-    if constexpr (V::technique == TechniqueKind::Qdm) {
-      const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
-      using Walk = trace::QdmWalk<V, SingleLayerSurface, false>;  // no recorder listens to paired batches
-      Walk walk_a(surface, setup_a.ray, ds_a, budget_a.stop_level, budget_a.cap, setup_a.active);
-      Walk walk_b(surface, setup_b.ray, ds_b, budget_b.stop_level, budget_b.cap, setup_b.active);
-      trace::qdm_pair(walk_a, walk_b);
-      hit_a = refine_qdm_hit(surface, setup_a, walk_a.hit());
-      hit_b = refine_qdm_hit(surface, setup_b, walk_b.hit());
-    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
-      hit_a = trace<V>(surface, setup_a, ds_a);
-      hit_b = trace<V>(surface, setup_b, ds_b);
+  constexpr TechniqueKind kind = V::technique;
+  if constexpr (kind == TechniqueKind::Qdm || kind == TechniqueKind::Relief || kind == TechniqueKind::Pom) {
+    if (layers_.size() == 1) {
+      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+      const SingleLayerSurface surface = layer_surface(0);
+      if constexpr (kind == TechniqueKind::Qdm) {
+        const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
+        using Walk = trace::QdmWalk<V, SingleLayerSurface, false>;  // no recorder listens to paired batches
+        Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
+        Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
+        trace::qdm_pair(walk_a, walk_b);
+        shade_hits<V>(a, setup_a, refine_qdm_hit(surface, setup_a, walk_a.hit()), setup_a.ds, out_a, b, setup_b,
+                      refine_qdm_hit(surface, setup_b, walk_b.hit()), setup_b.ds, out_b);
+      } else {  // relief and POM: their loops run at the core's throughput already; one after the other
+        Float ds_a = setup_a.ds, ds_b = setup_b.ds;
+        const Hit hit_a = trace<V>(surface, setup_a, ds_a);
+        const Hit hit_b = trace<V>(surface, setup_b, ds_b);
+        shade_hits<V>(a, setup_a, hit_a, ds_a, out_a, b, setup_b, hit_b, ds_b, out_b);
+      }
+      return;
     }
-    SurfaceAtHit at_a, at_b;
-    surface_at_hit(setup_a, surface, hit_a, ds_a, at_a);
-    surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
-    light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
-    light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
-    return;
   }
   shade_variant<V>(a, out_a);
   shade_variant<V>(b, out_b);
+}
+
+// shade_hit() of two single-layer batches, stage by stage: the surface at each hit, then the lighting of each.
+template <class V>
+void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const Float& ds_a,
+                                     ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
+                                     const Float& ds_b, ShadeOutput& out_b) const {
+  const SingleLayerSurface surface = layer_surface(0);
+  SurfaceAtHit at_a, at_b;
+  surface_at_hit(setup_a, surface, hit_a, ds_a, at_a);
+  surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
+  light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
+  light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
 }
 
 bool DisplacementProgram::pairs_batches() const {

@@ -88,6 +88,10 @@ private:
   template <class Surface>
   void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
                       SurfaceAtHit& at) const;
+  template <class V>
+  void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const simd::Float& ds_a,
+                  ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
+                  const simd::Float& ds_b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void light_hit(const Fragments& in, const Setup& setup, const Surface& surface, const SurfaceAtHit& at,
                  const simd::Float& ds, ShadeOutput& out) const;
