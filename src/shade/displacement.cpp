@@ -441,7 +441,7 @@ template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
   constexpr TechniqueKind kind = V::technique;
-  if constexpr (kind == TechniqueKind::Qdm || kind == TechniqueKind::Relief || kind == TechniqueKind::Pom) {
+  if constexpr (pairs_technique(kind)) {
     if (layers_.size() == 1) {
       const Setup setup_a = setup_for(a), setup_b = setup_for(b);
       const SingleLayerSurface surface = layer_surface(0);
@@ -480,8 +480,7 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
 }
 
 bool DisplacementProgram::pairs_batches() const {
-  const TechniqueKind k = technique_.kind;
-  return (k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom) && layers_.size() == 1;
+  return pairs_technique(technique_.kind) && layers_.size() == 1;
 }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {

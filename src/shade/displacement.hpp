@@ -75,6 +75,10 @@ private:
   Setup setup_for(const Fragments& in) const;
   template <class V>
   void shade_variant(const Fragments& in, ShadeOutput& out) const;
+  // The techniques whose single-layer batches are shaded in pairs (shade_pair_variant).
+  static constexpr bool pairs_technique(TechniqueKind k) {
+    return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
+  }
   template <class V>
   void shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   template <class V, class Surface>
