@@ -22,6 +22,10 @@ using UInt = xsimd::batch<std::uint32_t, Arch>;
 using Mask = xsimd::batch_bool<float, Arch>;
 using IntMask = xsimd::batch_bool<std::int32_t, Arch>;
 
+// A mask's complement is written ~m, never !m: xsimd 8's operator! compares with a batch_bool(false) built by a
+// recursive constructor, which GCC refused to inline in the displacement kernel's AVX-512 build (24 calls per QDM
+// step pair); ~ is one instruction in every kernel.
+
 inline constexpr int kLanes = static_cast<int>(Float::size);
 static_assert(kLanes == 4 || kLanes == 8 || kLanes == 16,
               "qdmr batches hold one (SSE4.2), two (AVX2) or four (AVX-512) 2x2 quads");

@@ -140,7 +140,7 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
   }
   if (!xsimd::all(coarse)) {
     FetchLanes lanes;
-    lanes.narrow(!simd::float_mask(coarse));
+    lanes.narrow(~simd::float_mask(coarse));
     // Level 0: the exact box value, as the combined tree was built from.
     Float h[kMaxLayers], w[kMaxLayers];
     for (int i = 0; i < count_; ++i)

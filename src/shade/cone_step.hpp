@@ -68,7 +68,7 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
       // the surface), or a relaxed step that went in.
       const Mask below = active & (s >= top);
       if constexpr (relaxed) search = search | (below & (s_prev < s));
-      active = active & !below;
+      active = active & ~below;
 
       // The walls of p ahead, each crossing computed from the integer wall as in QDM.
       const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx));
@@ -93,7 +93,7 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
       const Float disc = xsimd::max(b1 * b1 - a2 * c0, zero);
       const Float tau = xsimd::min(xsimd::max((zero - c0) / xsimd::max(b1 + xsimd::sqrt(disc), Float(1e-30f)), zero), T);
       const Float next = xsimd::select(to_top, top, xsimd::min(xsimd::select(exit1 <= sb, exit1, sb + tau), top));
-      active = active & !to_top;  // on p's top while over p: the hit
+      active = active & ~to_top;  // on p's top while over p: the hit
 
       // The texel at the step's end: the one ahead of the position, at least one past each wall crossed.
       const Mask stepping = active;
@@ -119,7 +119,7 @@ Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask ac
       const Mask below = mid >= ds * (Float(1.0f) - h);
       iterations += count(search);
       hi = xsimd::select(search & below, mid, hi);
-      lo = xsimd::select(search & !below, mid, lo);
+      lo = xsimd::select(search & ~below, mid, lo);
     }
     s = xsimd::select(search, hi, s);
   }

@@ -25,7 +25,7 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
     iterations += count(active);
     const Mask at_top = active & (gap0 <= Float(0.0f));
     s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
-    active = active & !at_top;
+    active = active & ~at_top;
     prev_gap = gap0;
   }
   for (int i = 1; i <= technique.max_steps && xsimd::any(active); ++i) {
@@ -38,7 +38,7 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
     const Mask found = in_range & (gap <= Float(0.0f));
     const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
     s_hit = xsimd::select(found, prev_s + (s - prev_s) * t, s_hit);
-    active = in_range & !found;
+    active = in_range & ~found;
     prev_s = s;
     prev_gap = gap;
   }

@@ -49,9 +49,9 @@ public:
     const Mask below = active_ & (s_ >= top_depth);
     const IntMask at_stop = level_ <= stop_;
     const Mask hit = below & float_mask(at_stop);
-    active_ = active_ & !hit;
+    active_ = active_ & ~hit;
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
-    const Mask above = active_ & !below;
+    const Mask above = active_ & ~below;
     Float tx, ty;
     exit_walls<fp64>(level_, cx_, cy_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, step_x_pos_, step_y_pos_, tx, ty);
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s_);
@@ -60,16 +60,16 @@ public:
     // Below the cell's top but not at the last level: descend into the child that holds the ray. On the cell's
     // top plane the ray is at its highest point: the hit at the last level, else descend now, as the next
     // iteration would after reading the same cell again (a filtered max moves with the ray: it reads again).
-    Mask descend = below & !hit;
+    Mask descend = below & ~hit;
     if constexpr (!V::filtered_max) {
       const Mask plane_hit = to_plane & float_mask(at_stop);
-      active_ = active_ & !plane_hit;
-      descend = descend | (to_plane & !plane_hit);
+      active_ = active_ & ~plane_hit;
+      descend = descend | (to_plane & ~plane_hit);
     }
     // No branch on whether any lane descends or crosses: a mispredicted one would also throw away the other
     // walk's steps in flight (qdm_pair).
     descend_to_child<fp64>(int_mask(descend), s_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, level_, cx_, cy_);
-    const Mask cross = above & !to_plane;
+    const Mask cross = above & ~to_plane;
     s_ = xsimd::select(cross, t_wall, s_);
     const IntMask cross_i = int_mask(cross);
     const IntMask cross_x = cross_i & int_mask(tx <= ty);

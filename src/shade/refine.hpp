@@ -47,7 +47,7 @@ Float refine_as(const Surface& surface, const Ray& ray, const Float& ds, const F
     iterations += count(searching);
     const Mask below = gap <= Float(0.0f);
     hi = xsimd::select(searching & below, mid, hi);
-    lo = xsimd::select(searching & !below, mid, lo);
+    lo = xsimd::select(searching & ~below, mid, lo);
   }
   return hi;
 }

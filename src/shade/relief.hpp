@@ -24,7 +24,7 @@ Hit relief(const Surface& surface, const Ray& ray, const Float& ds,
       iterations += count(active);
       hi = xsimd::select(found, s, hi);
       lo = xsimd::select(found, xsimd::max(s - step, Float(0.0f)), lo);
-      active = active & !found;
+      active = active & ~found;
     }
   }
   lo = xsimd::select(active, ds - step, lo);  // never below: the bottom (h >= 0 everywhere) is the hit
@@ -37,7 +37,7 @@ Hit relief(const Surface& surface, const Ray& ray, const Float& ds,
     const Mask below = mid >= ds * (Float(1.0f) - h);
     iterations += count(searching);
     hi = xsimd::select(searching & below, mid, hi);
-    lo = xsimd::select(searching & !below, mid, lo);
+    lo = xsimd::select(searching & ~below, mid, lo);
   }
   return {hi, iterations, Float(0.0f)};
 }

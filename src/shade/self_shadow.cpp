@@ -104,7 +104,7 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   if ((1 << top) >= std::max(surface.width(), surface.height()))
     floor_depth = p.ds * (Float(1.0f) - surface.max_height());
 
-  Mask active = p.active & !along_wall & !(p.s - c <= floor_depth);
+  Mask active = p.active & ~along_wall & ~(p.s - c <= floor_depth);
   Mask occluded = zero != zero;
   CappedLoop loop(Int(desc.max_iterations), FetchPhase::Shadow);
   while (loop.next(active)) {
@@ -113,12 +113,12 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     const Mask below = active & (p.s - c > top_depth);
     const Mask hit = below & float_mask(level == Int(0));
     occluded = occluded | hit;
-    active = active & !hit;
+    active = active & ~hit;
     // Below the cell's maximum above level 0: descend into the child that holds the ray at c (QDM's rule).
-    const IntMask descend = int_mask(below & !hit);
+    const IntMask descend = int_mask(below & ~hit);
     if (xsimd::any(descend)) descend_to_child(descend, c, x0, y0, dx, dy, inv_dx, inv_dy, level, cx, cy);
     // At or above the cell's maximum where it enters: above it all the way through; on to the next cell.
-    const Mask advance = active & !below;
+    const Mask advance = active & ~below;
     if (!xsimd::any(advance)) continue;
     Float tx, ty;
     exit_walls(level, cx, cy, x0, y0, dx, dy, inv_dx, inv_dy, step_x_pos, step_y_pos, tx, ty);
@@ -128,7 +128,7 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     cx = xsimd::select(cross_x, cx + step_x, cx);
     cy = xsimd::select(cross_y, cy + step_y, cy);
     climb_aligned(level, cx, cy, moving, cross_x, cross_y, step_x_pos, step_y_pos, top);
-    active = active & !(advance & (p.s - c <= floor_depth));
+    active = active & ~(advance & (p.s - c <= floor_depth));
   }
   return {xsimd::select(occluded, zero, Float(1.0f)), loop.iterations()};
 }

@@ -121,7 +121,7 @@ inline void climb_aligned(simd::Int& level, simd::Int& cx, simd::Int& cy, simd::
   climbing = climbing & (level < Int(top));
   for (int k = 0; k < top && xsimd::any(climbing); ++k) {
     const IntMask odd_x = (cx & Int(1)) == Int(1), odd_y = (cy & Int(1)) == Int(1);
-    const IntMask ok = climbing & ((!cross_x) | (step_x_pos ^ odd_x)) & ((!cross_y) | (step_y_pos ^ odd_y));
+    const IntMask ok = climbing & ((~cross_x) | (step_x_pos ^ odd_x)) & ((~cross_y) | (step_y_pos ^ odd_y));
     level = xsimd::select(ok, level + Int(1), level);
     cx = xsimd::select(ok, cx >> 1, cx);
     cy = xsimd::select(ok, cy >> 1, cy);
