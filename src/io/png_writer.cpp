@@ -1,11 +1,13 @@
 #include "io/png_writer.hpp"
 
+#include <isa-l/igzip_lib.h>
 #include <libdeflate.h>
 #include <png.h>
 
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -24,14 +26,39 @@ namespace {
 
 void on_warning(png_structp, png_const_charp) {}
 
-// The IDAT payload: every row with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
-// less zeros), as one zlib stream from libdeflate at `level`. Up is the fastest filter to apply; on the canonical
-// 1080p render it gives 1.67 MB at level 1, where libpng's per-row choice among all five with zlib level 3 gave
-// 1.71 MB (docs/performance.md). Empty on failure. Its buffers are not zeroed first (every byte is written) and
-// take huge pages where they are large (DefaultInitAllocator): fresh pages cost a fault each otherwise.
 using Bytes = std::vector<unsigned char, DefaultInitAllocator<unsigned char>>;
-Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows,
-                                           int level) {
+
+// `in` as one zlib stream from ISA-L's igzip at its level 1, in one call; empty if it did not fit `out`'s bound
+// (then the caller takes libdeflate).
+Bytes igzip_zlib(const Bytes& in) {
+  // igzip's level 1 wants a work buffer of this size (its "large" default: the best ratio of the level).
+  Bytes work(ISAL_DEF_LVL1_DEFAULT);
+  // Room for stored blocks (5 bytes per 64 KiB) on incompressible rows, the zlib header and trailer, and slack.
+  Bytes out(in.size() + in.size() / 64 + 1024);
+  isal_zstream stream;
+  isal_deflate_stateless_init(&stream);
+  stream.level = 1;
+  stream.level_buf = work.data();
+  stream.level_buf_size = std::uint32_t(work.size());
+  stream.gzip_flag = IGZIP_ZLIB;
+  stream.end_of_stream = 1;
+  stream.flush = NO_FLUSH;
+  stream.next_in = const_cast<unsigned char*>(in.data());
+  stream.avail_in = std::uint32_t(in.size());
+  stream.next_out = out.data();
+  stream.avail_out = std::uint32_t(out.size());
+  if (isal_deflate_stateless(&stream) != COMP_OK) return {};
+  out.resize(stream.total_out);
+  return out;
+}
+
+// The IDAT payload: every row with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
+// less zeros), as one zlib stream: from igzip at kPngFastLevel, else from libdeflate at `level`. Up is the fastest
+// filter to apply; on the canonical 1080p render it gives 1.67 MB with libdeflate's level 1, where libpng's
+// per-row choice among all five with zlib level 3 gave 1.71 MB (docs/performance.md). Empty on failure. Its
+// buffers are not zeroed first (every byte is written) and take huge pages where they are large
+// (DefaultInitAllocator): fresh pages cost a fault each otherwise.
+Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows, int level) {
   Bytes filtered((row_bytes + 1) * rows);
   for (std::size_t y = 0; y < rows; ++y) {
     unsigned char* out = filtered.data() + y * (row_bytes + 1);
@@ -43,6 +70,11 @@ Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::siz
     }
     const unsigned char* above = row - row_bytes;
     for (std::size_t i = 0; i < row_bytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - above[i]);
+  }
+  // igzip takes 32-bit sizes; beyond them (a PNG over 4 GiB of rows), and should its bound not fit, libdeflate.
+  if (level == kPngFastLevel && filtered.size() < (std::size_t(1) << 31)) {
+    Bytes fast = igzip_zlib(filtered);
+    if (!fast.empty()) return fast;
   }
   const std::unique_ptr<libdeflate_compressor, decltype(&libdeflate_free_compressor)> compressor(
       libdeflate_alloc_compressor(level), libdeflate_free_compressor);

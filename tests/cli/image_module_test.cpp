@@ -89,7 +89,7 @@ TEST(ImageModule, DirectPngHoldsTheCodesOfTheLinearRender) {
     ASSERT_EQ(std::uint32_t(codes[i]), srgb_code(linear[i], 255.0f)) << "value " << i << ": linear " << linear[i];
 }
 
-// --smallest-png: libdeflate's smallest level instead of its fastest; the same pixels in a smaller file. (The
+// --smallest-png: libdeflate's smallest level instead of igzip's fast one; the same pixels in a smaller file. (The
 // plane at 192x108: a frame small enough to render in a moment, large enough that the levels' sizes differ.)
 TEST(ImageModule, SmallestPngHoldsTheSamePixelsInFewerBytes) {
   TempDir dir;
