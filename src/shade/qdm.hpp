@@ -23,11 +23,10 @@ public:
   QdmWalk(const Surface& surface, const Ray& ray, const Float& ds, const Float& stop_level, const Int& cap,
           const Mask& active)
       : surface_(surface), ray_(ray), ds_(ds), top_(surface.top_level()),
-        x0_(ray.u0 * Float(float(surface.width()))), y0_(ray.v0 * Float(float(surface.height()))),
-        dx_(ray.du * Float(float(surface.width()))), dy_(ray.dv * Float(float(surface.height()))),
-        inv_dx_(Float(1.0f) / dx_), inv_dy_(Float(1.0f) / dy_),
-        step_x_pos_(int_mask(dx_ > Float(0.0f))), step_y_pos_(int_mask(dy_ > Float(0.0f))), level_(top_),
-        cx_(xsimd::to_int(xsimd::floor(x0_)) >> top_), cy_(xsimd::to_int(xsimd::floor(y0_)) >> top_),
+        grid_(ray.u0 * Float(float(surface.width())), ray.v0 * Float(float(surface.height())),
+              ray.du * Float(float(surface.width())), ray.dv * Float(float(surface.height()))),
+        level_(top_), cx_(xsimd::to_int(xsimd::floor(grid_.x0)) >> top_),
+        cy_(xsimd::to_int(xsimd::floor(grid_.y0)) >> top_),
         stop_(xsimd::to_int(stop_level)), active_(active), loop_(cap, FetchPhase::Trace) {}
   QdmWalk(const QdmWalk&) = delete;
   QdmWalk& operator=(const QdmWalk&) = delete;
@@ -53,7 +52,7 @@ public:
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
     const Mask above = active_ & ~below;
     Float tx, ty;
-    exit_walls<fp64>(level_, cx_, cy_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, step_x_pos_, step_y_pos_, tx, ty);
+    exit_walls<fp64>(level_, cx_, cy_, grid_, tx, ty);
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s_);
     const Mask to_plane = above & (top_depth <= t_wall);
     s_ = xsimd::select(to_plane, top_depth, s_);
@@ -68,7 +67,7 @@ public:
     }
     // No branch on whether any lane descends or crosses: a mispredicted one would also throw away the other
     // walk's steps in flight (qdm_pair).
-    descend_to_child<fp64>(int_mask(descend), s_, x0_, y0_, dx_, dy_, inv_dx_, inv_dy_, level_, cx_, cy_);
+    descend_to_child<fp64>(int_mask(descend), s_, grid_, level_, cx_, cy_);
     const Mask cross = above & ~to_plane;
     s_ = xsimd::select(cross, t_wall, s_);
     const IntMask cross_i = int_mask(cross);
@@ -78,13 +77,13 @@ public:
       // fp32 emulation: the cell is found again from the position, nudged 1/64 texel along the ray.
       const Float nudge = Float(1.0f / 64.0f);
       const Float cell = xsimd::to_float(Int(1) << level_);
-      const Float px = x0_ + dx_ * s_ + xsimd::select(dx_ > Float(0.0f), nudge, Float(0.0f) - nudge);
-      const Float py = y0_ + dy_ * s_ + xsimd::select(dy_ > Float(0.0f), nudge, Float(0.0f) - nudge);
+      const Float px = grid_.x0 + grid_.dx * s_ + xsimd::select(float_mask(grid_.pos_x), nudge, Float(0.0f) - nudge);
+      const Float py = grid_.y0 + grid_.dy * s_ + xsimd::select(float_mask(grid_.pos_y), nudge, Float(0.0f) - nudge);
       cx_ = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx_);
       cy_ = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy_);
     } else {
-      cx_ = xsimd::select(cross_x, xsimd::select(step_x_pos_, cx_ + Int(1), cx_ - Int(1)), cx_);
-      cy_ = xsimd::select(cross_y, xsimd::select(step_y_pos_, cy_ + Int(1), cy_ - Int(1)), cy_);
+      cx_ = xsimd::select(cross_x, xsimd::select(grid_.pos_x, cx_ + Int(1), cx_ - Int(1)), cx_);
+      cy_ = xsimd::select(cross_y, xsimd::select(grid_.pos_y, cy_ + Int(1), cy_ - Int(1)), cy_);
     }
     // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
     // while the wall just crossed is also a wall of the parent.
@@ -94,7 +93,7 @@ public:
       cx_ = xsimd::select(up, cx_ >> 1, cx_);
       cy_ = xsimd::select(up, cy_ >> 1, cy_);
     } else if constexpr (V::level_up == QdmLevelUp::Aligned) {
-      climb_aligned(level_, cx_, cy_, cross_i, cross_x, cross_y, step_x_pos_, step_y_pos_, top_);
+      climb_aligned(level_, cx_, cy_, cross_i, cross_x, cross_y, grid_.pos_x, grid_.pos_y, top_);
     }
     return true;
   }
@@ -107,9 +106,7 @@ private:
   const Ray& ray_;
   const Float ds_;
   const int top_;
-  const Float x0_, y0_, dx_, dy_;  // the ray in texels per unit of depth
-  const Float inv_dx_, inv_dy_;    // 1 / dx, 1 / dy (crossing)
-  const IntMask step_x_pos_, step_y_pos_;
+  const GridRay grid_;  // the ray in texels per unit of depth
   Int level_, cx_, cy_;
   const Int stop_;
   Float s_ = Float(0.0f);

@@ -78,8 +78,9 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   const Float x0 = (p.u - xsimd::floor(p.u)) * width, y0 = (p.v - xsimd::floor(p.v)) * height;
   const RepeatOrigin origin(p, surface.width(), surface.height());
   const Float dx = p.du * width, dy = p.dv * height;  // texels per unit of depth climbed
-  const Float inv_dx = Float(1.0f) / dx, inv_dy = Float(1.0f) / dy;
-  const IntMask step_x_pos = int_mask(dx > zero), step_y_pos = int_mask(dy > zero);
+  const GridRay ray(x0, y0, dx, dy);
+  const Float inv_dx = ray.inv_dx, inv_dy = ray.inv_dy;
+  const IntMask step_x_pos = ray.pos_x, step_y_pos = ray.pos_y;
   const Int step_x = xsimd::select(step_x_pos, Int(1), Int(-1)), step_y = xsimd::select(step_y_pos, Int(1), Int(-1));
 
   // Along a wall the ray is never inside a column.
@@ -116,12 +117,12 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     active = active & ~hit;
     // Below the cell's maximum above level 0: descend into the child that holds the ray at c (QDM's rule).
     const IntMask descend = int_mask(below & ~hit);
-    if (xsimd::any(descend)) descend_to_child(descend, c, x0, y0, dx, dy, inv_dx, inv_dy, level, cx, cy);
+    if (xsimd::any(descend)) descend_to_child(descend, c, ray, level, cx, cy);
     // At or above the cell's maximum where it enters: above it all the way through; on to the next cell.
     const Mask advance = active & ~below;
     if (!xsimd::any(advance)) continue;
     Float tx, ty;
-    exit_walls(level, cx, cy, x0, y0, dx, dy, inv_dx, inv_dy, step_x_pos, step_y_pos, tx, ty);
+    exit_walls(level, cx, cy, ray, tx, ty);
     c = xsimd::select(advance, xsimd::max(xsimd::min(tx, ty), c), c);
     const IntMask moving = int_mask(advance);
     const IntMask cross_x = moving & int_mask(tx <= ty), cross_y = moving & int_mask(ty <= tx);

@@ -68,46 +68,55 @@ inline simd::Float crossing(const simd::Float& wall, const simd::Float& origin, 
   }
 }
 
-// Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray x(t) = x0 + dx t,
-// y(t) = y0 + dy t (texel units; inv_dx = fl(1 / dx), inv_dy = fl(1 / dy)) at t: t is compared with where the ray
-// crosses the parent's mid lines, computed exactly as wall crossings are, so a ray standing on a wall is never put
-// back into the cell it just left.
+// A ray over a texel grid, x(t) = x0 + dx t, y(t) = y0 + dy t (texel units), with what every cell step asks of
+// it computed once: the reciprocals of its direction (crossing) and the sign of each axis, as masks.
+struct GridRay {
+  GridRay(const simd::Float& x0_in, const simd::Float& y0_in, const simd::Float& dx_in, const simd::Float& dy_in)
+      : x0(x0_in), y0(y0_in), dx(dx_in), dy(dy_in), inv_dx(simd::Float(1.0f) / dx), inv_dy(simd::Float(1.0f) / dy),
+        pos_x(simd::int_mask(dx > simd::Float(0.0f))), pos_y(simd::int_mask(dy > simd::Float(0.0f))),
+        neg_x(dx < simd::Float(0.0f)), neg_y(dy < simd::Float(0.0f)), flat_x(dx == simd::Float(0.0f)),
+        flat_y(dy == simd::Float(0.0f)) {}
+
+  simd::Float x0, y0, dx, dy;
+  simd::Float inv_dx, inv_dy;  // fl(1 / dx), fl(1 / dy)
+  simd::IntMask pos_x, pos_y;  // dx > 0, dy > 0: the cell index steps up
+  simd::Mask neg_x, neg_y;     // dx < 0, dy < 0
+  simd::Mask flat_x, flat_y;   // dx == 0, dy == 0: parallel to that axis's walls
+};
+
+// Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray at t: t is compared with
+// where the ray crosses the parent's mid lines, computed exactly as wall crossings are, so a ray standing on a wall
+// is never put back into the cell it just left.
 template <bool Fp64 = false>
-inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const simd::Float& x0,
-                             const simd::Float& y0, const simd::Float& dx, const simd::Float& dy,
-                             const simd::Float& inv_dx, const simd::Float& inv_dy, simd::Int& level, simd::Int& cx,
-                             simd::Int& cy) {
+inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const GridRay& ray, simd::Int& level,
+                             simd::Int& cx, simd::Int& cy) {
   using simd::Float;
   using simd::Int;
   const Int child_level = xsimd::max(level - Int(1), Int(0));
   const Float child_cell = xsimd::to_float(Int(1) << child_level);
   const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
   const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
-  const Float zero(0.0f);
-  const Float tx = crossing<Fp64>(mid_x, x0, dx, inv_dx), ty = crossing<Fp64>(mid_y, y0, dy, inv_dy);
-  const simd::Mask high_x = ((dx > zero) & (t >= tx)) | ((dx < zero) & (t < tx)) | ((dx == zero) & (x0 >= mid_x));
-  const simd::Mask high_y = ((dy > zero) & (t >= ty)) | ((dy < zero) & (t < ty)) | ((dy == zero) & (y0 >= mid_y));
+  const Float tx = crossing<Fp64>(mid_x, ray.x0, ray.dx, ray.inv_dx), ty = crossing<Fp64>(mid_y, ray.y0, ray.dy, ray.inv_dy);
+  const simd::Mask high_x = (simd::float_mask(ray.pos_x) & (t >= tx)) | (ray.neg_x & (t < tx)) | (ray.flat_x & (ray.x0 >= mid_x));
+  const simd::Mask high_y = (simd::float_mask(ray.pos_y) & (t >= ty)) | (ray.neg_y & (t < ty)) | (ray.flat_y & (ray.y0 >= mid_y));
   cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
   cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
   level = xsimd::select(descend, child_level, level);
 }
 
-// Where the ray x(t) = x0 + dx t, y(t) = y0 + dy t (texel units; inv_dx = fl(1 / dx), inv_dy = fl(1 / dy)) crosses
-// the exit walls of cell (cx, cy) of `level` (the walls ahead in each axis: step_*_pos says which), as t; infinity
+// Where the ray crosses the exit walls of cell (cx, cy) of `level` (the walls ahead in each axis), as t; infinity
 // in an axis the ray is parallel to.
 template <bool Fp64 = false>
-inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const simd::Float& x0,
-                       const simd::Float& y0, const simd::Float& dx, const simd::Float& dy, const simd::Float& inv_dx,
-                       const simd::Float& inv_dy, const simd::IntMask& step_x_pos, const simd::IntMask& step_y_pos, simd::Float& tx,
-                       simd::Float& ty) {
+inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const GridRay& ray,
+                       simd::Float& tx, simd::Float& ty) {
   using simd::Float;
   using simd::Int;
-  const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
+  const Float inf(std::numeric_limits<float>::infinity());
   const Float cell = xsimd::to_float(Int(1) << level);
-  const Float wall_x = xsimd::to_float(xsimd::select(step_x_pos, cx + Int(1), cx)) * cell;
-  const Float wall_y = xsimd::to_float(xsimd::select(step_y_pos, cy + Int(1), cy)) * cell;
-  tx = xsimd::select(dx != zero, crossing<Fp64>(wall_x, x0, dx, inv_dx), inf);
-  ty = xsimd::select(dy != zero, crossing<Fp64>(wall_y, y0, dy, inv_dy), inf);
+  const Float wall_x = xsimd::to_float(xsimd::select(ray.pos_x, cx + Int(1), cx)) * cell;
+  const Float wall_y = xsimd::to_float(xsimd::select(ray.pos_y, cy + Int(1), cy)) * cell;
+  tx = xsimd::select(ray.flat_x, inf, crossing<Fp64>(wall_x, ray.x0, ray.dx, ray.inv_dx));
+  ty = xsimd::select(ray.flat_y, inf, crossing<Fp64>(wall_y, ray.y0, ray.dy, ray.inv_dy));
 }
 
 // After a wall crossing, the `climbing` lanes go up while the wall just crossed (cross_x / cross_y) is also a
