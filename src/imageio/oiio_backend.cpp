@@ -107,7 +107,8 @@ bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_st
   }
   // Scanlines: read as the file stores them, top-down and contiguous, a few MB at a time, then converted and
   // flipped here. Asked for another type or row order, OpenImageIO decodes through a buffer of 64 MB whatever
-  // the image's size (ImageInput::read_scanlines), allocated for every image read.
+  // the image's size (ImageInput::read_scanlines), allocated for every image read; and OpenImageIO 2.4 takes
+  // its direct path only for TypeUnknown ("as stored"), not for the file's own type named explicitly.
   const std::size_t row_values = std::size_t(spec.width) * std::size_t(channels);
   const std::size_t row_bytes = row_values * spec.format.size();
   const int strip = std::max(1, spec.get_int_attribute("tiff:RowsPerStrip", 64));
@@ -115,7 +116,7 @@ bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_st
   std::unique_ptr<unsigned char[]> native(new unsigned char[row_bytes * std::size_t(rows)]);
   for (int y0 = 0; y0 < spec.height; y0 += rows) {
     const int y1 = std::min(y0 + rows, spec.height);
-    if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, channels, spec.format, native.get()) ||
+    if (!in.read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, channels, OIIO::TypeUnknown, native.get()) ||
         in.has_error())
       return failed();
     for (int y = y0; y < y1; ++y) {
