@@ -47,9 +47,10 @@ private:
 
 // Where the ray x(t) = origin + dir t crosses the line x = wall, per lane: in fp32 (wall - origin) * inv_dir, with
 // inv_dir = fl(1 / dir) computed once per ray (as GPUs divide: a reciprocal, then a product; dividing at every
-// crossing made the canonical QDM frame about 9 % slower), or with Fp64 (wall - origin) / dir in fp64 rounded once to fp32 (the
-// `exact` math mode's QDM walk). Either way the same line always gives the same t, and t is monotonic in the wall,
-// which is what the cell stepping needs: a ray standing on a wall is never put back into the cell it just left.
+// crossing made the canonical QDM frame about 9 % slower), or with Fp64 (wall - origin) / dir in fp64 rounded once
+// to fp32 (the `exact` math mode's QDM walk). Either way the same line always gives the same t, and t is monotonic
+// in the wall, which is what the cell stepping needs: a ray standing on a wall is never put back into the cell it
+// just left.
 // Lanes with dir 0 give an infinity or NaN for the caller to select away.
 template <bool Fp64>
 inline simd::Float crossing(const simd::Float& wall, const simd::Float& origin, const simd::Float& dir,
@@ -96,9 +97,12 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
   const Float child_cell = xsimd::to_float(Int(1) << child_level);
   const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
   const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
-  const Float tx = crossing<Fp64>(mid_x, ray.x0, ray.dx, ray.inv_dx), ty = crossing<Fp64>(mid_y, ray.y0, ray.dy, ray.inv_dy);
-  const simd::Mask high_x = (simd::float_mask(ray.pos_x) & (t >= tx)) | (ray.neg_x & (t < tx)) | (ray.flat_x & (ray.x0 >= mid_x));
-  const simd::Mask high_y = (simd::float_mask(ray.pos_y) & (t >= ty)) | (ray.neg_y & (t < ty)) | (ray.flat_y & (ray.y0 >= mid_y));
+  const Float tx = crossing<Fp64>(mid_x, ray.x0, ray.dx, ray.inv_dx);
+  const Float ty = crossing<Fp64>(mid_y, ray.y0, ray.dy, ray.inv_dy);
+  const simd::Mask high_x =
+      (simd::float_mask(ray.pos_x) & (t >= tx)) | (ray.neg_x & (t < tx)) | (ray.flat_x & (ray.x0 >= mid_x));
+  const simd::Mask high_y =
+      (simd::float_mask(ray.pos_y) & (t >= ty)) | (ray.neg_y & (t < ty)) | (ray.flat_y & (ray.y0 >= mid_y));
   cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
   cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
   level = xsimd::select(descend, child_level, level);
