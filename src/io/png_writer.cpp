@@ -31,8 +31,9 @@ using Bytes = std::vector<unsigned char, DefaultInitAllocator<unsigned char>>;
 // `in` as one zlib stream from ISA-L's igzip at its level 1, in one call; empty if it did not fit `out`'s bound
 // (then the caller takes libdeflate).
 Bytes igzip_zlib(const Bytes& in) {
-  // igzip's level 1 wants a work buffer of this size (its "large" default: the best ratio of the level).
-  Bytes work(ISAL_DEF_LVL1_DEFAULT);
+  // igzip's level 1 wants a work buffer of this size (its "large" default: the best ratio of the level), zeroed
+  // (about 300 KB): what it holds must not depend on what the allocator gave back, or the bytes written might.
+  std::vector<unsigned char> work(ISAL_DEF_LVL1_DEFAULT);
   // Room for stored blocks (5 bytes per 64 KiB) on incompressible rows, the zlib header and trailer, and slack.
   Bytes out(in.size() + in.size() / 64 + 1024);
   isal_zstream stream;
@@ -71,7 +72,8 @@ Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::siz
     const unsigned char* above = row - row_bytes;
     for (std::size_t i = 0; i < row_bytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - above[i]);
   }
-  // igzip takes 32-bit sizes; beyond them (a PNG over 4 GiB of rows), and should its bound not fit, libdeflate.
+  // igzip takes 32-bit sizes: from 2 GiB of rows on (the output's bound must fit too), and should its bound not
+  // fit, libdeflate.
   if (level == kPngFastLevel && filtered.size() < (std::size_t(1) << 31)) {
     Bytes fast = igzip_zlib(filtered);
     if (!fast.empty()) return fast;
