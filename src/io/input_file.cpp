@@ -20,6 +20,13 @@ std::vector<KnownInput>& inputs() {
   return list;
 }
 
+void note_identity(const FileIdentity& id, const std::filesystem::path& file) {
+  const std::lock_guard lock(inputs_mutex);
+  for (const KnownInput& k : inputs())
+    if (k.id == id) return;
+  inputs().push_back({id, file});
+}
+
 std::string type_reason(mode_t mode) {
   if (S_ISREG(mode)) return "";
   if (S_ISDIR(mode)) return "is a directory, not a file";
@@ -92,7 +99,7 @@ std::uint64_t check_input_file(const std::filesystem::path& file, const std::str
   std::string reason = type_reason(st.st_mode);
   if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
   if (!reason.empty()) throw Error(where, about(file, where, reason));
-  note_input(file);
+  note_identity({st.st_dev, st.st_ino}, file);
   return std::uint64_t(st.st_size);
 }
 
@@ -109,22 +116,25 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
   std::string reason = type_reason(st.st_mode);
   if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
   if (!reason.empty()) throw Error(where, about(file, where, reason));
-  // Read up to the limit + 1: a file growing while it is read is still bounded.
+  // The size fstat gave, then a probe for more through a small buffer: a file that grew while it is read is
+  // still read to its end, bounded by the limit + 1, and a file that did not grow costs no larger buffer.
   const std::uint64_t limit = input_size_limit(kind);
   std::string text;
   text.resize(std::size_t(st.st_size));
   std::size_t have = 0;
+  char probe[4096];
   for (;;) {
-    if (have == text.size()) {
-      if (text.size() > limit) break;
-      text.resize(std::min<std::size_t>(std::size_t(limit) + 1, text.size() + 65536));
-    }
-    const ssize_t n = ::read(fd, text.data() + have, text.size() - have);
+    const bool probing = have == text.size();
+    if (probing && have > limit) break;
+    char* const into = probing ? probe : text.data() + have;
+    const std::size_t room = probing ? sizeof probe : text.size() - have;
+    const ssize_t n = ::read(fd, into, room);
     if (n < 0) {
       if (errno == EINTR) continue;
       throw Error(where, "cannot read " + file.string() + ": " + std::strerror(errno));
     }
     if (n == 0) break;
+    if (probing) text.append(probe, std::size_t(n));
     have += std::size_t(n);
   }
   text.resize(have);
@@ -134,12 +144,7 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
 
 void note_input(const std::filesystem::path& file) {
   struct stat st {};
-  if (::stat(file.c_str(), &st) != 0) return;
-  const FileIdentity id{st.st_dev, st.st_ino};
-  const std::lock_guard lock(inputs_mutex);
-  for (const KnownInput& k : inputs())
-    if (k.id == id) return;
-  inputs().push_back({id, file});
+  if (::stat(file.c_str(), &st) == 0) note_identity({st.st_dev, st.st_ino}, file);
 }
 
 std::vector<KnownInput> known_inputs() {
