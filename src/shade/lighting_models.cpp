@@ -41,7 +41,7 @@ void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, cons
                      ? cook_torrance(n_dot_l, n_dot_v, xsimd::max(dot(shading_normal, h), zero),
                                      xsimd::max(dot(view, h), zero), surface.specular, lighting.roughness) *
                            facing
-                     : detmath::pow(xsimd::max(dot(shading_normal, h), zero), Float(lighting.shininess)) *
+                     : detmath::pow_uniform(xsimd::max(dot(shading_normal, h), zero), lighting.shininess) *
                            surface.specular * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
     if (light_visibility) {
       n_dot_l = n_dot_l * light_visibility[i];
@@ -62,7 +62,7 @@ Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs
   const Float luminance = Float(0.2126f) * albedo[0] + Float(0.7152f) * albedo[1] + Float(0.0722f) * albedo[2];
   const Float clamped = xsimd::min(xsimd::max(luminance, Float(0.0f)), one);
   const Float x = coeffs.invert ? one - clamped : clamped;
-  return Float(coeffs.scale) * detmath::pow(x, Float(coeffs.power));
+  return Float(coeffs.scale) * detmath::pow_uniform(x, coeffs.power);
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE::shading

@@ -16,7 +16,8 @@ namespace qdmr::shading {
 namespace {
 
 // The Blinn-Phong the programs used before lighting_models.hpp (kept here as the oracle: the golden images
-// were made with it): directional lights plus ambient; `geometric` gates highlights below the polygon.
+// were made with it; since bits version 4 with the highlight's power by detmath::pow_uniform): directional lights
+// plus ambient; `geometric` gates highlights below the polygon.
 inline void blinn_phong(const Vec3& shading_normal, const Vec3& geometric, const Vec3& view, const Float* albedo,
                         const LightingDesc& lighting, const LightRig& lights, Float* color) {
   Float diffuse[3] = {Float(lights.ambient.x), Float(lights.ambient.y), Float(lights.ambient.z)};
@@ -27,7 +28,7 @@ inline void blinn_phong(const Vec3& shading_normal, const Vec3& geometric, const
     const Float n_dot_l = xsimd::max(dot(shading_normal, l), zero);
     const Vec3 h = normalize(add(l, view));
     const Float facing = xsimd::select(dot(geometric, l) > zero, Float(1.0f), zero);
-    const Float spec = detmath::pow(xsimd::max(dot(shading_normal, h), zero), Float(lighting.shininess)) *
+    const Float spec = detmath::pow_uniform(xsimd::max(dot(shading_normal, h), zero), lighting.shininess) *
                        Float(lighting.specular) * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
     const float radiance[3] = {light.radiance.x, light.radiance.y, light.radiance.z};
     for (int c = 0; c < 3; ++c) {
@@ -273,7 +274,8 @@ TEST(LightingModels, SpecularFromAlbedo) {
           const double luminance = 0.2126 * r[k] + 0.7152 * g[k] + 0.0722 * b[k];
           const double x = invert ? 1.0 - luminance : luminance;
           const double expected = 0.7 * std::pow(x, double(power));
-          // detmath::pow: log2 within 2e-7 absolute, times power <= 4, and exp2 within 3e-7 relative (~1.1e-6);
+          // detmath::pow (powers 0.5, 2.5): log2 within 2e-7 absolute, times power <= 4, and exp2 within 3e-7
+          // relative (~1.1e-6); pow_whole (powers 1, 4): 3 roundings (1.8e-7);
           // the fp32 luminance (3 products, 2 sums: <= 4 ulp = 5e-7 relative) raised to power <= 4 (2e-6).
           // For x near 0 after inversion the relative rounding of 1 - luminance grows: an absolute 1e-6 covers it.
           EXPECT_NEAR(got[k], expected, 4e-6 * expected + 1e-6) << power << invert << l;
