@@ -82,11 +82,13 @@ inline simd::Float pow(const simd::Float& x, const simd::Float& y) {
 // The largest exponent pow_uniform() raises to by multiplication: x^1024 takes 10 squarings and 1 product.
 inline constexpr float kMaxProductExponent = 1024.0f;
 
-// x^n for a whole n >= 1 by binary exponentiation: x^(2^k) by squaring, multiplied into the result low bit first,
-// the same products in the same order for a scalar and for every lane. Its n - 1 roundings leave x^n within about
-// (n - 1) 2^-24 relative (while the result is a normal float), where exp2(n log2 x) is within n * 1.4e-7 + 3e-7.
-inline float pow_whole(float x, unsigned n) {
-  float result = 1.0f, square = x;
+// x^n for a whole n >= 1 by binary exponentiation: x^(2^k) by squaring, multiplied into the result low bit first;
+// one template for scalars and batches, so a lane of a batch gives exactly the scalar result. Its n - 1 roundings
+// leave x^n within about (n - 1) 2^-24 relative (while the result is a normal float), where exp2(n log2 x) is
+// within n * 1.4e-7 + 3e-7.
+template <class T>
+inline T pow_whole(const T& x, unsigned n) {
+  T result(1.0f), square = x;
   for (;;) {
     if (n & 1u) result *= square;
     n >>= 1;
@@ -95,21 +97,12 @@ inline float pow_whole(float x, unsigned n) {
   }
 }
 
-inline simd::Float pow_whole(const simd::Float& x, unsigned n) {
-  simd::Float result(1.0f), square = x;
-  for (;;) {
-    if (n & 1u) result *= square;
-    n >>= 1;
-    if (n == 0) return result;
-    square *= square;
-  }
-}
-
-// x^y for x >= 0 with one exponent y for every lane (a material's shininess, say): a whole y in
-// [1, kMaxProductExponent] by pow_whole (a handful of products instead of a log2 and an exp2), any other y as pow.
-// 0^y = 0 for y > 0; a lane with x NaN or <= 0 gives 0, as pow's.
+// Whether pow_uniform() raises to y by products: a whole y in [1, kMaxProductExponent].
 inline bool is_product_exponent(float y) { return y >= 1.0f && y <= kMaxProductExponent && y == float(int(y)); }
 
+// x^y for x >= 0 with one exponent y for every lane (a material's shininess, say): by pow_whole (a handful of
+// products instead of a log2 and an exp2) where is_product_exponent(y), else as pow. 0^y = 0 for y > 0; a lane
+// with x NaN or <= 0 gives 0, as pow's.
 inline float pow_uniform(float x, float y) {
   if (!is_product_exponent(y)) return pow(x, y);
   return x > 0.0f ? pow_whole(x, unsigned(y)) : 0.0f;
