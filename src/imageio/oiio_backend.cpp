@@ -1,5 +1,6 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -8,12 +9,19 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string_view>
+#include <vector>
 
 #include "imageio/backend.hpp"
+#include "imageio/jpeg_segments.hpp"
 
 namespace qdmr::imageio {
 
 struct Reader {
+  // A JPEG without its metadata segments (imageio/jpeg_segments.hpp) is read from memory: the bytes and their
+  // proxy outlive the input (members are destroyed last to first).
+  std::vector<unsigned char> bytes;
+  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
   std::unique_ptr<OIIO::ImageInput> input;
 };
 
@@ -28,11 +36,32 @@ OIIO::TypeDesc type_desc(PixelType type) {
   return OIIO::TypeDesc::FLOAT;
 }
 
+// Opens `input` on `path`, a JPEG through imageio/jpeg_segments.hpp: from memory without its metadata segments,
+// or refused when its segments before the first scan are damaged.
+bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path, Reader& reader, std::string& error) {
+  OIIO::ImageSpec header;
+  if (input->format_name() == std::string_view("jpeg")) {
+    std::vector<unsigned char> stripped;
+    if (!jpeg_without_metadata(path, stripped, error)) return false;
+    if (!stripped.empty()) {
+      reader.bytes = std::move(stripped);
+      reader.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(reader.bytes.data(), reader.bytes.size());
+      input->set_ioproxy(reader.proxy.get());
+    }
+  }
+  if (!input->open(path, header)) {
+    error = input->geterror();
+    return false;
+  }
+  reader.input = std::move(input);
+  return true;
+}
+
 // The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads
 // textures from, each of which checks the magic number first (valid_file). OpenImageIO's own fallback
 // (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file:
 // each a decoder run on an untrusted file for a format qdmr refuses anyway, and a few milliseconds.
-std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, std::string& error) {
+bool open_input(const std::string& path, Reader& reader, std::string& error) {
   // OpenImageIO's "extension_list": "tiff:tif,tiff;jpeg:jpg,jpe,jpeg;..." (every reader's and writer's).
   static const std::map<std::string, std::string> formats = [] {
     std::map<std::string, std::string> map;
@@ -53,26 +82,25 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, std::strin
     // A format name alone: the reader is created, not opened.
     if (auto input = OIIO::ImageInput::create(format->second)) {
       tried = input->format_name();
-      OIIO::ImageSpec header;
-      if (input->open(path, header)) return input;
-      error = input->geterror();
+      if (open_file(std::move(input), path, reader, error)) return true;
     }
   }
   for (const char* format : {"png", "jpeg", "openexr", "tiff", "pnm"}) {
     if (format == tried) continue;
     auto input = OIIO::ImageInput::create(format);
     if (!input || !input->valid_file(path)) continue;
-    OIIO::ImageSpec header;
-    if (input->open(path, header)) return input;
-    if (error.empty()) error = input->geterror();
+    std::string failed;
+    if (open_file(std::move(input), path, reader, failed)) return true;
+    if (error.empty()) error = failed;
   }
   if (error.empty()) error = tried.empty() ? "not a PNG, JPEG, OpenEXR, TIFF or PNM file" : "not a " + tried + " file";
-  return nullptr;
+  return false;
 }
 
 Reader* open(const std::string& path, ReadSpec& spec, std::string& error) {
-  auto input = open_input(path, error);
-  if (!input) return nullptr;
+  auto reader = std::make_unique<Reader>();
+  if (!open_input(path, *reader, error)) return nullptr;
+  const OIIO::ImageInput* input = reader->input.get();
   const OIIO::ImageSpec& s = input->spec();
   spec.width = s.width;
   spec.height = s.height;
@@ -85,7 +113,7 @@ Reader* open(const std::string& path, ReadSpec& spec, std::string& error) {
                                                    : PixelType::Float;
   spec.bits_version = s.get_string_attribute("qdmr:bits_version");
   spec.software = s.get_string_attribute("Software");
-  return new Reader{std::move(input)};
+  return reader.release();
 }
 
 bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {

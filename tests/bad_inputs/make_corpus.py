@@ -84,6 +84,12 @@ def exr_window(data, xmin, ymin, xmax, ymax):
     at = data.index(key) + len(key)
     return data[:at] + struct.pack("<iiii", xmin, ymin, xmax, ymax) + data[at + 16:]
 
+def jpeg_segment(marker, payload):
+    return bytes([0xFF, marker]) + struct.pack(">H", len(payload) + 2) + payload
+
+# Photoshop's image resource 0x0404 (IPTC) holding a record (1C 02 ...) that claims 32752 bytes.
+iptc_past_end = b"8BIM\x04\x04\0\0" + struct.pack(">I", 12) + b"\x1c\x02\x78\x7f\xf0caption"
+
 # --- bad images: (file, reason fragment) --------------------------------------------------------------
 images = [
     ("empty.png", b"", "is empty (0 bytes)"),
@@ -108,6 +114,14 @@ images = [
     ("jpeg_truncated_end.jpg", jpg[:-2], "truncated JPEG"),
     ("jpeg_soi_only.jpg", jpg[:2], "cannot read"),
     ("jpeg_header_only.jpg", jpg[:300], "cannot read"),
+    # Found by fuzz_image: OpenImageIO 2.4's IPTC decoder read past a Photoshop (APP13) segment whose record
+    # claims more bytes than the segment has (a heap-buffer-overflow under ASan). qdmr walks a JPEG's segments
+    # first: metadata segments are dropped before the reader sees the file (a JPEG with whole ones reads fine:
+    # tests/io/jpeg_segments_test.cpp), and a file whose segments are not whole is refused, as these two.
+    ("jpeg_not_a_marker_then_iptc.jpg", jpg[:2] + b"\xff\x00" * 4 + jpeg_segment(0xED, b"Photoshop 3.0\0" + iptc_past_end)
+     + jpg[2:], "damaged JPEG (byte 2 is not a marker, before the first scan)"),
+    ("jpeg_iptc_past_end.jpg", jpg[:2] + b"\xff\xed\x7f\xff" + b"Photoshop 3.0\0" + iptc_past_end,
+     "truncated JPEG (the FFED segment at byte 2 claims 32767 bytes after its marker"),
     ("exr_truncated.exr", exr[: len(exr) // 2], "cannot read"),
     ("exr_magic_only.exr", exr[:4], "cannot read"),
     # Header fields OpenEXR allocates from before anything is checked: refused by qdmr's walk of the header.
