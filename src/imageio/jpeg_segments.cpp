@@ -24,9 +24,11 @@ std::string hex(int marker) {
 bool jpeg_without_metadata(const std::string& path, std::vector<unsigned char>& stripped, std::string& error) {
   stripped.clear();
   std::ifstream in(path, std::ios::binary);
+  // Not a JPEG (no SOI): libjpeg refuses it before it reads any segment.
+  if (in.get() != 0xFF || in.get() != 0xD8) return true;
   in.seekg(0, std::ios::end);
   const std::uint64_t size = std::uint64_t(std::max<std::streamoff>(in.tellg(), 0));
-  in.seekg(2);  // after SOI
+  in.seekg(2);
   std::uint64_t at = 2;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> drop;  // [begin, end) of each metadata segment
   const auto next = [&]() -> int {
@@ -34,28 +36,24 @@ bool jpeg_without_metadata(const std::string& path, std::vector<unsigned char>& 
     if (c != std::char_traits<char>::eof()) ++at;
     return c;
   };
+  const auto ends_early = [&] {
+    error = "truncated JPEG (it ends at byte " + std::to_string(at) + ", before its first scan)";
+    return false;
+  };
   for (;;) {
     const std::uint64_t start = at;
-    int c = next();
-    if (c == std::char_traits<char>::eof()) {
-      error = "truncated JPEG (it ends at byte " + std::to_string(at) + ", before its first scan)";
-      return false;
-    }
-    if (c != 0xFF) {
+    const auto not_a_marker = [&] {
       error = "damaged JPEG (byte " + std::to_string(start) + " is not a marker, before the first scan)";
       return false;
-    }
+    };
+    int c = next();
+    if (c == std::char_traits<char>::eof()) return ends_early();
+    if (c != 0xFF) return not_a_marker();
     while ((c = next()) == 0xFF) {  // fill bytes
     }
-    if (c == std::char_traits<char>::eof()) {
-      error = "truncated JPEG (it ends at byte " + std::to_string(at) + ", before its first scan)";
-      return false;
-    }
+    if (c == std::char_traits<char>::eof()) return ends_early();
+    if (c == 0x00) return not_a_marker();  // FF 00 is a stuffed zero byte of scan data
     const int marker = c;
-    if (marker == 0x00) {  // FF 00 is a stuffed zero byte of scan data, not a marker
-      error = "damaged JPEG (byte " + std::to_string(start) + " is not a marker, before the first scan)";
-      return false;
-    }
     if (marker == 0xDA || marker == 0xD9) break;  // the first scan (SOS), or EOI: no header segment follows
     if (standalone(marker)) continue;
     const int high = next(), low = next();

@@ -9,10 +9,11 @@
 
 namespace qdmr::imageio {
 
-// Walks the JPEG `path` (it starts FF D8) from its start to its first scan: every segment must be whole (its
-// declared length within the file) and start with a marker. Returns false with `error` set when not. Otherwise
-// `stripped` is the file without its metadata segments before the first scan (APP1 to APP13, APP15, COM; APP0
-// and APP14 stay: libjpeg reads them), or empty when it has none, so the file can be read as it is.
+// Walks the JPEG `path` from its start (SOI, FF D8) to its first scan: every segment must be whole (its declared
+// length within the file) and start with a marker. Returns false with `error` set when not. Otherwise `stripped`
+// is the file without its metadata segments before the first scan (APP1 to APP13, APP15, COM; APP0 and APP14
+// stay: libjpeg reads them), or empty when it has none or `path` does not start with SOI (libjpeg refuses such a
+// file before it reads a segment), so the file can be read as it is.
 bool jpeg_without_metadata(const std::string& path, std::vector<unsigned char>& stripped, std::string& error);
 
 }  // namespace qdmr::imageio

@@ -104,6 +104,12 @@ TEST(JpegSegments, DamagedSegmentsBeforeTheFirstScanAreRefusedWithWhatIsWrong) {
       << error_of(dir / "past_end.jpg");
   const Bytes short_length = plain.substr(0, 2) + Bytes("\xFF\xE1\x00\x01", 4) + plain.substr(2);
   EXPECT_NE(refused("short.jpg", short_length).find("declares 1 bytes"), std::string::npos);
+  // A file that does not start with SOI is left to the decoder, which refuses it before reading any segment.
+  write_bytes(dir / "png.jpg", "\x89PNG\r\n\x1A\n");
+  std::vector<unsigned char> stripped;
+  std::string error;
+  EXPECT_TRUE(imageio::jpeg_without_metadata((dir / "png.jpg").string(), stripped, error)) << error;
+  EXPECT_TRUE(stripped.empty());
   // Through read_image: one line naming the file and what is wrong.
   try {
     read_image(dir / "past_end.jpg", "test");
