@@ -170,14 +170,7 @@ Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const Ao
   const std::filesystem::path file = cache_dir / ("ao-" + hex(key) + ".bin");
   const AoMapSize size = map_size(field, desc);
   const FloatCacheId id{kMagic, kAoFormatVersion, 0, size.width, size.height, key};
-  if (std::optional<std::vector<float>> cached = read_float_cache(file, id, 0.0f, 1.0f)) {
-    Image map;  // the cached values themselves, not a second buffer
-    map.width = size.width;
-    map.height = size.height;
-    map.channels = 1;
-    map.texels = std::move(*cached);
-    return map;
-  }
+  if (Image cached(size.width, size.height, 1); read_float_cache(file, id, 0.0f, 1.0f, cached.texels)) return cached;
   Image map = bake_ao_map(field, depth_scale, desc);
   write_float_cache(file, id, map.texels);
   return map;

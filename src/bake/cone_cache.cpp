@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <optional>
 #include <string>
 
 #include "qdmr/bake/cone_map.hpp"
@@ -45,15 +44,14 @@ ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std
   const std::filesystem::path file =
       cache_dir / ("cone-" + std::string(cone_kind_name(kind)) + "-" + hex(key) + ".bin");
   const FloatCacheId id{kMagic, kConeFormatVersion, std::uint32_t(kind), field.width, field.height, key};
-  if (field.width > 0 && field.height > 0)
-    if (std::optional<std::vector<float>> cached = read_float_cache(file, id, 0.0f, kMaxConeRatio)) {
-      ConeMap map;
-      map.width = field.width;
-      map.height = field.height;
-      map.kind = kind;
-      map.ratio = std::move(*cached);
-      return map;
-    }
+  if (field.width > 0 && field.height > 0) {
+    ConeMap cached;
+    cached.width = field.width;
+    cached.height = field.height;
+    cached.kind = kind;
+    cached.ratio.resize(std::size_t(field.width) * std::size_t(field.height));
+    if (read_float_cache(file, id, 0.0f, kMaxConeRatio, cached.ratio)) return cached;
+  }
   ConeMap map = bake_cone_map(field, kind);
   write_float_cache(file, id, map.ratio);
   return map;

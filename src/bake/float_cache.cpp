@@ -22,7 +22,7 @@ struct Header {
 };
 static_assert(sizeof(Header) == 40);
 
-std::uint64_t payload_hash(const std::vector<float>& values) {
+std::uint64_t payload_hash(std::span<const float> values) {
   Fnv1a f;
   f.bytes(values.data(), values.size() * sizeof(float));
   return f.hash;
@@ -30,31 +30,31 @@ std::uint64_t payload_hash(const std::vector<float>& values) {
 
 }  // namespace
 
-std::optional<std::vector<float>> read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo,
-                                                   float hi) {
+bool read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo, float hi,
+                      std::span<float> values) {
   // Only a regular file of exactly the expected size is opened: a FIFO or device in its place is a miss, not a
   // hang (the cache is then rewritten over it by rename).
-  if (!non_regular_reason(file).empty()) return std::nullopt;
+  if (!non_regular_reason(file).empty()) return false;
   const std::size_t count = std::size_t(id.width) * std::size_t(id.height);
+  if (values.size() != count) return false;
   std::error_code ec;
-  if (std::filesystem::file_size(file, ec) != sizeof(Header) + count * sizeof(float) || ec) return std::nullopt;
+  if (std::filesystem::file_size(file, ec) != sizeof(Header) + count * sizeof(float) || ec) return false;
   std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
+  if (!in) return false;
   note_input(file);
   Header header{};
-  if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return std::nullopt;
+  if (!in.read(reinterpret_cast<char*>(&header), sizeof header)) return false;
   if (std::memcmp(header.magic, id.magic.data(), sizeof header.magic) != 0 || header.version != id.version ||
       header.tag != id.tag || header.width != id.width || header.height != id.height || header.key != id.key)
-    return std::nullopt;
-  std::vector<float> values(count);
-  if (!in.read(reinterpret_cast<char*>(values.data()), std::streamsize(count * sizeof(float)))) return std::nullopt;
-  if (payload_hash(values) != header.payload_hash) return std::nullopt;
+    return false;
+  if (!in.read(reinterpret_cast<char*>(values.data()), std::streamsize(count * sizeof(float)))) return false;
+  if (payload_hash(values) != header.payload_hash) return false;
   for (float v : values)
-    if (!(v >= lo && v <= hi)) return std::nullopt;
-  return values;
+    if (!(v >= lo && v <= hi)) return false;
+  return true;
 }
 
-void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, const std::vector<float>& values) {
+void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, std::span<const float> values) {
   std::error_code ec;
   std::filesystem::create_directories(file.parent_path(), ec);
   if (ec) return;

@@ -6,8 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
-#include <optional>
-#include <vector>
+#include <span>
 
 namespace qdmr {
 
@@ -19,8 +18,9 @@ struct FloatCacheId {
   std::uint64_t key;          // content hash of what the map was baked from
 };
 
-std::optional<std::vector<float>> read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo,
-                                                   float hi);
-void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, const std::vector<float>& values);
+// Fills `values` (id.width x id.height of them) from the cache; false, `values` unspecified, when it is not usable.
+bool read_float_cache(const std::filesystem::path& file, const FloatCacheId& id, float lo, float hi,
+                      std::span<float> values);
+void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, std::span<const float> values);
 
 }  // namespace qdmr

@@ -178,7 +178,7 @@ Image stored_pixels(const Frame& frame, std::optional<Aov> aov, const std::files
     for (std::size_t i = 0; i < image.texels.size(); ++i) image.texels[i] = float(encoded.bytes16[i]) / 65535.0f;
     image.source_bits = 16;
   } else {
-    image.texels = encoded.floats;
+    image.texels.assign(encoded.floats.begin(), encoded.floats.end());
     image.source_bits = 32;
   }
   return image;

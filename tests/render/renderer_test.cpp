@@ -21,14 +21,6 @@ SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overri
   return test::small_scene(name, std::move(overrides), 96, 54);
 }
 
-// Resident set size now (not the peak), from /proc/self/statm.
-std::uint64_t resident_bytes() {
-  std::ifstream statm("/proc/self/statm");
-  std::uint64_t size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * std::uint64_t(::sysconf(_SC_PAGESIZE));
-}
-
 TEST(Renderer, FramesEqualTheOneShotRenderAndRepeat) {
   const SceneDesc scene = small_scene("surface_blend_4layers");
   RenderOptions options;
@@ -153,9 +145,9 @@ TEST(Renderer, MemoryDoesNotGrowOverAThousandFrames) {
   Renderer renderer;
   renderer.set_scene(small_scene("plane"), {Aov::Depth, Aov::Normal});
   for (int i = 0; i < 50; ++i) renderer.draw();  // sizes settle, allocator pools fill
-  const std::uint64_t before = resident_bytes();
+  const std::uint64_t before = test::resident_bytes();
   for (int i = 0; i < 1000; ++i) renderer.draw();
-  const std::uint64_t after = resident_bytes();
+  const std::uint64_t after = test::resident_bytes();
   // One frame's buffers are 96x54x(3+1+3) floats = 145 KB; a leak of even one small allocation per frame
   // would add 1000 of them. 512 KiB of slack covers allocator and oneTBB bookkeeping noise.
   EXPECT_LT(after, before + 512 * 1024) << "resident set grew from " << before << " to " << after << " bytes";

@@ -121,6 +121,7 @@ TimedResult run_timed(const std::filesystem::path& program, const std::vector<st
   ::wait4(pid, &status, 0, &usage);
   result.cpu_seconds = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
                        double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+  result.peak_resident_bytes = std::uint64_t(usage.ru_maxrss) * 1024;  // reported in KiB
   result.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
   result.exit_code = result.timed_out ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
@@ -131,6 +132,13 @@ int spawn(const std::filesystem::path& program, const std::vector<std::string>& 
   const pid_t pid = start(program, args, null);
   ::close(null);
   return pid;
+}
+
+std::uint64_t resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::uint64_t size = 0, resident = 0;
+  statm >> size >> resident;
+  return resident * std::uint64_t(::sysconf(_SC_PAGESIZE));
 }
 
 std::string read_file(const std::filesystem::path& file) {

@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the tests: paths of the repo, the data folder and the built command, and running it.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -37,6 +38,7 @@ CommandResult run(const std::filesystem::path& program, const std::vector<std::s
 struct TimedResult : CommandResult {
   double seconds = 0.0;      // wall time until it exited or was killed
   double cpu_seconds = 0.0;  // user + system time of the command
+  std::uint64_t peak_resident_bytes = 0;  // the most memory it ever held in RAM (getrusage's ru_maxrss)
   bool timed_out = false;
 };
 TimedResult run_timed(const std::filesystem::path& program, const std::vector<std::string>& args,
@@ -45,6 +47,9 @@ TimedResult run_timed(const std::filesystem::path& program, const std::vector<st
 // Starts `program args...` with stdout and stderr to /dev/null and returns its process id (for tests that
 // signal it); reap it with waitpid.
 int spawn(const std::filesystem::path& program, const std::vector<std::string>& args);
+
+// This process's resident set size now (not the peak), from /proc/self/statm.
+std::uint64_t resident_bytes();
 
 std::string read_file(const std::filesystem::path& file);
 void write_file(const std::filesystem::path& file, const std::string& text);

@@ -144,7 +144,7 @@ TEST(TextureImage, HeightChannelScaleOffset) {
   // No height: flat at the top.
   const Image flat = make_layer_height(LayerDesc{}, "t");
   EXPECT_EQ(flat.width, 1);
-  EXPECT_EQ(flat.texels, std::vector<float>{1.0f});
+  EXPECT_EQ(flat.texels, Texels{1.0f});
 }
 
 TEST(TextureImage, NormalsFromFile) {
@@ -165,7 +165,7 @@ TEST(TextureImage, NormalsFromFile) {
     EXPECT_NEAR(n.at(0, 0, 2), z / len, 1e-6);
   }
   const Image flat = make_texture(TextureDesc{}, TexturePurpose::Normal, layer, nullptr, "t");
-  EXPECT_EQ(flat.texels, (std::vector<float>{0, 0, 1}));
+  EXPECT_EQ(flat.texels, (Texels{0, 0, 1}));
 }
 
 TEST(TextureImage, NormalsFromHeight) {

@@ -26,7 +26,7 @@ std::uint16_t r16_at(const Texture& t, int level, int x, int y) {
 // A w x h image of one row of values per channel, channel-major in `values`.
 Image row_image(const std::vector<float>& values, int channels = 1) {
   Image img(int(values.size()) / channels, 1, channels);
-  img.texels = values;
+  img.texels.assign(values.begin(), values.end());
   return img;
 }
 
@@ -372,7 +372,7 @@ TEST(MipTexture, ThreadCountDoesNotChangeTheResult) {
 TEST(MipTexture, LevelImageDecodes) {
   Texture t = r8_texture(2, 2, {0, 51, 102, 255});
   const Image img = t.level_image(0);
-  EXPECT_EQ(img.texels, (std::vector<float>{0.0f, 0.2f, 0.4f, 1.0f}));
+  EXPECT_EQ(img.texels, (Texels{0.0f, 0.2f, 0.4f, 1.0f}));
   EXPECT_THROW(t.texel(0, 2, 0, 0), Error);
   EXPECT_THROW(t.level_image(2), Error);
 }

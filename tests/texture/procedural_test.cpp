@@ -49,7 +49,7 @@ TEST(TextureProcedural, SeedsChangeRandomPatterns) {
 }
 
 TEST(TextureProcedural, KnownValues) {
-  EXPECT_EQ(generate_procedural(desc(ProceduralPattern::Flat, 4)).texels, std::vector<float>(16, 1.0f));
+  EXPECT_EQ(generate_procedural(desc(ProceduralPattern::Flat, 4)).texels, Texels(16, 1.0f));
   // Checker: squares of size / cells texels, texel (0, 0) black.
   const Image checker = generate_procedural(desc(ProceduralPattern::Checker, 8, 1, 4));
   for (int y = 0; y < 8; ++y)
@@ -60,7 +60,7 @@ TEST(TextureProcedural, KnownValues) {
   EXPECT_EQ(spikes.at(0, 0, 0), 0.0f);
   // Steps: `cells` levels, 0 and 1 both present.
   const Image steps = generate_procedural(desc(ProceduralPattern::Steps, 64, 1, 5));
-  std::vector<float> levels = steps.texels;
+  std::vector<float> levels(steps.texels.begin(), steps.texels.end());
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
   EXPECT_EQ(levels, (std::vector<float>{0.0f, 0.25f, 0.5f, 0.75f, 1.0f}));
@@ -96,7 +96,7 @@ TEST(TextureProcedural, Tileable) {
 }
 
 // FNV-1a over the texels' bits.
-std::uint64_t digest(const std::vector<float>& texels) {
+std::uint64_t digest(const Texels& texels) {
   std::uint64_t h = 0xcbf29ce484222325u;
   for (const float t : texels)
     for (int byte = 0; byte < 4; ++byte) h = (h ^ ((std::bit_cast<std::uint32_t>(t) >> (8 * byte)) & 0xFFu)) * 0x100000001b3u;

@@ -42,6 +42,8 @@
 #include <string>
 #include <vector>
 
+#include "qdmr/core/zeroed_allocator.hpp"
+
 #include "qdmr/texture/heightfield.hpp"
 
 namespace qdmr {
@@ -51,7 +53,7 @@ enum class ConeKind { Conservative, Relaxed };
 struct ConeMap {
   int width = 0, height = 0;
   ConeKind kind = ConeKind::Conservative;
-  std::vector<float> ratio;  // row-major, row 0 at v = 0; >= 0; capped at kMaxConeRatio
+  std::vector<float, ZeroedAllocator<float>> ratio;  // row-major, row 0 at v = 0; >= 0; capped at kMaxConeRatio
 };
 
 inline constexpr float kMaxConeRatio = 64.0f;

@@ -7,17 +7,23 @@
 #include <string>
 #include <vector>
 
+#include "qdmr/core/zeroed_allocator.hpp"
+
 namespace qdmr {
+
+// Zero until written; pages are committed as they are written (qdmr/core/zeroed_allocator.hpp), so reading a
+// file that declares more pixels than it holds fails before its size in memory is ever touched.
+using Texels = std::vector<float, ZeroedAllocator<float>>;
 
 struct Image {
   int width = 0;
   int height = 0;
   int channels = 0;
   int source_bits = 32;  // bits per channel of the data it came from: 8 or 16 for integer files, 32 otherwise
-  std::vector<float> texels;
+  Texels texels;
 
   Image() = default;
-  Image(int w, int h, int c) : width(w), height(h), channels(c), texels(std::size_t(w) * h * c, 0.0f) {}
+  Image(int w, int h, int c) : width(w), height(h), channels(c), texels(std::size_t(w) * h * c) {}
   float& at(int x, int y, int c) { return texels[(std::size_t(y) * width + x) * channels + c]; }
   float at(int x, int y, int c) const { return texels[(std::size_t(y) * width + x) * channels + c]; }
   std::size_t bytes() const { return texels.size() * sizeof(float); }
