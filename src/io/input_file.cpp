@@ -49,11 +49,17 @@ std::string size_reason(std::uint64_t size, InputKind kind) {
 // "<reason>" when the message already starts with the file (where == file), else "<file> <reason>".
 std::string about(const std::filesystem::path& file, const std::string& where, const std::string& reason) {
   if (where == file.string()) return reason;
-  if (reason == "file not found") return reason + ": " + file.string();
-  return file.string() + " " + reason;
+  if (reason == "file not found") return reason + ": " + shown_path(file);
+  return shown_path(file) + " " + reason;
 }
 
 }  // namespace
+
+std::string shown_path(const std::filesystem::path& file) {
+  const std::string& path = file.native();
+  if (path.size() <= 240) return path;
+  return path.substr(0, 120) + "...(" + std::to_string(path.size() - 220) + " bytes)..." + path.substr(path.size() - 100);
+}
 
 const char* input_kind_name(InputKind kind) {
   switch (kind) {
@@ -106,13 +112,13 @@ std::uint64_t check_input_file(const std::filesystem::path& file, const std::str
 std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
   check_input_file(file, where, kind);
   const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) throw Error(where, "cannot open " + file.string() + ": " + std::strerror(errno));
+  if (fd < 0) throw Error(where, "cannot open " + shown_path(file) + ": " + std::strerror(errno));
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw Error(where, "cannot read " + file.string() + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) != 0) throw Error(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
   std::string reason = type_reason(st.st_mode);
   if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
   if (!reason.empty()) throw Error(where, about(file, where, reason));
@@ -131,7 +137,7 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
     const ssize_t n = ::read(fd, into, room);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw Error(where, "cannot read " + file.string() + ": " + std::strerror(errno));
+      throw Error(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
     }
     if (n == 0) break;
     if (probing) text.append(probe, std::size_t(n));

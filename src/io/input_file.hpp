@@ -17,6 +17,10 @@ enum class InputKind { Scene, Obj, Mtl, Image, Cache, Manifest, StudySpec };
 const char* input_kind_name(InputKind kind);    // "scene file", "OBJ file", ...
 std::uint64_t input_size_limit(InputKind kind);  // bytes, see qdmr/core/limits.hpp
 
+// `file` as error messages show it: whole up to 240 bytes, longer ones (a name the system refuses as too long)
+// with their middle elided, so an error stays one readable line.
+std::string shown_path(const std::filesystem::path& file);
+
 // "" when `file` is a regular file (following symlinks); otherwise what it is, e.g. "is a FIFO (named pipe),
 // not a regular file", "file not found", "is a directory, not a file".
 std::string non_regular_reason(const std::filesystem::path& file);

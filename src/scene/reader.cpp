@@ -208,8 +208,8 @@ std::filesystem::path Value::existing_file() const {
   if (!path.has_filename()) path = path.parent_path();  // "dir/." normalises to "dir/"
   // Devices, FIFOs and sockets are refused here, before anything opens them; sizes are checked when read.
   const std::string reason = non_regular_reason(path);
-  if (reason == "file not found" || reason == "is a directory, not a file") fail(reason + ": " + path.string());
-  if (!reason.empty()) fail(path.string() + " " + reason);
+  if (reason == "file not found" || reason == "is a directory, not a file") fail(reason + ": " + shown_path(path));
+  if (!reason.empty()) fail(shown_path(path) + " " + reason);
   note_input(path);
   return path;
 }

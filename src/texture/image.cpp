@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "imageio/backend.hpp"
@@ -62,6 +63,16 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   if (fields[0] > std::uint64_t(limits::kMaxTextureSide) || fields[1] > std::uint64_t(limits::kMaxTextureSide))
     return "size " + std::to_string(fields[0]) + "x" + std::to_string(fields[1]) + " is outside 1.." +
            std::to_string(limits::kMaxTextureSide);
+  // Plain (ASCII) variants: every value takes a byte at least, and in PGM/PPM a separator too (PBM's bits need
+  // none). OpenImageIO allocates the whole image before it finds them missing, and says nothing when it does.
+  if (magic == '1' || magic == '2' || magic == '3') {
+    const std::uint64_t values = fields[0] * fields[1] * (magic == '3' ? 3 : 1);
+    const std::uint64_t least = magic == '1' ? values : 2 * values - 1;
+    const std::uint64_t room = size > at ? size - at : 0;
+    if (room < least)
+      return "truncated: the header promises " + std::to_string(values) + " values, which take " +
+             std::to_string(least) + " bytes at least, the file has " + std::to_string(room);
+  }
   // Binary variants: exactly one whitespace byte after the header, then the pixels.
   if (magic == '4' || magic == '5' || magic == '6') {
     const std::uint64_t channels = magic == '6' ? 3 : 1;
@@ -74,11 +85,47 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   return "";
 }
 
+// A name read from a damaged file, fit for a one-line message: bytes outside printable ASCII as \xHH, at most 40
+// of them shown.
+std::string shown(std::string_view name) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  for (std::size_t i = 0; i < name.size() && i < 40; ++i) {
+    const auto c = static_cast<unsigned char>(name[i]);
+    if (c >= 0x20 && c < 0x7F && c != '\\') {
+      out += char(c);
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return name.size() > 40 ? out + "..." : out;
+}
+
+// The bytes of an OpenEXR attribute type whose value OpenEXR 3.1 reads at a fixed size, whatever size the file
+// declares; -1 for the others (strings, vectors, previews and unknown types are read at the declared size, a
+// channel list up to its terminating empty name).
+std::int64_t exr_fixed_size(std::string_view type) {
+  static constexpr std::pair<std::string_view, std::int64_t> kSizes[] = {
+      {"box2i", 16},   {"box2f", 16},    {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1},
+      {"double", 8},   {"envmap", 1},    {"float", 4},           {"int", 4},         {"keycode", 28},
+      {"lineOrder", 1}, {"m33d", 72},    {"m33f", 36},           {"m44d", 128},      {"m44f", 64},
+      {"rational", 8}, {"tiledesc", 9},  {"timecode", 8},        {"v2d", 16},        {"v2f", 8},
+      {"v2i", 8},      {"v3d", 24},      {"v3f", 12},            {"v3i", 12}};
+  for (const auto& [name, bytes] : kSizes)
+    if (name == type) return bytes;
+  return -1;
+}
+
 // OpenEXR: OpenEXR allocates each header attribute's value at the size the file declares before reading it
 // (a 64 KiB file can claim a 2 GB string), and the tables of a part from its data window. So the headers are
 // walked here first, without allocating: every attribute's value must fit in the file, and the first part's
-// data window (the image qdmr reads) must be within the size limit. Returns what is wrong, or "" (also when the
-// walk meets what it does not know, a name longer than OpenEXR's 255 bytes: left to OpenEXR's own checks).
+// data window (the image qdmr reads) must be within the size limit. OpenEXR 3.1 does not check that a value it
+// reads by its type (a box, a number, a channel list) takes the bytes the file declares for it, and reads the next
+// attribute from wherever that value ended: a channel list longer than declared made it read a string's bytes as
+// a 1.9 GB length. So those values must take exactly the declared bytes. Returns what is wrong, or "" (also when
+// the walk meets what it does not know, a name longer than OpenEXR's 255 bytes: left to OpenEXR's own checks).
 std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
   std::ifstream in(file, std::ios::binary);
   const auto le32 = [](const unsigned char* b) {
@@ -114,10 +161,30 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
       if (!in.read(reinterpret_cast<char*>(field), 4)) return "truncated OpenEXR header";
       at += 4;
       const std::int32_t bytes = le32(field);
+      const std::string attribute = "damaged OpenEXR header: attribute '" + shown(name) + "' ";
       if (bytes < 0 || at + std::uint64_t(bytes) > size)
-        return "damaged OpenEXR header: attribute '" + name + "' claims " + std::to_string(bytes) +
-               " bytes, the file has " + std::to_string(size - at) + " left";
-      if (part == 0 && name == "dataWindow" && type == "box2i" && bytes == 16) {
+        return attribute + "claims " + std::to_string(bytes) + " bytes, the file has " + std::to_string(size - at) +
+               " left";
+      if (const std::int64_t fixed = exr_fixed_size(type); fixed >= 0 && bytes != fixed)
+        return attribute + "of type " + shown(type) + " claims " + std::to_string(bytes) + " bytes, the type has " +
+               std::to_string(fixed);
+      if (type == "chlist") {
+        // Channels until an empty name: each a name, then pixel type, linear flag, 3 reserved bytes, x and y
+        // sampling (16 bytes).
+        const std::uint64_t end = at + std::uint64_t(bytes);
+        std::string channel;
+        for (bool truncated = false;;) {
+          if (!text(channel, truncated)) return truncated ? "truncated OpenEXR header" : "";
+          if (channel.empty() || at > end) break;
+          in.seekg(16, std::ios::cur);
+          at += 16;
+        }
+        if (at != end)
+          return attribute + "holds a channel list of " + std::to_string(at - (end - std::uint64_t(bytes))) +
+                 " bytes, it claims " + std::to_string(bytes);
+        continue;
+      }
+      if (part == 0 && name == "dataWindow" && type == "box2i") {
         unsigned char box[16];
         if (!in.read(reinterpret_cast<char*>(box), 16)) return "truncated OpenEXR header";
         const std::int64_t width = std::int64_t(le32(box + 8)) - le32(box) + 1;
@@ -156,11 +223,21 @@ std::string check_png_chunks(const std::filesystem::path& file, std::uint64_t si
   return no_end;  // what is left is shorter than a chunk header
 }
 
-// OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line.
+// OIIO may report several lines (e.g. "Read error: hit end of file\nPNG read error: ..."): an error is one line,
+// with the first three of them (a TIFF decoder missing its data reports once per row: 30 KB for 256 rows).
 Error read_error(const std::string& where, const std::filesystem::path& file, std::string message) {
   while (!message.empty() && message.back() == '\n') message.pop_back();
-  for (std::size_t at; (at = message.find('\n')) != std::string::npos;) message.replace(at, 1, "; ");
-  return Error(where, "cannot read '" + file.string() + "': " + (message.empty() ? "unknown error" : message));
+  std::size_t lines = 1;
+  for (std::size_t at; (at = message.find('\n')) != std::string::npos; ++lines) {
+    if (lines == 3) {
+      const auto more = std::count(message.begin() + std::ptrdiff_t(at), message.end(), '\n');
+      message.replace(at, std::string::npos, "; and " + std::to_string(more) + " more decoder messages");
+      break;
+    }
+    message.replace(at, 1, "; ");
+  }
+  if (message.empty()) message = "the decoder stopped without saying why (damaged or missing pixel data)";
+  return Error(where, "cannot read '" + shown_path(file) + "': " + message);
 }
 
 // The file checked (kind, size), opened, and its header checked (format, size, channels, PNM fields, a
