@@ -49,7 +49,7 @@ ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std
     cached.width = field.width;
     cached.height = field.height;
     cached.kind = kind;
-    cached.ratio.resize(std::size_t(field.width) * std::size_t(field.height));
+    cached.ratio = ZeroedBuffer<float>(std::size_t(field.width) * std::size_t(field.height));
     if (read_float_cache(file, id, 0.0f, kMaxConeRatio, cached.ratio)) return cached;
   }
   ConeMap map = bake_cone_map(field, kind);

@@ -40,9 +40,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
-#include <vector>
 
-#include "qdmr/core/zeroed_allocator.hpp"
+#include "qdmr/core/zeroed_buffer.hpp"
 
 #include "qdmr/texture/heightfield.hpp"
 
@@ -53,7 +52,7 @@ enum class ConeKind { Conservative, Relaxed };
 struct ConeMap {
   int width = 0, height = 0;
   ConeKind kind = ConeKind::Conservative;
-  std::vector<float, ZeroedAllocator<float>> ratio;  // row-major, row 0 at v = 0; >= 0; capped at kMaxConeRatio
+  ZeroedBuffer<float> ratio;  // row-major, row 0 at v = 0; >= 0; capped at kMaxConeRatio
 };
 
 inline constexpr float kMaxConeRatio = 64.0f;

@@ -5,15 +5,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
-#include <vector>
 
-#include "qdmr/core/zeroed_allocator.hpp"
+#include "qdmr/core/zeroed_buffer.hpp"
 
 namespace qdmr {
 
-// Zero until written; pages are committed as they are written (qdmr/core/zeroed_allocator.hpp), so reading a
+// Zero until written; pages are committed as they are written (qdmr/core/zeroed_buffer.hpp), so reading a
 // file that declares more pixels than it holds fails before its size in memory is ever touched.
-using Texels = std::vector<float, ZeroedAllocator<float>>;
+using Texels = ZeroedBuffer<float>;
 
 struct Image {
   int width = 0;
