@@ -11,7 +11,6 @@
 // Its size is set when it is made (or assigned); there is no growth, so no capacity and no old values to clear.
 #include <algorithm>
 #include <cstddef>
-#include <cstring>
 #include <initializer_list>
 #include <iterator>
 #include <new>
