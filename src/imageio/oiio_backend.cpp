@@ -137,10 +137,17 @@ bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_st
   // flipped here. Asked for another type or row order, OpenImageIO decodes through a buffer of 64 MB whatever
   // the image's size (ImageInput::read_scanlines), allocated for every image read; and OpenImageIO 2.4 takes
   // its direct path only for TypeUnknown ("as stored"), not for the file's own type named explicitly.
+  //
+  // A TIFF whose photometric interpretation is "min is white" is read one scanline per call: OpenImageIO 2.4
+  // (TIFFInput::read_native_scanlines) inverts each deflate-compressed strip it reads as a strip over `channels`
+  // times the strip's size, so past the end of the caller's rows for a file of more than one channel (a heap
+  // overflow that fuzz_image found). A single scanline takes its per-scanline path, which inverts the row only.
+  const bool min_is_white = spec.get_int_attribute("tiff:PhotometricInterpretation", -1) == 0;
   const std::size_t row_values = std::size_t(spec.width) * std::size_t(channels);
   const std::size_t row_bytes = row_values * spec.format.size();
   const int strip = std::max(1, spec.get_int_attribute("tiff:RowsPerStrip", 64));
-  const int rows = std::min(spec.height, std::max(1, int((std::size_t(4) << 20) / row_bytes) / strip) * strip);
+  const int chunk_rows = std::max(1, int((std::size_t(4) << 20) / row_bytes) / strip) * strip;
+  const int rows = min_is_white ? 1 : std::min(spec.height, chunk_rows);
   std::unique_ptr<unsigned char[]> native(new unsigned char[row_bytes * std::size_t(rows)]);
   for (int y0 = 0; y0 < spec.height; y0 += rows) {
     const int y1 = std::min(y0 + rows, spec.height);

@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -69,6 +70,130 @@ TEST(TextureImage, Reads16BitPngExactly) {
   const Image img = read_image(dir / "b.png", "test");
   ASSERT_EQ(img.channels, 1);
   for (std::size_t i = 0; i < data.size(); ++i) ASSERT_EQ(img.texels[i], data[i] / 65535.0f) << i;
+}
+
+// A TIFF of 8-bit samples, `channels` per pixel (the second and later ones unspecified extra samples), whose
+// photometric interpretation is "min is white", in deflate-compressed strips of `rows_per_strip` rows (zlib streams
+// of stored blocks: valid deflate without a compressor). `top_first` holds the samples as the file stores them.
+std::vector<char> min_is_white_tiff(int w, int h, int channels, int rows_per_strip,
+                                    const std::vector<std::uint8_t>& top_first) {
+  std::vector<char> out;
+  const auto u16 = [&](unsigned v) { out.insert(out.end(), {char(v & 0xFF), char(v >> 8)}); };
+  const auto u32 = [&](std::uint32_t v) {
+    u16(v & 0xFFFF);
+    u16(v >> 16);
+  };
+  const int strips = (h + rows_per_strip - 1) / rows_per_strip;
+  std::vector<std::uint32_t> offsets, counts;
+  out.insert(out.end(), {'I', 'I', 42, 0, 0, 0, 0, 0});  // the IFD's offset is patched below
+  for (int s = 0; s < strips; ++s) {
+    const std::size_t row = std::size_t(w) * std::size_t(channels);
+    const std::size_t begin = std::size_t(s) * std::size_t(rows_per_strip) * row;
+    const std::size_t end = std::min(top_first.size(), begin + std::size_t(rows_per_strip) * row);
+    offsets.push_back(std::uint32_t(out.size()));
+    out.insert(out.end(), {char(0x78), char(0x01), char(0x01)});  // zlib header; one final stored block
+    const unsigned length = unsigned(end - begin);
+    u16(length);
+    u16(~length & 0xFFFF);
+    std::uint32_t a = 1, b = 0;  // Adler-32 of the data, stored big-endian
+    for (std::size_t i = begin; i < end; ++i) {
+      out.push_back(char(top_first[i]));
+      a = (a + top_first[i]) % 65521;
+      b = (b + a) % 65521;
+    }
+    const std::uint32_t adler = (b << 16) | a;
+    out.insert(out.end(), {char(adler >> 24), char(adler >> 16), char(adler >> 8), char(adler)});
+    counts.push_back(std::uint32_t(out.size()) - offsets.back());
+  }
+  const auto array_at = [&](const std::vector<std::uint32_t>& values) {
+    const auto at = std::uint32_t(out.size());
+    for (const std::uint32_t v : values) u32(v);
+    return at;
+  };
+  const std::uint32_t offsets_at = array_at(offsets), counts_at = array_at(counts);
+  const auto bits_at = std::uint32_t(out.size());
+  for (int c = 0; c < channels; ++c) u16(8);
+  const auto extra_at = std::uint32_t(out.size());
+  for (int c = 1; c < channels; ++c) u16(0);
+  if (out.size() % 2) out.push_back(0);
+  const auto ifd = std::uint32_t(out.size());
+  for (int i = 0; i < 4; ++i) out[std::size_t(4 + i)] = char(ifd >> (8 * i));
+  struct Entry {
+    unsigned tag, type;
+    std::uint32_t count, value;
+  };
+  // Values of up to 4 bytes sit in the entry itself (SHORT pairs: the first in the low half); longer arrays at
+  // their offset.
+  std::vector<Entry> entries = {
+      {256, 3, 1, std::uint32_t(w)},
+      {257, 3, 1, std::uint32_t(h)},
+      {258, 3, std::uint32_t(channels), channels == 1 ? 8u : channels == 2 ? 8u | (8u << 16) : bits_at},
+      {259, 3, 1, 8},  // Adobe deflate
+      {262, 3, 1, 0},  // min is white
+      {273, 4, std::uint32_t(strips), strips == 1 ? offsets[0] : offsets_at},
+      {277, 3, 1, std::uint32_t(channels)},
+      {278, 3, 1, std::uint32_t(rows_per_strip)},
+      {279, 4, std::uint32_t(strips), strips == 1 ? counts[0] : counts_at},
+      {284, 3, 1, 1}};  // contiguous samples
+  if (channels > 1) entries.push_back({338, 3, std::uint32_t(channels - 1), channels <= 3 ? 0u : extra_at});
+  u16(unsigned(entries.size()));
+  for (const Entry& e : entries) {
+    u16(e.tag);
+    u16(e.type);
+    u32(e.count);
+    u32(e.value);
+  }
+  u32(0);  // no next IFD
+  return out;
+}
+
+// OpenImageIO 2.4 inverted a "min is white" TIFF's deflate strips over `channels` times their size, past the end of
+// the rows it was asked for (a heap overflow fuzz_image found; oiio_backend.cpp reads such files a scanline at a
+// time). Every sample must come back inverted once, and under AddressSanitizer (the input tests run there in CI)
+// nothing may be written outside the image.
+TEST(TextureImage, MinIsWhiteTiffOfSeveralChannelsReadsEachSampleInvertedOnce) {
+  test::TempDir dir;
+  for (const int channels : {1, 2, 4}) {
+    const int w = 5, h = 9, rows_per_strip = 2;  // 5 strips, the last one short
+    std::vector<std::uint8_t> top_first;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < channels; ++c) top_first.push_back(std::uint8_t((y * 37 + x * 11 + c * 101) % 256));
+    const std::filesystem::path file = dir / ("white" + std::to_string(channels) + ".tif");
+    const std::vector<char> bytes = min_is_white_tiff(w, h, channels, rows_per_strip, top_first);
+    test::write_file(file, std::string(bytes.begin(), bytes.end()));
+    const Image img = read_image(file, "test");
+    ASSERT_EQ(img.width, w);
+    ASSERT_EQ(img.height, h);
+    ASSERT_EQ(img.channels, channels);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < channels; ++c) {
+          const std::uint8_t stored = top_first[(std::size_t(y) * w + x) * channels + c];
+          ASSERT_EQ(img.at(x, h - 1 - y, c), float(255 - stored) / 255.0f) << channels << " " << x << " " << y << " " << c;
+        }
+  }
+}
+
+// Why oiio_backend.cpp reads such a file a scanline at a time: asked for all its rows at once, OpenImageIO 2.4 (as
+// Debian 12 ships it) inverts each strip's samples over `channels` times the strip, past the rows it was asked for.
+// The bytes after the rows are checked here. Should this fail, the OpenImageIO in use has fixed it, and the
+// one-scanline reads of "min is white" files can go.
+TEST(TextureImage, OpenImageIOWritesPastTheRowsOfAMinIsWhiteTiffReadAsStrips) {
+  test::TempDir dir;
+  const int w = 5, h = 8, channels = 4, rows_per_strip = 2;
+  const std::vector<std::uint8_t> top_first(std::size_t(w) * h * channels, 7);
+  const std::vector<char> bytes = min_is_white_tiff(w, h, channels, rows_per_strip, top_first);
+  test::write_file(dir / "white.tif", std::string(bytes.begin(), bytes.end()));
+  auto in = OIIO::ImageInput::open((dir / "white.tif").string());
+  ASSERT_TRUE(in);
+  const std::size_t rows_bytes = top_first.size(), slack = 4 * rows_bytes;
+  std::vector<std::uint8_t> buffer(rows_bytes + slack, 0x55);
+  ASSERT_TRUE(in->read_scanlines(0, 0, 0, h, 0, 0, channels, OIIO::TypeUnknown, buffer.data()));
+  EXPECT_EQ(buffer[0], 255 - 7);
+  const auto written_past = std::count_if(buffer.begin() + std::ptrdiff_t(rows_bytes), buffer.end(),
+                                          [](std::uint8_t b) { return b != 0x55; });
+  EXPECT_GT(written_past, 0) << "OpenImageIO no longer writes past the rows it reads";
 }
 
 TEST(TextureImage, BadFilesThrow) {
