@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -27,6 +28,7 @@ TEST(ZeroedBuffer, SmallAndLargeBuffersStartAtZero) {
 
 TEST(ZeroedBuffer, ValuesGivenAreWritten) {
   EXPECT_EQ(Floats(3, 2.5f), (Floats{2.5f, 2.5f, 2.5f}));
+  EXPECT_TRUE(std::signbit(Floats(2, -0.0f)[1]));  // equal to 0, but not all zero bytes
   const std::vector<float> source{1.0f, -2.0f, 3.0f};
   const Floats copied(source.begin(), source.end());
   EXPECT_EQ(std::vector<float>(copied.begin(), copied.end()), source);

@@ -38,9 +38,7 @@ class ZeroedBuffer {
 
   ZeroedBuffer() noexcept = default;
   explicit ZeroedBuffer(std::size_t n) : data_(allocate(n)), size_(n) {}
-  ZeroedBuffer(std::size_t n, T value) : ZeroedBuffer(n) {
-    if (value != T(0)) std::fill_n(data_, n, value);
-  }
+  ZeroedBuffer(std::size_t n, T value) : ZeroedBuffer(n) { std::fill_n(data_, n, value); }
   template <class It, class = typename std::iterator_traits<It>::iterator_category>
   ZeroedBuffer(It first, It last) : ZeroedBuffer(std::size_t(std::distance(first, last))) {
     std::copy(first, last, data_);
