@@ -1,5 +1,7 @@
 #include "qdmr/core/zeroed_buffer.hpp"
 
+#include "qdmr/core/address_sanitizer.hpp"
+
 #include <sys/mman.h>
 
 #include <cstdlib>
@@ -8,14 +10,9 @@
 namespace qdmr {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer only checks memory that came from its own allocator.
+#ifdef QDMR_ADDRESS_SANITIZER
 constexpr bool kMapLargeBlocks = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kMapLargeBlocks = false;
-#else
-constexpr bool kMapLargeBlocks = true;
-#endif
 #else
 constexpr bool kMapLargeBlocks = true;
 #endif

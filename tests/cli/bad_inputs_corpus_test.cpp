@@ -23,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "support/sanitizer.hpp"
+#include "qdmr/core/address_sanitizer.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -35,7 +35,7 @@ namespace fs = std::filesystem;
 // command's CPU time (user + system): wall time on a shared 2-core CI machine measures the other jobs too (a
 // loaded machine took 2.2 s of wall time for 0.6 s of CPU). A hang that blocks without using the CPU (a FIFO, a
 // device) is caught by the wall-time kill at 20 s. Sanitizer builds run several times slower: limit 10 s.
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
 constexpr double kMaxSeconds = 10.0;
 #else
 constexpr double kMaxSeconds = 2.0;
@@ -46,7 +46,7 @@ constexpr double kKillSeconds = 20.0;
 // base.json planned: about 150 MB in a release build (measured: the printed peak). The limit leaves room for
 // allocator and library differences, and is far below any image a bad header declares (a 16384 x 10240 RGB
 // texture is 2 GB as floats). ASan's shadow memory and quarantine roughly double a process's footprint.
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
 constexpr std::uint64_t kMaxResidentBytes = 1024ull << 20;
 #else
 constexpr std::uint64_t kMaxResidentBytes = 512ull << 20;

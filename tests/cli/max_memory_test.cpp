@@ -15,11 +15,11 @@
 #include "prepare/assets.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/bake/cone_map.hpp"
+#include "qdmr/core/address_sanitizer.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
-#include "support/sanitizer.hpp"
 #include "support/test_support.hpp"
 
 
@@ -29,7 +29,7 @@ namespace {
 // CPU seconds a refusal from an image header may take: reading the header loads the command's image module
 // (OpenImageIO and ~260 libraries, ~0.3 s) and nothing is decoded; decoding 16384² pixels would take far longer.
 // Sanitizer builds run several times slower (dynamic loading under ASan took 2.7 s): 10 s, as bad_inputs_corpus.
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
 constexpr double kHeaderRefusalSeconds = 10.0;
 #else
 constexpr double kHeaderRefusalSeconds = 2.0;
@@ -296,7 +296,7 @@ template <class Work>
 // Measured (Release): 1024^2 relaxed mirror 185.4 MiB for an estimate of 185.4; 2048^2 conservative wrap 85.3 for
 // 85.4. (The test changes this process's malloc settings: ctest runs each test in a process of its own.)
 TEST(MaxMemory, ConeBakeEstimateCoversTheBakersPeak) {
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
 #else
   // Every allocation of the baker from fresh pages, none from memory freed before (glibc would otherwise raise its
@@ -371,7 +371,7 @@ TEST(MaxMemory, ThePlanCountsTheAoBakersWorkingMemory) {
 // pyramid copied them before, 32 MiB more for a 2048² field). Directions 4 and a radius of 2 texels keep the bakes
 // short. Measured (Release): 2048² coarse to a 256² map 10.8 MiB for 10.9; 1024² fine at full size 3.8 for 4.0.
 TEST(MaxMemory, AoBakeEstimateCoversTheBakersPeak) {
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
 #else
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);  // as in ConeBakeEstimateCoversTheBakersPeak
@@ -416,7 +416,7 @@ TEST(MaxMemory, AoBakeEstimateCoversTheBakersPeak) {
 // Measured (Release, 2048²): the two file albedos 69.2 MiB for 69.3, the height with its normals 83.9 for 96.0, the
 // procedural albedo 80.0 for 80.0, the procedural height with normals and quadtree 90.7 for 106.7.
 TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
 #else
   TempDir dir;
@@ -473,7 +473,7 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
 // previous scene first: the peak of the second set_scene stays below the new plan's total less the previous
 // albedo (106.7 MiB with its decoded copy), where holding it would peak at the whole total.
 TEST(MaxMemory, ANewSceneReleasesThePreviousOneWhenBothWouldNotFit) {
-#ifdef QDMR_TEST_ASAN
+#ifdef QDMR_ADDRESS_SANITIZER
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
 #else
   TempDir dir;
