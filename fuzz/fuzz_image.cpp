@@ -6,9 +6,9 @@
 // render is refused). Under AddressSanitizer an image's cost grows with its declared size, decoded or not (the
 // shadow of every block is poisoned when it is allocated and again when it is freed): mutations of a few small
 // TIFFs whose strips all point at the same bytes (254 x 12336 RGBA from 7 KB, 62 MB to read) took most of the
-// run's time. A 64 KiB input decodes the same rows, strips and tiles at 32 MiB as at 2 GB; the large blocks
-// themselves are covered by the bad-input corpus under AddressSanitizer in CI (the `*_declares_*` cases) and by
-// `ZeroedBuffer.*`.
+// run's time. A 64 KiB input decodes the same rows, strips and tiles at 32 MiB as at 2 GB; blocks of gigabytes are
+// allocated and freed under AddressSanitizer in CI by the input tests
+// (TextureImage.SmallFilesThatDeclareLargeImagesThrowAfterTheirHeader, ZeroedBuffer.*).
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
