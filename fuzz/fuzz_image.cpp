@@ -1,12 +1,13 @@
 // libFuzzer harness: image files through qdmr::read_image, the function every texture, weights map and bake
 // input is read with. The file name's extension follows the content's magic number, as real files would.
 //
-// It reads as far as a render with `--max-memory 32` (MiB) would: the header first (read_image_header, as the plan
-// does), and the pixels only when the plan's estimate of the read (read_image_bytes) fits in 32 MiB (above it the
-// render is refused). Under AddressSanitizer an image's cost grows with its declared size, decoded or not (the
-// shadow of every block is poisoned when it is allocated and again when it is freed): mutations of a few small
-// TIFFs whose strips all point at the same bytes (254 x 12336 RGBA from 7 KB, 62 MB to read) took most of the
-// run's time. A 64 KiB input decodes the same rows, strips and tiles at 32 MiB as at 2 GB; blocks of gigabytes are
+// It reads as far as a render with `--max-memory 8` (MiB) would: the header first (read_image_header, as the plan
+// does), and the pixels only when the plan's estimate of the read (read_image_bytes) fits in 8 MiB (above it the
+// render is refused): 512 x 512 RGBA of 16 bits, 1024 x 1024 of one 8-bit channel. Under AddressSanitizer an
+// image's cost grows with its size, decoded or not (the shadow of every block is poisoned when it is allocated and
+// again when it is freed): mutations of a few small TIFFs whose strips all point at the same bytes (254 x 12336
+// RGBA from 7 KB, 62 MB to read, and their smaller variants up to any cap) took most of the run's time. A 64 KiB
+// input exercises the same header, row, strip and tile code at 8 MiB as at 2 GB; blocks of gigabytes are
 // allocated and freed under AddressSanitizer in CI by the input tests
 // (TextureImage.SmallFilesThatDeclareLargeImagesThrowAfterTheirHeader, ZeroedBuffer.*).
 #include <cstddef>
@@ -27,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                      : size >= 2 && data[0] == 'P'          ? "image.pgm"
                                                             : "image.png";
   const auto file = qdmr::fuzz::write(name, reinterpret_cast<const char*>(data), size);
-  constexpr std::uint64_t kMaxReadBytes = std::uint64_t(32) << 20;
+  constexpr std::uint64_t kMaxReadBytes = std::uint64_t(8) << 20;
   try {
     if (qdmr::read_image_bytes(qdmr::read_image_header(file, "fuzz")) <= kMaxReadBytes)
       static_cast<void>(qdmr::read_image(file, "fuzz"));
