@@ -135,17 +135,34 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
   if (!in.read(reinterpret_cast<char*>(head), 8)) return "truncated OpenEXR header";
   const bool multipart = (le32(head + 4) & 0x1000) != 0;
   std::uint64_t at = 8;
-  // A null-terminated string of at most 255 bytes; false at the end of the file or when longer.
+  // A null-terminated string of at most 255 bytes; false at the end of the file or when longer. Read in bulk
+  // (istream::get stops before the null), and attribute values skipped through the stream's buffer: a seekg per
+  // attribute cost an lseek and a refill of the buffer, most of the time of fuzz_image on headers of many small
+  // attributes.
   const auto text = [&](std::string& out, bool& truncated) {
-    out.clear();
-    for (char c; in.get(c);) {
-      ++at;
-      if (c == '\0') return true;
-      if (out.size() == 255) return false;
-      out += c;
+    char buffer[257];
+    in.get(buffer, sizeof buffer, '\0');
+    const auto got = std::size_t(in.gcount());
+    if (in.eof()) {
+      truncated = true;
+      return false;
     }
-    truncated = true;
-    return false;
+    if (got > 255) return false;
+    in.clear();  // get() sets failbit when the null comes first
+    char null;
+    if (!in.get(null)) {
+      truncated = true;
+      return false;
+    }
+    at += got + 1;
+    out.assign(buffer, got);
+    return true;
+  };
+  const auto skip = [&](std::uint64_t bytes) {
+    if (bytes <= (std::uint64_t(1) << 16))
+      in.ignore(std::streamsize(bytes));
+    else
+      in.seekg(std::streamoff(bytes), std::ios::cur);
   };
   for (int part = 0;; ++part) {
     for (bool first = true;; first = false) {
@@ -161,12 +178,12 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
       if (!in.read(reinterpret_cast<char*>(field), 4)) return "truncated OpenEXR header";
       at += 4;
       const std::int32_t bytes = le32(field);
-      const std::string attribute = "damaged OpenEXR header: attribute '" + shown(name) + "' ";
+      const auto attribute = [&] { return "damaged OpenEXR header: attribute '" + shown(name) + "' "; };
       if (bytes < 0 || at + std::uint64_t(bytes) > size)
-        return attribute + "claims " + std::to_string(bytes) + " bytes, the file has " + std::to_string(size - at) +
+        return attribute() + "claims " + std::to_string(bytes) + " bytes, the file has " + std::to_string(size - at) +
                " left";
       if (const std::int64_t fixed = exr_fixed_size(type); fixed >= 0 && bytes != fixed)
-        return attribute + "of type " + shown(type) + " claims " + std::to_string(bytes) + " bytes, the type has " +
+        return attribute() + "of type " + shown(type) + " claims " + std::to_string(bytes) + " bytes, the type has " +
                std::to_string(fixed);
       if (type == "chlist") {
         // Channels until an empty name: each a name, then pixel type, linear flag, 3 reserved bytes, x and y
@@ -176,11 +193,11 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
         for (bool truncated = false;;) {
           if (!text(channel, truncated)) return truncated ? "truncated OpenEXR header" : "";
           if (channel.empty() || at > end) break;
-          in.seekg(16, std::ios::cur);
+          skip(16);
           at += 16;
         }
         if (at != end)
-          return attribute + "holds a channel list of " + std::to_string(at - (end - std::uint64_t(bytes))) +
+          return attribute() + "holds a channel list of " + std::to_string(at - (end - std::uint64_t(bytes))) +
                  " bytes, it claims " + std::to_string(bytes);
         continue;
       }
@@ -193,7 +210,7 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
           return "size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +
                  std::to_string(limits::kMaxTextureSide);
       } else {
-        in.seekg(bytes, std::ios::cur);
+        skip(std::uint64_t(bytes));
       }
       at += std::uint64_t(bytes);
     }
