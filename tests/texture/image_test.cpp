@@ -152,8 +152,9 @@ std::vector<char> min_is_white_tiff(int w, int h, int channels, int rows_per_str
 // OpenImageIO 2.4 inverted a "min is white" TIFF's deflate strips over `channels` times their size, past the end of
 // the rows it was asked for (a heap overflow fuzz_image found; oiio_backend.cpp reads such files a scanline at a
 // time). Every sample must come back inverted once. The overflow itself is written by uninstrumented library code,
-// which AddressSanitizer does not see here; the reproducer among fuzz_image's seeds (fuzz/corpus/image) makes
-// ASan's allocator fail its own check when the overflow is back, and the next test shows the library's.
+// which AddressSanitizer does not see here; fuzz_image's seed
+// fuzz/corpus/image/regression_tiff_min_is_white_four_channels_deflate (254 x 160, five strips) makes ASan's
+// allocator fail its own check when the overflow is back, and the next test shows the library's.
 TEST(TextureImage, MinIsWhiteTiffOfSeveralChannelsReadsEachSampleInvertedOnce) {
   test::TempDir dir;
   for (const int channels : {1, 2, 4}) {
