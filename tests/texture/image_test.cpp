@@ -227,7 +227,7 @@ TEST(TextureImage, BadFilesThrow) {
 
 // Small files of the bad-input corpus that declare images of 0.8 to 4 GB: each is refused, after its header, when
 // its pixels run out. The input tests run under AddressSanitizer in CI, so this is where blocks of that size are
-// allocated, poisoned and freed under it (fuzz_image reads pixels only up to 32 MiB; the bad-input corpus test
+// allocated, poisoned and freed under it (fuzz_image reads pixels only up to 8 MiB; the bad-input corpus test
 // runs in the release build). The ASCII PNM ones are refused from the header (the data cannot be that long).
 TEST(TextureImage, SmallFilesThatDeclareLargeImagesThrowAfterTheirHeader) {
   const std::filesystem::path images = std::filesystem::path(QDMR_SOURCE_DIR) / "tests/bad_inputs/files/images";
