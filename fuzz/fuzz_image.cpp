@@ -1,13 +1,13 @@
 // libFuzzer harness: image files through qdmr::read_image, the function every texture, weights map and bake
 // input is read with. The file name's extension follows the content's magic number, as real files would.
 //
-// It reads as far as a render with `--max-memory 8` (MiB) would: the header first (read_image_header, as the plan
-// does), and the pixels only when the plan's estimate of the read (read_image_bytes) fits in 8 MiB (above it the
-// render is refused): 512 x 512 RGBA of 16 bits, 1024 x 1024 of one 8-bit channel. Under AddressSanitizer an
-// image's cost grows with its size, decoded or not (the shadow of every block is poisoned when it is allocated and
-// again when it is freed): mutations of a few small TIFFs whose strips all point at the same bytes (254 x 12336
-// RGBA from 7 KB, 62 MB to read, and their smaller variants up to any cap) took most of the run's time. A 64 KiB
-// input exercises the same header, row, strip and tile code at 8 MiB as at 2 GB; blocks of gigabytes are
+// It reads the header first (read_image_header, as a render's plan does) and the pixels only when the memory the
+// plan charges for the read (read_image_bytes) is at most 8 MiB, the check a render makes against `--max-memory`,
+// with 8 MiB for this image alone: 512 x 512 RGBA of 16 bits, 1024 x 1024 of one 8-bit channel. Under
+// AddressSanitizer an image's cost grows with its size, decoded or not (the shadow of every block is poisoned when
+// it is allocated and again when it is freed): mutations of a few small TIFFs whose strips all point at the same
+// bytes (254 x 12336 RGBA from 7 KB, 62 MB to read, and their variants under any cap) took most of the run's time.
+// A 64 KiB input exercises the same header, row, strip and tile code at 8 MiB as at 2 GB; blocks of gigabytes are
 // allocated and freed under AddressSanitizer in CI by the input tests
 // (TextureImage.SmallFilesThatDeclareLargeImagesThrowAfterTheirHeader, ZeroedBuffer.*).
 #include <cstddef>
