@@ -1,5 +1,5 @@
-"""What the bench scripts share: their command line and one render through the qdmr command, read back from
-its --stats JSON."""
+"""What the bench scripts share: their command line, one render through the qdmr command, read back from its
+--stats JSON, and reading an image (an AOV) back as an array."""
 import argparse
 import json
 import os
@@ -42,3 +42,16 @@ def bits_version(qdmr):
     """The bits version of a qdmr build ("qdmr 0.1.0 (bits version 2)"), for the manifests a benchmark writes."""
     out = subprocess.run([qdmr, "--version"], check=True, capture_output=True, text=True).stdout
     return int(out.rsplit("bits version", 1)[1].strip(" )\n"))
+
+
+def read_exr(path):
+    """An image as a float array (height, width, channels), top row first. Needs numpy and OpenImageIO's Python
+    module (Debian: python3-openimageio, for the system python3), imported here so that the scripts that read no
+    image do not need them."""
+    import OpenImageIO as oiio
+
+    buf = oiio.ImageBuf(path)
+    pixels = buf.get_pixels(oiio.FLOAT)
+    if buf.has_error or pixels is None:
+        raise RuntimeError(f"cannot read {path}: {buf.geterror()}")
+    return pixels

@@ -28,10 +28,12 @@ import tempfile
 
 try:
     import numpy
-    import OpenImageIO as oiio
+    import OpenImageIO  # noqa: F401 (bench_util.read_exr reads the AOVs with it: missing, say so before any render)
 except ImportError:
     sys.exit("llvmpipe_compare.py needs numpy and OpenImageIO's Python module (Debian: python3-openimageio, "
              "for the system python3)")
+
+from bench_util import read_exr  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "bench", "llvmpipe", "canonical.json")
@@ -90,15 +92,6 @@ def read_pfm(path):
         channels = {b"PF": 3, b"Pf": 1}[kind]
         data = numpy.frombuffer(f.read(width * height * channels * 4), dtype="<f4" if scale < 0 else ">f4")
     return data.reshape(height, width, channels)[::-1]
-
-
-def read_exr(path):
-    """An image as a float array (height, width, channels), top row first."""
-    buf = oiio.ImageBuf(path)
-    pixels = buf.get_pixels(oiio.FLOAT)
-    if buf.has_error or pixels is None:
-        raise RuntimeError(f"cannot read {path}: {buf.geterror()}")
-    return pixels
 
 
 def check_case(qdmr, llvmpipe, technique, depth, args, tmp):

@@ -16,24 +16,13 @@ Needs numpy and OpenImageIO's Python module (Debian's python3-numpy, python3-ope
 """
 import os
 import subprocess
-import sys
 import tempfile
 
 import numpy as np
-import OpenImageIO as oiio
 
 import bench_util
 
 MATERIAL = "/materials/cobbles"
-
-
-def read_aov(path, height, width, channels):
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        sys.exit(f"quad_footprints: cannot read {path}: {oiio.geterror()}")
-    pixels = image.read_image("float")
-    image.close()
-    return np.asarray(pixels).reshape(height, width, channels)
 
 
 def quads(values):
@@ -67,9 +56,9 @@ def main():
                             "--set", f'{MATERIAL}/technique/name="{technique}"',
                             "--aov", f"uv={uv_file}", "--aov", f"hit_uv={hit_file}", "--aov", f"depth={depth_file}"],
                            check=True, stdout=subprocess.DEVNULL)
-            uv = quads(read_aov(uv_file, args.height, args.width, 2) * args.texture_size)
-            hit = quads(read_aov(hit_file, args.height, args.width, 2) * args.texture_size)
-            covered = (quads(read_aov(depth_file, args.height, args.width, 1)) > 0).all(axis=(2, 3, 4))
+            uv = quads(bench_util.read_exr(uv_file) * args.texture_size)
+            hit = quads(bench_util.read_exr(hit_file) * args.texture_size)
+            covered = (quads(bench_util.read_exr(depth_file)) > 0).all(axis=(2, 3, 4))
             ddx = uv[:, :, 0, 1] - uv[:, :, 0, 0]
             ddy = uv[:, :, 1, 0] - uv[:, :, 0, 0]
             rho = np.maximum(np.linalg.norm(ddx, axis=-1), np.linalg.norm(ddy, axis=-1))
