@@ -75,42 +75,55 @@ std::uint16_t quantise_unorm16(float v) {
 // round(encode(v) * 255) with the exact curve: the number of decoded midpoints between codes at or below v (no
 // pow on the value itself, so the result does not depend on the machine's libm), counted from v's bucket on.
 // v * kSrgbBuckets is exact (a power of two), so v's bucket starts at or below v.
-std::uint8_t encode_srgb8(float v) {
+std::uint8_t encode_srgb8(const Tables& t, float v) {
   if (!(v > 0.0f)) return 0;
   if (v >= 1.0f) return 255;
-  const Tables& t = tables();
   int k = t.srgb_first[std::size_t(v * float(Tables::kSrgbBuckets))];
   while (k < 255 && t.srgb_mid[std::size_t(k)] <= double(v)) ++k;
   return std::uint8_t(k);
 }
 
+// The texel codec of one format, fixed at compile time: the loops over texels below are instantiated per codec
+// (with_codec), so no texel pays for a switch on the format, an sRGB test per channel or the tables' guard.
+template <TexelFormat Format, bool Srgb>
 struct Codec {
-  TexelFormat format;
-  bool srgb;
+  static constexpr int kChannels = channel_count(Format);
+  static constexpr int kTexelBytes = bytes_per_texel(Format);
+  const Tables& t = tables();
 
   float decode(const std::uint8_t* texel, int c) const {
-    switch (format) {
-      case TexelFormat::R16: return float(load<std::uint16_t>(texel, 0)) / 65535.0f;
-      case TexelFormat::R32F: return load<float>(texel, 0);
-      default: return (srgb && c < 3 ? tables().srgb8 : tables().unorm8)[texel[c]];
-    }
+    if constexpr (Format == TexelFormat::R16) return float(load<std::uint16_t>(texel, 0)) / 65535.0f;
+    else if constexpr (Format == TexelFormat::R32F) return load<float>(texel, 0);
+    else return (Srgb && c < 3 ? t.srgb8 : t.unorm8)[texel[c]];
   }
 
   void encode(std::uint8_t* texel, int c, float v) const {
-    switch (format) {
-      case TexelFormat::R16: store<std::uint16_t>(texel, 0, quantise_unorm16(v)); break;
-      case TexelFormat::R32F: store<float>(texel, 0, v); break;
-      default: texel[c] = srgb && c < 3 ? encode_srgb8(v) : quantise_unorm8(v); break;
-    }
+    if constexpr (Format == TexelFormat::R16) store<std::uint16_t>(texel, 0, quantise_unorm16(v));
+    else if constexpr (Format == TexelFormat::R32F) store<float>(texel, 0, v);
+    else texel[c] = Srgb && c < 3 ? encode_srgb8(t, v) : quantise_unorm8(v);
   }
 };
 
+// f(codec) with the codec of `format` (sRGB only where the format's channels are bytes: allocate_texture's rule).
+template <class F>
+decltype(auto) with_codec(TexelFormat format, bool srgb, F&& f) {
+  switch (format) {
+    case TexelFormat::R8: return srgb ? f(Codec<TexelFormat::R8, true>{}) : f(Codec<TexelFormat::R8, false>{});
+    case TexelFormat::RG8: return srgb ? f(Codec<TexelFormat::RG8, true>{}) : f(Codec<TexelFormat::RG8, false>{});
+    case TexelFormat::RGBA8:
+      return srgb ? f(Codec<TexelFormat::RGBA8, true>{}) : f(Codec<TexelFormat::RGBA8, false>{});
+    case TexelFormat::R16: return f(Codec<TexelFormat::R16, false>{});
+    case TexelFormat::R32F: return f(Codec<TexelFormat::R32F, false>{});
+  }
+  throw Error("texture", "unknown texel format");
+}
+
 // Box and BoxNormal: sums of decoded values in tap order (rows, then columns), re-encoded per level.
-void reduce_box(const Texture& t, int level, bool normal, std::uint8_t* out_base) {
+template <bool Normal, class C>
+void reduce_box(const Texture& t, int level, const C& codec, std::uint8_t* out_base) {
+  constexpr int channels = C::kChannels, texel_bytes = C::kTexelBytes;
   const TextureLevel& in = t.levels[std::size_t(level)];
   const TextureLevel& out = t.levels[std::size_t(level) + 1];
-  const Codec codec{t.format, t.srgb};
-  const int channels = t.channels(), texel_bytes = bytes_per_texel(t.format);
   const std::uint8_t* in_base = t.storage.data() + in.offset;
   // A texel costs about 8x more here than in a Max build: weight the row size accordingly.
   for_rows(out.height, std::size_t(out.width) * texel_bytes * 8, [&](int y0, int y1) {
@@ -124,13 +137,13 @@ void reduce_box(const Texture& t, int level, bool normal, std::uint8_t* out_base
             const std::uint8_t* texel = in_base + (std::size_t(j) * in.width + i) * texel_bytes;
             for (int c = 0; c < channels; ++c) {
               const float v = codec.decode(texel, c);
-              sum[c] += normal && c < 3 ? 2.0f * v - 1.0f : v;
+              sum[c] += Normal && c < 3 ? 2.0f * v - 1.0f : v;
             }
           }
         std::uint8_t* texel = out_base + (std::size_t(y) * out.width + x) * texel_bytes;
         const float count = float(tx.count * ty.count);
-        for (int c = normal ? 3 : 0; c < channels; ++c) codec.encode(texel, c, sum[c] / count);
-        if (normal) {
+        for (int c = Normal ? 3 : 0; c < channels; ++c) codec.encode(texel, c, sum[c] / count);
+        if constexpr (Normal) {
           const double len2 = double(sum[0]) * sum[0] + double(sum[1]) * sum[1] + double(sum[2]) * sum[2];
           const double inv = len2 > 0.0 ? 1.0 / std::sqrt(len2) : 0.0;
           const float n[3] = {len2 > 0.0 ? float(sum[0] * inv) : 0.0f, len2 > 0.0 ? float(sum[1] * inv) : 0.0f,
@@ -149,17 +162,18 @@ float Texture::texel(int level, int x, int y, int c) const {
     throw Error("texture", "texel: level or channel out of range");
   const TextureLevel& l = levels[std::size_t(level)];
   if (x < 0 || y < 0 || x >= l.width || y >= l.height) throw Error("texture", "texel: position out of range");
-  return Codec{format, srgb}.decode(texel_address(level, x, y), c);
+  return with_codec(format, srgb, [&](const auto& codec) { return codec.decode(texel_address(level, x, y), c); });
 }
 
 Image Texture::level_image(int level) const {
   if (level < 0 || level >= level_count()) throw Error("texture", "level_image: level out of range");
   const TextureLevel& l = levels[std::size_t(level)];
-  const Codec codec{format, srgb};
   Image image(l.width, l.height, channels());
-  for (int y = 0; y < l.height; ++y)
-    for (int x = 0; x < l.width; ++x)
-      for (int c = 0; c < image.channels; ++c) image.at(x, y, c) = codec.decode(texel_address(level, x, y), c);
+  with_codec(format, srgb, [&](const auto& codec) {
+    for (int y = 0; y < l.height; ++y)
+      for (int x = 0; x < l.width; ++x)
+        for (int c = 0; c < image.channels; ++c) image.at(x, y, c) = codec.decode(texel_address(level, x, y), c);
+  });
   return image;
 }
 
@@ -194,21 +208,24 @@ std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool 
 void add_linear_copy(Texture& texture) {
   if (texture.levels.empty() || linear_copy_bytes(texture.width(), texture.height(), texture.format, texture.srgb) == 0)
     return;
-  const std::size_t texel_bytes = bytes_per_texel(texture.format);
-  const std::size_t channels = std::size_t(texture.channels());
-  texture.linear.assign(texture.storage.size() / texel_bytes * channels, 0.0f);
-  const Codec codec{texture.format, texture.srgb};
-  for (int k = 0; k < texture.level_count(); ++k) {
-    const TextureLevel& l = texture.levels[std::size_t(k)];
-    for_rows(l.height, std::size_t(l.width) * 4 * channels, [&](int y0, int y1) {
-      for (int y = y0; y < y1; ++y)
-        for (int x = 0; x < l.width; ++x) {
-          const std::size_t texel = l.offset / texel_bytes + std::size_t(y) * std::size_t(l.width) + std::size_t(x);
-          for (std::size_t c = 0; c < channels; ++c)
-            texture.linear[texel * channels + c] = codec.decode(texture.storage.data() + texel * texel_bytes, int(c));
-        }
-    });
-  }
+  texture.linear.assign(texture.storage.size() / std::size_t(bytes_per_texel(texture.format)) *
+                            std::size_t(texture.channels()),
+                        0.0f);
+  with_codec(texture.format, texture.srgb, [&](const auto& codec) {
+    constexpr std::size_t channels = std::decay_t<decltype(codec)>::kChannels;
+    constexpr std::size_t texel_bytes = std::decay_t<decltype(codec)>::kTexelBytes;
+    for (int k = 0; k < texture.level_count(); ++k) {
+      const TextureLevel& l = texture.levels[std::size_t(k)];
+      for_rows(l.height, std::size_t(l.width) * 4 * channels, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+          for (int x = 0; x < l.width; ++x) {
+            const std::size_t texel = l.offset / texel_bytes + std::size_t(y) * std::size_t(l.width) + std::size_t(x);
+            for (std::size_t c = 0; c < channels; ++c)
+              texture.linear[texel * channels + c] = codec.decode(texture.storage.data() + texel * texel_bytes, int(c));
+          }
+      });
+    }
+  });
 }
 
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
@@ -230,15 +247,17 @@ Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, Mip
   if (level0.channels < 1 || level0.channels > 4)
     throw Error("texture", "level 0 must have 1 to 4 channels, not " + std::to_string(level0.channels));
   Texture t = allocate_texture(level0.width, level0.height, format, srgb);
-  const Codec codec{format, srgb};
-  const int channels = t.channels(), texel_bytes = bytes_per_texel(format);
-  for_rows(level0.height, std::size_t(level0.width) * texel_bytes * 8, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y)
-      for (int x = 0; x < level0.width; ++x) {
-        std::uint8_t* texel = t.storage.data() + (std::size_t(y) * level0.width + x) * texel_bytes;
-        for (int c = 0; c < channels; ++c)
-          codec.encode(texel, c, c < level0.channels ? level0.at(x, y, c) : c == 3 ? 1.0f : 0.0f);
-      }
+  with_codec(format, srgb, [&](const auto& codec) {
+    constexpr int channels = std::decay_t<decltype(codec)>::kChannels;
+    constexpr int texel_bytes = std::decay_t<decltype(codec)>::kTexelBytes;
+    for_rows(level0.height, std::size_t(level0.width) * texel_bytes * 8, [&](int y0, int y1) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < level0.width; ++x) {
+          std::uint8_t* texel = t.storage.data() + (std::size_t(y) * level0.width + x) * texel_bytes;
+          for (int c = 0; c < channels; ++c)
+            codec.encode(texel, c, c < level0.channels ? level0.at(x, y, c) : c == 3 ? 1.0f : 0.0f);
+        }
+    });
   });
   build_mip_levels(t, reduce);
   return t;
@@ -255,8 +274,13 @@ void build_mip_levels(Texture& texture, MipReduce reduce) {
     std::uint8_t* out_base = texture.storage.data() + out.offset;
     const std::uint8_t* in_base = texture.storage.data() + in.offset;
     switch (reduce) {
-      case MipReduce::Box: reduce_box(texture, k, false, out_base); break;
-      case MipReduce::BoxNormal: reduce_box(texture, k, true, out_base); break;
+      case MipReduce::Box:
+        with_codec(texture.format, texture.srgb,
+                   [&](const auto& codec) { reduce_box<false>(texture, k, codec, out_base); });
+        break;
+      case MipReduce::BoxNormal:  // rgba8 without sRGB, checked above
+        reduce_box<true>(texture, k, Codec<TexelFormat::RGBA8, false>{}, out_base);
+        break;
       case MipReduce::Max:
         reduce_extremum_best(true, texture.format, in_base, in.width, in.height, out_base, out.width, out.height);
         break;
