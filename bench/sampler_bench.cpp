@@ -6,6 +6,9 @@
 //   coherent  a sweep over the texel centres of level 0 in row order (kPoints consecutive texels, then the next
 //             rows on the next iteration), LOD 0.25: the cache-friendly order of a magnified 1:1 screen mapping
 // Name: sample/<filter>/<format>/<size>/<random|coherent>/<gather|portable|reference>; items/s = samples/s.
+// And an albedo (RGBA8 sRGB with its decoded copy, as the renderer prepares it) and a normal map (RGBA8) of one size
+// sampled at the same points, as the shading programs do: two TextureSamplers, or one TwinSampler that addresses
+// both at once. Name: twin/<filter>/<size>/<random|coherent>/<separate|twin>; items/s = points/s (two samples each).
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -125,6 +128,59 @@ void bench_sample(benchmark::State& state, Filter filter, Format format, int sid
   state.SetItemsProcessed(std::int64_t(state.iterations()) * kPoints);
 }
 
+// The albedo and normal map of twin/...: random texels, the albedo with its decoded sRGB copy.
+const std::pair<Texture, Texture>& albedo_and_normal(int side) {
+  static std::map<int, std::pair<Texture, Texture>> cache;
+  auto it = cache.find(side);
+  if (it == cache.end()) {
+    Image img(side, side, 4);
+    std::mt19937 rng{unsigned(side) + 7u};
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (float& t : img.texels) t = unit(rng);
+    Texture albedo = make_mip_texture(img, TexelFormat::RGBA8, true, MipReduce::Box);
+    add_linear_copy(albedo);
+    for (float& t : img.texels) t = unit(rng);
+    it = cache.emplace(side, std::pair{std::move(albedo), make_mip_texture(img, TexelFormat::RGBA8, false, MipReduce::Box)})
+             .first;
+  }
+  return it->second;
+}
+
+void bench_twin(benchmark::State& state, Filter filter, int side, Access access, bool twin) {
+  const auto& [albedo, normal] = albedo_and_normal(side);
+  SamplingDesc desc;
+  desc.filter = filter;
+  desc.address = AddressMode::Wrap;
+  const SamplerState sampler_state = SamplerState::from(desc);
+  const TwinSampler both(albedo, normal, sampler_state);
+  if (!both.shares_addresses()) {
+    state.SkipWithError("the two textures do not share addresses");
+    return;
+  }
+  const Points points = make_points(albedo, access);
+  std::mt19937 rng(2);
+  long iteration = 0;
+  for (auto _ : state) {
+    const auto [du, dv] = offset(albedo, access, rng, iteration++);
+    Float sum(0.0f);
+    const Float fu(du), fv(dv);
+    for (std::size_t i = 0; i < std::size_t(kPoints); i += std::size_t(kLanes)) {
+      Float a[4], n[4];
+      const Float u = Float::load_aligned(&points.u[i]) + fu, v = Float::load_aligned(&points.v[i]) + fv;
+      const Float lod = Float::load_aligned(&points.lod[i]);
+      if (twin) {
+        both.sample(u, v, lod, lod, a, n);
+      } else {
+        both.first().sample(u, v, lod, a);
+        both.second().sample(u, v, lod, n);
+      }
+      sum += a[0] + n[0];
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * kPoints);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -151,6 +207,16 @@ int main(int argc, char** argv) {
                 ->Unit(benchmark::kMicrosecond)
                 ->MinTime(0.03);  // 30+ iterations even for the slowest case; 432 cases x 3 repetitions in ~3 minutes
           }
+  for (const auto& [filter, filter_name] : {filters[1], filters[2]})
+    for (int side : {512, 2048})
+      for (const auto& [access, access_name] : accesses)
+        for (const bool twin : {false, true}) {
+          const std::string name = std::string("twin/") + filter_name + "/" + std::to_string(side) + "/" + access_name +
+                                   (twin ? "/twin" : "/separate");
+          benchmark::RegisterBenchmark(name.c_str(), bench_twin, filter, side, access, twin)
+              ->Unit(benchmark::kMicrosecond)
+              ->MinTime(0.05);
+        }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

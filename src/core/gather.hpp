@@ -87,16 +87,14 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
 }
 #endif
 
-// 8 bytes at base + byte_offset[lane] (unaligned): bytes 0-3 as `first`, bytes 4-7 as `second` (two adjacent
-// 4-byte texels from one load). AVX2 and AVX-512 build them from 64-bit loads by hand: measured on this project's
-// machines, a pair costs what one 8-lane vpgatherdd of single texels does, where two 4-lane vpgatherdq take
-// 1.2-1.4x that.
-[[gnu::always_inline]] inline void load_bytes8(const std::uint8_t* base, const Int& byte_offset, FetchPath path,
-                                               Int& first, Int& second) {
+// 8 bytes at base + o[lane] (unaligned), o: the lanes' byte offsets in memory: bytes 0-3 as `first`, bytes 4-7 as
+// `second` (two adjacent 4-byte texels from one load). AVX2 and AVX-512 build them from 64-bit loads by hand:
+// measured on this project's machines, a pair costs what one 8-lane vpgatherdd of single texels does, where two
+// 4-lane vpgatherdq take 1.2-1.4x that.
+[[gnu::always_inline]] inline void load_bytes8_at(const std::uint8_t* base, const std::int32_t* o, FetchPath path,
+                                                  Int& first, Int& second) {
 #if defined(__AVX512F__)
   if (path == FetchPath::Gather) {
-    alignas(64) std::int32_t o[kLanes];
-    byte_offset.store_aligned(o);
     const __m512 x = avx512_pairs(base, o, 0), y = avx512_pairs(base, o, 2);
     first = Int(_mm512_castps_si512(_mm512_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0))));
     second = Int(_mm512_castps_si512(_mm512_shuffle_ps(x, y, _MM_SHUFFLE(3, 1, 3, 1))));
@@ -104,8 +102,6 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   }
 #elif defined(__AVX2__)
   if (path == FetchPath::Gather) {
-    alignas(32) std::int32_t o[kLanes];
-    byte_offset.store_aligned(o);
     const auto halves = [&](int lane) {  // low half: lanes lane, lane + 1; high half: lanes lane + 4, lane + 5
       return _mm256_castsi256_ps(_mm256_inserti128_si256(_mm256_castsi128_si256(load_two_pairs(base, o, lane)),
                                                          load_two_pairs(base, o, lane + 4), 1));
@@ -117,32 +113,36 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   }
 #endif
   (void)path;
-  alignas(64) std::int32_t offset[kLanes], a[kLanes], b[kLanes];
-  byte_offset.store_aligned(offset);
+  alignas(64) std::int32_t a[kLanes], b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
-    std::memcpy(&a[lane], base + offset[lane], 4);
-    std::memcpy(&b[lane], base + offset[lane] + 4, 4);
+    std::memcpy(&a[lane], base + o[lane], 4);
+    std::memcpy(&b[lane], base + o[lane] + 4, 4);
   }
   first = Int::load_aligned(a);
   second = Int::load_aligned(b);
 }
 
-// Two texels of 4 floats at base + index[lane] (unaligned): floats 0-3 into first[0..3], floats 4-7 into
-// second[0..3], one vector per float. AVX2 and AVX-512 transpose them from 128-bit loads (4x4 per 128-bit segment).
-[[gnu::always_inline]] inline void load_f32x4_pair(const float* base, const Int& index, FetchPath path, Float* first,
-                                                   Float* second) {
+// load_bytes8_at() with the offsets in a vector.
+[[gnu::always_inline]] inline void load_bytes8(const std::uint8_t* base, const Int& byte_offset, FetchPath path,
+                                               Int& first, Int& second) {
+  alignas(64) std::int32_t o[kLanes];
+  byte_offset.store_aligned(o);
+  load_bytes8_at(base, o, path, first, second);
+}
+
+// Two texels of 4 floats at base + o[lane] (unaligned), o: the lanes' float indices in memory: floats 0-3 into
+// first[0..3], floats 4-7 into second[0..3], one vector per float. AVX2 and AVX-512 transpose them from 128-bit
+// loads (4x4 per 128-bit segment).
+[[gnu::always_inline]] inline void load_f32x4_pair_at(const float* base, const std::int32_t* o, FetchPath path,
+                                                      Float* first, Float* second) {
 #if defined(__AVX512F__)
   if (path == FetchPath::Gather) {
-    alignas(64) std::int32_t o[kLanes];
-    index.store_aligned(o);
     avx512_transpose(base, o, 0, first);
     avx512_transpose(base, o, 4, second);
     return;
   }
 #elif defined(__AVX2__)
   if (path == FetchPath::Gather) {
-    alignas(32) std::int32_t o[kLanes];
-    index.store_aligned(o);
     const auto transpose = [&](int at, Float* out) {
       const auto row = [&](int lane) {  // lane's texel in the low half, lane + 4's in the high half
         return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + o[lane] + at)),
@@ -165,10 +165,8 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   // costs a store-forwarding stall per vector).
   static_assert(kLanes == 4);
   (void)path;
-  alignas(16) std::int32_t lane_index[kLanes];
-  index.store_aligned(lane_index);
   for (int at : {0, 4}) {
-    const auto row = [&](int lane) { return _mm_loadu_ps(base + lane_index[lane] + at); };
+    const auto row = [&](int lane) { return _mm_loadu_ps(base + o[lane] + at); };
     __m128 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
     _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
     Float* out = at == 0 ? first : second;
@@ -180,15 +178,21 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   return;
 #endif
   (void)path;
-  alignas(64) std::int32_t o[kLanes];
   alignas(64) float value[8][kLanes];
-  index.store_aligned(o);
   for (int lane = 0; lane < kLanes; ++lane)
     for (int i = 0; i < 8; ++i) value[i][lane] = base[o[lane] + i];
   for (int i = 0; i < 4; ++i) {
     first[i] = Float::load_aligned(value[i]);
     second[i] = Float::load_aligned(value[4 + i]);
   }
+}
+
+// load_f32x4_pair_at() with the indices in a vector.
+[[gnu::always_inline]] inline void load_f32x4_pair(const float* base, const Int& index, FetchPath path, Float* first,
+                                                   Float* second) {
+  alignas(64) std::int32_t o[kLanes];
+  index.store_aligned(o);
+  load_f32x4_pair_at(base, o, path, first, second);
 }
 
 // table[index[lane]] for int32 and float tables.

@@ -54,7 +54,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   ao_sampler.filter = Filter::Bilinear;
   for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
     const LayerInputs& l = inputs.layers[i];
-    Layer layer{TextureSampler(*l.albedo, sampler_), TextureSampler(*l.normal, sampler_), std::nullopt, std::nullopt,
+    Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_), std::nullopt, std::nullopt,
                 i < material.layers.size() ? material.layers[i].specular : SpecularFromAlbedo{}};
     if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, technique_.height_fetch);
     if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);
@@ -236,16 +236,16 @@ DisplacementProgram::QdmBudget DisplacementProgram::qdm_budget(const Setup& setu
 
 namespace {
 
-// Albedo and tangent-space normal (unnormalised) of one layer at the hit.
-void layer_colour(const TextureSampler& albedo_texture, const TextureSampler& normal_texture, const UvDerivatives& d,
-                  const Float& u, const Float& v, Float* albedo, Float* normal) {
+// Albedo and tangent-space normal (unnormalised) of one layer at the hit; textures: albedo first, normal second.
+void layer_colour(const TwinSampler& textures, const UvDerivatives& d, const Float& u, const Float& v, Float* albedo,
+                  Float* normal) {
+  const TextureSampler &albedo_texture = textures.first(), &normal_texture = textures.second();
   const Float albedo_lod = albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
-  albedo_texture.sample(u, v, albedo_lod, albedo);
   Float n[4];
-  normal_texture.sample(u, v,
-                        normal_texture.same_lod_as(albedo_texture) ? albedo_lod
-                                                                   : normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
-                        n);
+  textures.sample(u, v, albedo_lod,
+                  normal_texture.same_lod_as(albedo_texture) ? albedo_lod
+                                                             : normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
+                  albedo, n);
   for (int c = 0; c < 3; ++c) normal[c] = n[c] * Float(2.0f) - Float(1.0f);
 }
 
@@ -321,7 +321,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
   FetchLanes surface_lanes(FetchPhase::Surface);
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
     const Layer& l = layers_[0];
-    layer_colour(l.albedo, l.normal, d, hu, hv, albedo, tangent_normal);
+    layer_colour(l.textures, d, hu, hv, albedo, tangent_normal);
     specular = specular_from_albedo(albedo, l.specular, lighting_.specular);
     if (l.ao) ao = baked_ao(l);
   } else {
@@ -348,7 +348,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
       layer_lanes.narrow(f[i] > Float(0.0f));
       const Layer& l = layers_[std::size_t(i)];
       Float a[4], n[3];
-      layer_colour(l.albedo, l.normal, d, hu, hv, a, n);
+      layer_colour(l.textures, d, hu, hv, a, n);
       for (int c = 0; c < 4; ++c) albedo[c] += f[i] * a[c];
       for (int c = 0; c < 3; ++c) tangent_normal[c] += f[i] * n[c];
       specular += f[i] * specular_from_albedo(a, l.specular, lighting_.specular);

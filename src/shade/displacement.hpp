@@ -44,7 +44,7 @@ public:
 
 private:
   struct Layer {
-    TextureSampler albedo, normal;
+    TwinSampler textures;  // albedo first, normal map second
     std::optional<HeightLayerTextures> height;  // and its max chain
     std::optional<TextureSampler> ao;          // bilinear
     SpecularFromAlbedo specular;

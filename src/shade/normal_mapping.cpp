@@ -14,13 +14,13 @@ struct NormalMappingProgram::Samples {
 
 Float NormalMappingProgram::albedo_lod(const Fragments& in) const {
   const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
-  return albedo_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+  return textures_.first().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
 Float NormalMappingProgram::normal_lod(const Fragments& in, const Float& albedo_lod) const {
-  if (normal_.same_lod_as(albedo_)) return albedo_lod;
+  if (textures_.second().same_lod_as(textures_.first())) return albedo_lod;
   const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
-  return normal_.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+  return textures_.second().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
 void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOutput& out) const {
@@ -43,8 +43,7 @@ void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOut
 void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   Samples s;
   const Float lod = albedo_lod(in);
-  albedo_.sample(in.varyings[kU], in.varyings[kV], lod, s.albedo);
-  normal_.sample(in.varyings[kU], in.varyings[kV], normal_lod(in, lod), s.tangent_normal);
+  textures_.sample(in.varyings[kU], in.varyings[kV], lod, normal_lod(in, lod), s.albedo, s.tangent_normal);
   light(in, s, out);
 }
 
@@ -55,10 +54,8 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
                                       ShadeOutput& out_b) const {
   Samples sa, sb;
   const Float lod_a = albedo_lod(a), lod_b = albedo_lod(b);
-  albedo_.sample(a.varyings[kU], a.varyings[kV], lod_a, sa.albedo);
-  albedo_.sample(b.varyings[kU], b.varyings[kV], lod_b, sb.albedo);
-  normal_.sample(a.varyings[kU], a.varyings[kV], normal_lod(a, lod_a), sa.tangent_normal);
-  normal_.sample(b.varyings[kU], b.varyings[kV], normal_lod(b, lod_b), sb.tangent_normal);
+  textures_.sample(a.varyings[kU], a.varyings[kV], lod_a, normal_lod(a, lod_a), sa.albedo, sa.tangent_normal);
+  textures_.sample(b.varyings[kU], b.varyings[kV], lod_b, normal_lod(b, lod_b), sb.albedo, sb.tangent_normal);
   light(a, sa, out_a);
   light(b, sb, out_b);
 }

@@ -12,7 +12,7 @@ public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
                        const LightingDesc& lighting, const SpecularFromAlbedo& specular, const LightRig& lights)
-      : ShadingProgram(variant, kBaseVaryingCount), albedo_(albedo, SamplerState::from(sampling)), normal_(normal, SamplerState::from(sampling)), lod_mode_(sampling.lod),
+      : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling)), lod_mode_(sampling.lod),
         lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
@@ -24,7 +24,7 @@ private:
   simd::Float normal_lod(const Fragments& in, const simd::Float& albedo_lod) const;
   void light(const Fragments& in, const Samples& samples, ShadeOutput& out) const;
 
-  TextureSampler albedo_, normal_;
+  TwinSampler textures_;  // albedo first, normal map second
   LodMode lod_mode_;
   LightingDesc lighting_;
   SpecularFromAlbedo specular_;

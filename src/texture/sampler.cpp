@@ -50,19 +50,71 @@ constexpr FetchPath kDefaultFetch = simd::kHasHardwareGather ? FetchPath::Gather
 constexpr std::size_t kFormatCount = std::size(kCommonFormats);
 constexpr std::size_t kCommonKeys = std::size(kCommonFilters) * std::size(kCommonBits) * 2 * kFormatCount;
 
-constexpr SamplerKey common_key(std::size_t i) {
+// Key i of formats x texel rounding (exact_texel) x fraction bits x filters, with wrap addressing and this build's
+// default fetch path.
+template <std::size_t F, std::size_t L>
+constexpr SamplerKey enumerated_key(std::size_t i, const std::pair<TexelFormat, bool> (&formats)[F],
+                                    const Filter (&filters)[L]) {
   SamplerKey k;
-  k.format = kCommonFormats[i % kFormatCount].first;
-  k.srgb = kCommonFormats[i % kFormatCount].second;
-  i /= kFormatCount;
+  k.format = formats[i % F].first;
+  k.srgb = formats[i % F].second;
+  i /= F;
   k.exact_texel = i % 2 == 1;
   i /= 2;
   k.fraction_bits = kCommonBits[i % std::size(kCommonBits)];
   i /= std::size(kCommonBits);
-  k.filter = kCommonFilters[i];
+  k.filter = filters[i];
   k.address = AddressMode::Wrap;
   k.fetch = kDefaultFetch;
   return k;
+}
+
+constexpr SamplerKey common_key(std::size_t i) { return enumerated_key(i, kCommonFormats, kCommonFilters); }
+
+// Twin samples (TwinSampler): the common keys' linear filters for an RGBA8 first texture, sRGB or not, and an
+// RGBA8 second one that is not (a normal map).
+constexpr Filter kTwinFilters[] = {Filter::Bilinear, Filter::Trilinear};
+constexpr std::pair<TexelFormat, bool> kTwinFirstFormats[] = {{TexelFormat::RGBA8, false}, {TexelFormat::RGBA8, true}};
+constexpr std::size_t kTwinKeys = std::size(kTwinFilters) * std::size(kCommonBits) * 2 * std::size(kTwinFirstFormats);
+
+constexpr SamplerKey twin_first_key(std::size_t i) { return enumerated_key(i, kTwinFirstFormats, kTwinFilters); }
+
+constexpr SamplerKey twin_second_key(std::size_t i) {
+  SamplerKey k = twin_first_key(i);
+  k.srgb = false;
+  return k;
+}
+
+template <SamplerKey KA, SamplerKey KB>
+void sample_twin_fixed(const TextureView& a, const TextureView& b, const SamplerState& s, const Float& u,
+                       const Float& v, const Float& lod, Float* out_a, Float* out_b) {
+  sample_twin_with(KA, KB, a, b, s, u, v, lod, out_a, out_b);
+}
+
+struct TwinEntry {
+  SamplerKey first, second;
+  TwinSampleFunction sample;
+};
+
+template <std::size_t... I>
+constexpr std::array<TwinEntry, sizeof...(I)> twin_samplers(std::index_sequence<I...>) {
+  return {{{twin_first_key(I), twin_second_key(I), &sample_twin_fixed<twin_first_key(I), twin_second_key(I)>}...}};
+}
+constexpr std::array<TwinEntry, kTwinKeys> kTwinSamplers = twin_samplers(std::make_index_sequence<kTwinKeys>());
+
+// Both chains laid out alike: the same level count, and per level the same size and byte offset.
+bool same_layout(const TextureView& a, const TextureView& b) {
+  return a.levels() == b.levels() && std::equal(a.widths(), a.widths() + TextureView::kMaxLevels, b.widths()) &&
+         std::equal(a.heights(), a.heights() + TextureView::kMaxLevels, b.heights()) &&
+         std::equal(a.offsets(), a.offsets() + TextureView::kMaxLevels, b.offsets());
+}
+
+TwinSampleFunction twin_sample_function(const TextureSampler& a, const TextureSampler& b) {
+  const SamplerKey ka = a.key(), kb = b.key();
+  if (!twin_keys(ka, kb) || !same_layout(a.view(), b.view())) return nullptr;
+  for (const TwinEntry& e : kTwinSamplers)
+    if (e.first == ka && e.second == kb) return e.sample;
+  return nullptr;
 }
 
 struct SampleEntry {
@@ -177,5 +229,8 @@ TextureSampler::TextureSampler(const Texture& texture, const SamplerState& state
   load_ = e ? e->clamped : static_cast<LoadFunction>(&qdmr::QDMR_ISA::load);
   load_wrapped_ = e ? e->wrapped : &load_generic_wrapped;
 }
+
+TwinSampler::TwinSampler(const Texture& first, const Texture& second, const SamplerState& state)
+    : first_(first, state), second_(second, state), twin_(twin_sample_function(first_, second_)) {}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -138,4 +138,35 @@ private:
   LoadFunction load_, load_wrapped_;
 };
 
+using TwinSampleFunction = void (*)(const TextureView& a, const TextureView& b, const SamplerState&,
+                                    const simd::Float& u, const simd::Float& v, const simd::Float& lod,
+                                    simd::Float* out_a, simd::Float* out_b);
+
+// Two textures a program samples at the same coordinates under one sampler state, such as its albedo and its
+// normal map. Where both are RGBA8 chains of one size and the key is a common one, a texel sits at the same offset
+// in both, so one address computation and one offset per lane serve both textures (sample_twin_with in
+// sampling_code.hpp); otherwise, and while a texture-cache recorder listens, two samples. The same bits either way.
+class TwinSampler {
+public:
+  TwinSampler(const Texture& first, const Texture& second, const SamplerState& state);
+
+  const TextureSampler& first() const { return first_; }
+  const TextureSampler& second() const { return second_; }
+  bool shares_addresses() const { return twin_ != nullptr; }
+  // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as).
+  void sample(const simd::Float& u, const simd::Float& v, const simd::Float& first_lod, const simd::Float& second_lod,
+              simd::Float* first_out, simd::Float* second_out) const {
+    if (twin_ != nullptr && !fetch_recorder_listens()) {
+      twin_(first_.view(), second_.view(), first_.state(), u, v, first_lod, first_out, second_out);
+      return;
+    }
+    first_.sample(u, v, first_lod, first_out);
+    second_.sample(u, v, second_lod, second_out);
+  }
+
+private:
+  TextureSampler first_, second_;
+  TwinSampleFunction twin_;
+};
+
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

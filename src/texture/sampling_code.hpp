@@ -113,6 +113,16 @@ QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, con
   decode(k, simd::load_bytes4(t.storage.data(), offset, k.fetch), out);
 }
 
+// Texels (x, y) and (x + 1, y) of every lane of a texture with 4-byte texels, from one 8-byte load per lane, o: the
+// lanes' byte offsets of texel (x, y).
+QDMR_SAMPLER_INLINE void fetch_texel_pair_at(const Texture& t, const SamplerKey& k, const std::int32_t* o, Float* a,
+                                             Float* b) {
+  Int first, second;
+  simd::load_bytes8_at(t.storage.data(), o, k.fetch, first, second);
+  decode(k, first, a);
+  decode(k, second, b);
+}
+
 // fetch() of texels (xa, y) and (xb, y) = (xa + 1, y), adjacent in memory, from one load per lane: 4 bytes for
 // texels of 1 or 2 bytes, 8 bytes for texels of 4.
 QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k, const LevelInfo& level, const Int& xa,
@@ -138,10 +148,9 @@ QDMR_SAMPLER_INLINE void fetch_pair(const TextureView& view, const SamplerKey& k
     decode(k, raw >> (8 * bytes), b);  // decode keeps the texel's low bytes only
     return;
   }
-  Int first, second;
-  simd::load_bytes8(t.storage.data(), offset, k.fetch, first, second);
-  decode(k, first, a);
-  decode(k, second, b);
+  alignas(64) std::int32_t o[kLanes];
+  offset.store_aligned(o);
+  fetch_texel_pair_at(t, k, o, a, b);
 }
 
 // fetch_pair() of an RGBA8 sRGB texture from its decoded copy (Texture::linear): whole texels, no table lookups.
@@ -200,46 +209,132 @@ QDMR_SAMPLER_INLINE void split(const Float& u, const Float& n, bool n_power_of_t
   weight = xsimd::to_float(f & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
 }
 
-QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
-                              const LevelInfo& info, bool linear, Float* out, bool record = true) {
+// The four texels of a bilinear footprint on one level and the weights between them: texels (xa | xb, ya | yb).
+struct BilinearTaps {
+  Int xa, xb, ya, yb;
+  Float wx, wy;
+  // Every lane's xb is xa + 1, so texel xb follows texel xa in memory (all but the lanes at a wrap or clamp edge)
+  // and one load per row gives both.
+  bool adjacent;
+};
+
+QDMR_SAMPLER_INLINE BilinearTaps bilinear_taps(const TextureView& view, const SamplerKey& k, const Float& u,
+                                               const Float& v, const LevelInfo& info) {
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
   const bool pow2 = view.power_of_two();
+  Int x0, y0;
+  BilinearTaps t;
+  split(u, w, pow2, 0.5f, k.fraction_bits, k.exact_texel, x0, t.wx);
+  split(v, h, pow2, 0.5f, k.fraction_bits, k.exact_texel, y0, t.wy);
+  t.xa = address(x0, info.width, k.address);
+  t.xb = address(x0 + Int(1), info.width, k.address);
+  t.ya = address(y0, info.height, k.address);
+  t.yb = address(y0 + Int(1), info.height, k.address);
+  t.adjacent = xsimd::all(t.xb == t.xa + Int(1));
+  return t;
+}
+
+// The point-sampled texel of each lane.
+QDMR_SAMPLER_INLINE void point_texel(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
+                                     const LevelInfo& info, Int& x, Int& y) {
+  const bool pow2 = view.power_of_two();
+  Float unused;
+  split(u, xsimd::to_float(info.width), pow2, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
+  split(v, xsimd::to_float(info.height), pow2, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
+  x = address(x, info.width, k.address);
+  y = address(y, info.height, k.address);
+}
+
+// The taps' texels one by one (any lane at an edge).
+QDMR_SAMPLER_INLINE void fetch_taps(const TextureView& view, const SamplerKey& k, const LevelInfo& info,
+                                    const BilinearTaps& t, Float* t00, Float* t10, Float* t01, Float* t11,
+                                    bool record) {
+  fetch(view, k, info, t.xa, t.ya, t00, record);
+  fetch(view, k, info, t.xb, t.ya, t10, record);
+  fetch(view, k, info, t.xa, t.yb, t01, record);
+  fetch(view, k, info, t.xb, t.yb, t11, record);
+}
+
+QDMR_SAMPLER_INLINE void filter_taps(const SamplerKey& k, const BilinearTaps& t, const Float* t00, const Float* t10,
+                                     const Float* t01, const Float* t11, Float* out) {
+  for (int c = 0; c < channel_count(k.format); ++c) {
+    const Float top = t00[c] + (t10[c] - t00[c]) * t.wx;
+    const Float bottom = t01[c] + (t11[c] - t01[c]) * t.wx;
+    out[c] = top + (bottom - top) * t.wy;
+  }
+}
+
+QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
+                              const LevelInfo& info, bool linear, Float* out, bool record = true) {
   if (!linear) {
     Int x, y;
-    Float unused;
-    split(u, w, pow2, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
-    split(v, h, pow2, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
-    fetch(view, k, info, address(x, info.width, k.address), address(y, info.height, k.address), out, record);
+    point_texel(view, k, u, v, info, x, y);
+    fetch(view, k, info, x, y, out, record);
     return;
   }
-  Int x0, y0;
-  Float wx, wy;
-  split(u, w, pow2, 0.5f, k.fraction_bits, k.exact_texel, x0, wx);
-  split(v, h, pow2, 0.5f, k.fraction_bits, k.exact_texel, y0, wy);
-  const Int xa = address(x0, info.width, k.address), xb = address(x0 + Int(1), info.width, k.address);
-  const Int ya = address(y0, info.height, k.address), yb = address(y0 + Int(1), info.height, k.address);
+  const BilinearTaps t = bilinear_taps(view, k, u, v, info);
   Float t00[4], t10[4], t01[4], t11[4];
-  // Texel xa + 1 follows texel xa in memory, so where every lane's xb is xa + 1 (all but the lanes at a wrap or
-  // clamp edge) one load per row gives both texels.
-  if (xsimd::all(xb == xa + Int(1))) {
+  if (t.adjacent) {
     if (k.format == TexelFormat::RGBA8 && k.srgb && !view.texture().linear.empty()) {
-      fetch_linear_pair(view, k, info, xa, xb, ya, t00, t10, record);
-      fetch_linear_pair(view, k, info, xa, xb, yb, t01, t11, record);
+      fetch_linear_pair(view, k, info, t.xa, t.xb, t.ya, t00, t10, record);
+      fetch_linear_pair(view, k, info, t.xa, t.xb, t.yb, t01, t11, record);
     } else {
-      fetch_pair(view, k, info, xa, xb, ya, t00, t10, record);
-      fetch_pair(view, k, info, xa, xb, yb, t01, t11, record);
+      fetch_pair(view, k, info, t.xa, t.xb, t.ya, t00, t10, record);
+      fetch_pair(view, k, info, t.xa, t.xb, t.yb, t01, t11, record);
     }
   } else {
-    fetch(view, k, info, xa, ya, t00, record);
-    fetch(view, k, info, xb, ya, t10, record);
-    fetch(view, k, info, xa, yb, t01, record);
-    fetch(view, k, info, xb, yb, t11, record);
+    fetch_taps(view, k, info, t, t00, t10, t01, t11, record);
   }
-  for (int c = 0; c < channel_count(k.format); ++c) {
-    const Float top = t00[c] + (t10[c] - t00[c]) * wx;
-    const Float bottom = t01[c] + (t11[c] - t01[c]) * wx;
-    out[c] = top + (bottom - top) * wy;
+  filter_taps(k, t, t00, t10, t01, t11, out);
+}
+
+// Two RGBA8 textures whose chains have one size (so one layout) sampled at the same coordinates: twin_keys()
+// says where that holds. A texel sits at the same byte offset in both chains, and in texels of 4 floats at that
+// float index of the decoded sRGB copy, so one texel offset per lane serves both textures.
+QDMR_SAMPLER_INLINE bool twin_keys(const SamplerKey& a, const SamplerKey& b) {
+  return a.format == TexelFormat::RGBA8 && b.format == TexelFormat::RGBA8 && a.filter == b.filter &&
+         a.address == b.address && a.fraction_bits == b.fraction_bits && a.exact_texel == b.exact_texel &&
+         a.fetch == b.fetch;
+}
+
+// Texels (x, y) and (x + 1, y) of every lane of an RGBA8 texture, o: the lanes' byte offsets of texel (x, y).
+QDMR_SAMPLER_INLINE void fetch_rgba8_pair_at(const TextureView& view, const SamplerKey& k, const std::int32_t* o,
+                                             Float* first, Float* second) {
+  const Texture& t = view.texture();
+  if (k.srgb && !t.linear.empty())
+    simd::load_f32x4_pair_at(t.linear.data(), o, k.fetch, first, second);
+  else
+    fetch_texel_pair_at(t, k, o, first, second);
+}
+
+// sample_level() of two textures (twin_keys) at once: out[0..3] texture a's channels, out[4..7] texture b's. Never
+// recorded: the caller knows no texture-cache recorder listens.
+QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
+                                           const SamplerKey& kb, const Float& u, const Float& v, const LevelInfo& info,
+                                           bool linear, Float* out) {
+  if (!linear) {
+    Int x, y;
+    point_texel(va, ka, u, v, info, x, y);
+    fetch(va, ka, info, x, y, out, false);
+    fetch(vb, kb, info, x, y, out + 4, false);
+    return;
   }
+  const BilinearTaps t = bilinear_taps(va, ka, u, v, info);
+  Float a00[4], a10[4], a01[4], a11[4], b00[4], b10[4], b01[4], b11[4];
+  if (t.adjacent) {
+    alignas(64) std::int32_t top[kLanes], bottom[kLanes];
+    (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
+    (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
+    fetch_rgba8_pair_at(va, ka, top, a00, a10);
+    fetch_rgba8_pair_at(vb, kb, top, b00, b10);
+    fetch_rgba8_pair_at(va, ka, bottom, a01, a11);
+    fetch_rgba8_pair_at(vb, kb, bottom, b01, b11);
+  } else {
+    fetch_taps(va, ka, info, t, a00, a10, a01, a11, false);
+    fetch_taps(vb, kb, info, t, b00, b10, b01, b11, false);
+  }
+  filter_taps(ka, t, a00, a10, a01, a11, out);
+  filter_taps(kb, t, b00, b10, b01, b11, out + 4);
 }
 
 // Whether a mip-linear sample may skip its coarse level: no lane weighs it (f, the LOD's fraction, is 0 in every
@@ -251,16 +346,19 @@ QDMR_SAMPLER_INLINE bool coarse_level_weightless(const SamplerKey& k, const Floa
   return k.format != TexelFormat::R32F && (!record || !fetch_recorder_listens()) && xsimd::all(f == Float(0.0f));
 }
 
-// record false: the caller knows no texture-cache recorder listens (see fetch()).
-QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const SamplerState& s, const Float& u,
-                             const Float& v, const Float& lod, Float* out, bool record = true) {
+// The filter's levels and their blend, for one texture or two alike (sample_twin_with): at_level(ru, rv, info,
+// linear, out) samples `channels` channels of one level, first_texel[c] is channel c's value for lanes with
+// non-finite coordinates. k's filter, address mode, fraction bits and format decide; view gives the levels.
+template <class AtLevel>
+QDMR_SAMPLER_INLINE void sample_levels(const SamplerKey& k, const TextureView& view, const SamplerState& s,
+                                       const Float& u, const Float& v, const Float& lod, int channels,
+                                       const float* first_texel, bool record, const AtLevel& at_level, Float* out) {
   const Mask finite = is_finite(u) & is_finite(v);
   const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), k.address);
   const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), k.address);
   const bool linear = k.filter == Filter::Bilinear || k.filter == Filter::Trilinear || k.filter == Filter::LinearMipPoint;
-  const int channels = channel_count(k.format);
   if (k.filter == Filter::Point || k.filter == Filter::Bilinear) {
-    sample_level(view, k, ru, rv, level_zero(view), linear, out, record);
+    at_level(ru, rv, level_zero(view), linear, out);
   } else {
     const Float last(float(view.levels() - 1));
     Float l = lod + Float(s.lod_bias);
@@ -270,23 +368,55 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
     const int bits = k.fraction_bits;
     if (bits > 0) l = xsimd::floor(l * Float(float(1 << bits))) * Float(1.0f / float(1 << bits));
     if (k.filter == Filter::PointMipPoint || k.filter == Filter::LinearMipPoint) {
-      sample_level(view, k, ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f)))), linear, out,
-                   record);
+      at_level(ru, rv, level_info(view, xsimd::to_int(xsimd::floor(l + Float(0.5f)))), linear, out);
     } else {  // trilinear, point-mip-linear
       const Float l0 = xsimd::floor(l), f = l - l0;
       const Int i0 = xsimd::to_int(l0);
-      Float fine[4], coarse[4];
-      sample_level(view, k, ru, rv, level_info(view, i0), linear, fine, record);
+      Float fine[8], coarse[8];
+      at_level(ru, rv, level_info(view, i0), linear, fine);
       if (coarse_level_weightless(k, f, record)) {
         for (int c = 0; c < channels; ++c) out[c] = fine[c];
       } else {
-        sample_level(view, k, ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear,
-                     coarse, record);
+        at_level(ru, rv, level_info(view, xsimd::min(i0 + Int(1), Int(view.levels() - 1))), linear, coarse);
         for (int c = 0; c < channels; ++c) out[c] = fine[c] + (coarse[c] - fine[c]) * f;
       }
     }
   }
-  for (int c = 0; c < channels; ++c) out[c] = xsimd::select(finite, out[c], Float(view.first_texel()[std::size_t(c)]));
+  for (int c = 0; c < channels; ++c) out[c] = xsimd::select(finite, out[c], Float(first_texel[c]));
+}
+
+// record false: the caller knows no texture-cache recorder listens (see fetch()).
+QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& view, const SamplerState& s, const Float& u,
+                             const Float& v, const Float& lod, Float* out, bool record = true) {
+  sample_levels(k, view, s, u, v, lod, channel_count(k.format), view.first_texel().data(), record,
+                [&](const Float& ru, const Float& rv, const LevelInfo& info, bool linear,
+                    Float* level_out) __attribute__((always_inline)) {
+                  sample_level(view, k, ru, rv, info, linear, level_out, record);
+                },
+                out);
+}
+
+// sample_with() of two textures alike (twin_keys, one chain layout) at the same coordinates and LOD: out_a and
+// out_b get what sample_with() gives each, from one address computation. Never recorded.
+QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey& kb, const TextureView& va,
+                                          const TextureView& vb, const SamplerState& s, const Float& u,
+                                          const Float& v, const Float& lod, Float* out_a, Float* out_b) {
+  float first_texel[8];
+  for (int c = 0; c < 4; ++c) {
+    first_texel[c] = va.first_texel()[std::size_t(c)];
+    first_texel[4 + c] = vb.first_texel()[std::size_t(c)];
+  }
+  Float out[8];
+  sample_levels(ka, va, s, u, v, lod, 8, first_texel, false,
+                [&](const Float& ru, const Float& rv, const LevelInfo& info, bool linear,
+                    Float* level_out) __attribute__((always_inline)) {
+                  sample_level_twin(va, ka, vb, kb, ru, rv, info, linear, level_out);
+                },
+                out);
+  for (int c = 0; c < 4; ++c) {
+    out_a[c] = out[c];
+    out_b[c] = out[4 + c];
+  }
 }
 
 // wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.

@@ -582,5 +582,72 @@ TEST(TextureSampler, CellMaxIsLoadWrapped) {
   }
 }
 
+// A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler, for
+// every sampler state, on both fetch paths, with and without the albedo's decoded sRGB copy, power-of-two and
+// other sizes, lanes with non-finite coordinates, lanes at the wrap and clamp edges, and batches that skip the
+// coarse level. It shares addresses exactly where sampler.cpp instantiates a twin: RGBA8 chains of one size, the
+// second not sRGB, bilinear or trilinear with wrap, exact or 8-bit weights, on the default fetch path.
+TEST(TwinSampler, GivesEachTextureTheBitsOfItsOwnSampler) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-3.0f, 4.0f), lod(-1.0f, 9.0f);
+  struct Case {
+    int w, h;
+    bool srgb, decoded_copy;
+  };
+  const auto chain = [&](int w, int h, bool srgb, bool decoded_copy) {
+    Image img(w, h, 4);
+    for (float& t : img.texels) t = unit(rng);
+    Texture t = make_mip_texture(img, TexelFormat::RGBA8, srgb, MipReduce::Box);
+    if (decoded_copy) add_linear_copy(t);
+    return t;
+  };
+  for (const Case& c : {Case{32, 64, true, true}, Case{32, 64, true, false}, Case{37, 20, true, true},
+                        Case{16, 16, false, false}, Case{1, 1, true, true}}) {
+    const Texture albedo = chain(c.w, c.h, c.srgb, c.decoded_copy), normal = chain(c.w, c.h, false, false);
+    ASSERT_EQ(albedo.linear.empty(), !c.decoded_copy);
+    int shared = 0, expected_shared = 0;
+    for (const SamplerState& state : every_sampler_state()) {
+      const TwinSampler twin(albedo, normal, state);
+      const TextureSampler first(albedo, state), second(normal, state);
+      const bool common = state.address == AddressMode::Wrap && state.precision != SamplePrecision::Hw6 &&
+                          (state.filter == Filter::Bilinear || state.filter == Filter::Trilinear) &&
+                          state.fetch == SamplerState{}.fetch;
+      EXPECT_EQ(twin.shares_addresses(), common) << filter_name(state.filter) << " " << c.w << "x" << c.h;
+      shared += twin.shares_addresses() ? 1 : 0;
+      expected_shared += common ? 1 : 0;
+      for (int round = 0; round < 12; ++round) {
+        Lanes u, v, l;
+        for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+        if (round == 0) u[1 % kLanes] = kNaN, v[2 % kLanes] = -kInf, l[3 % kLanes] = kNaN;
+        if (round % 3 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
+          for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
+        if (round % 4 == 2)  // whole LODs: no lane weighs the coarse level
+          for (int i = 0; i < kLanes; ++i) l[i] = std::floor(l[i]) - state.lod_bias;
+        Float a[4], b[4], twin_a[4], twin_b[4];
+        first.sample(load(u), load(v), load(l), a);
+        second.sample(load(u), load(v), load(l), b);
+        twin.sample(load(u), load(v), load(l), load(l), twin_a, twin_b);
+        for (int ch = 0; ch < 4; ++ch)
+          for (int i = 0; i < kLanes; ++i) {
+            ASSERT_EQ(bits(lanes(twin_a[ch])[i]), bits(lanes(a[ch])[i]))
+                << filter_name(state.filter) << " first, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
+            ASSERT_EQ(bits(lanes(twin_b[ch])[i]), bits(lanes(b[ch])[i]))
+                << filter_name(state.filter) << " second, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
+          }
+      }
+    }
+    EXPECT_GT(shared, 0) << c.w << "x" << c.h;
+    EXPECT_EQ(shared, expected_shared);
+  }
+  // Nothing is shared between chains of different sizes, or with a second texture in another format or in sRGB.
+  const Texture a = chain(32, 32, true, true), wider = chain(64, 32, false, false), srgb = chain(32, 32, true, false);
+  Image grey(32, 32, 1);
+  const Texture r8 = make_mip_texture(grey, TexelFormat::R8, false, MipReduce::Box);
+  EXPECT_FALSE(TwinSampler(a, wider, SamplerState{}).shares_addresses());
+  EXPECT_FALSE(TwinSampler(a, r8, SamplerState{}).shares_addresses());
+  EXPECT_FALSE(TwinSampler(a, srgb, SamplerState{}).shares_addresses());
+  EXPECT_TRUE(TwinSampler(a, chain(32, 32, false, false), SamplerState{}).shares_addresses());
+}
+
 }  // namespace
 }  // namespace qdmr
