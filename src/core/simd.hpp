@@ -34,21 +34,6 @@ inline constexpr int kQuadsPerBatch = kLanes / 4;
 // Lane layout inside one quad: 0 1 / 2 3 (x to the right, y down). Quad q occupies lanes 4q..4q+3.
 inline constexpr int kQuadTopLeft = 0, kQuadTopRight = 1, kQuadBottomLeft = 2, kQuadBottomRight = 3;
 
-// Bit i set = lane i active.
-inline std::uint32_t to_bits(const Mask& m) {
-  alignas(64) bool lanes[kLanes];
-  m.store_aligned(lanes);
-  std::uint32_t bits = 0;
-  for (int i = 0; i < kLanes; ++i) bits |= std::uint32_t(lanes[i]) << i;
-  return bits;
-}
-
-inline Mask from_bits(std::uint32_t bits) {
-  alignas(64) float lanes[kLanes];
-  for (int i = 0; i < kLanes; ++i) lanes[i] = ((bits >> i) & 1u) ? 1.0f : 0.0f;
-  return Float::load_aligned(lanes) != Float(0.0f);
-}
-
 // Mask conversions between float and integer lanes (xsimd 8 has no batch_bool_cast): a reinterpretation of the
 // register, all-ones or all-zero lanes with SSE and AVX2, the same 16-bit mask with AVX-512. And a mask as 0/1.
 template <class To, class From>
@@ -65,51 +50,60 @@ inline IntMask int_mask(const Mask& m) { return reinterpret_mask<IntMask>(m); }
 inline Mask float_mask(const IntMask& m) { return reinterpret_mask<Mask>(m); }
 inline Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
 
+// Bit i set = lane i active: the sign bits by movemask (SSE4.2, AVX2), the mask register itself (AVX-512).
+inline std::uint32_t to_bits(const Mask& m) {
+#if defined(__AVX512F__)
+  return std::uint32_t(static_cast<__mmask16>(m));
+#elif defined(__AVX__)
+  return std::uint32_t(_mm256_movemask_ps(static_cast<__m256>(m)));
+#else
+  return std::uint32_t(_mm_movemask_ps(static_cast<__m128>(m)));
+#endif
+}
+
+// Lane i active where bit i is set: each lane tests its own bit.
+inline Mask from_bits(std::uint32_t bits) {
+  struct LaneBit {
+    static constexpr std::uint32_t get(std::size_t i, std::size_t) { return std::uint32_t(1) << i; }
+  };
+  const UInt lane_bit = xsimd::make_batch_constant<UInt, LaneBit>();
+  const auto set = (UInt(bits) & lane_bit) != UInt(0u);
+  return reinterpret_mask<Mask>(set);
+}
+
+// Two batches of doubles (half a Float's lanes each; low: lanes 0 .. kLanes / 2 - 1) rounded to floats, as
+// float(double) rounds each.
+inline Float narrow(const xsimd::batch<double, Arch>& low, const xsimd::batch<double, Arch>& high) {
+#if defined(__AVX512F__)
+  return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(_mm512_cvtpd_ps(low))),
+                                             _mm256_castps_pd(_mm512_cvtpd_ps(high)), 1));
+#elif defined(__AVX__)
+  return _mm256_set_m128(_mm256_cvtpd_ps(high), _mm256_cvtpd_ps(low));
+#else
+  return _mm_movelh_ps(_mm_cvtpd_ps(low), _mm_cvtpd_ps(high));
+#endif
+}
+
+// Every lane gets the value of corner P[c] of its own quad, c being the lane's corner (0 1 / 2 3): a register
+// shuffle.
+template <unsigned P0, unsigned P1, unsigned P2, unsigned P3>
+inline Float from_quad_corners(const Float& v) {
+  struct Corners {
+    static constexpr std::uint32_t get(std::size_t i, std::size_t) {
+      constexpr unsigned corner[4] = {P0, P1, P2, P3};
+      return std::uint32_t(i / 4 * 4 + corner[i % 4]);
+    }
+  };
+  return xsimd::swizzle(v, xsimd::make_batch_constant<UInt, Corners>());
+}
+
 // Coarse derivatives (what GPUs do): per quad, d/dx = top-right - top-left, d/dy = bottom-left - top-left,
 // the same value broadcast to the quad's four lanes.
-inline Float quad_ddx(const Float& v) {
-  alignas(64) float a[kLanes];
-  v.store_aligned(a);
-  for (int q = 0; q < kQuadsPerBatch; ++q) {
-    const float d = a[4 * q + kQuadTopRight] - a[4 * q + kQuadTopLeft];
-    for (int i = 0; i < 4; ++i) a[4 * q + i] = d;
-  }
-  return Float::load_aligned(a);
-}
-
-inline Float quad_ddy(const Float& v) {
-  alignas(64) float a[kLanes];
-  v.store_aligned(a);
-  for (int q = 0; q < kQuadsPerBatch; ++q) {
-    const float d = a[4 * q + kQuadBottomLeft] - a[4 * q + kQuadTopLeft];
-    for (int i = 0; i < 4; ++i) a[4 * q + i] = d;
-  }
-  return Float::load_aligned(a);
-}
+inline Float quad_ddx(const Float& v) { return from_quad_corners<1, 1, 1, 1>(v) - from_quad_corners<0, 0, 0, 0>(v); }
+inline Float quad_ddy(const Float& v) { return from_quad_corners<2, 2, 2, 2>(v) - from_quad_corners<0, 0, 0, 0>(v); }
 
 // Fine derivatives (per pixel): d/dx from the pixel's own row of the quad, d/dy from its own column.
-inline Float pixel_ddx(const Float& v) {
-  alignas(64) float a[kLanes], d[kLanes];
-  v.store_aligned(a);
-  for (int q = 0; q < kQuadsPerBatch; ++q) {
-    const float top = a[4 * q + kQuadTopRight] - a[4 * q + kQuadTopLeft];
-    const float bottom = a[4 * q + kQuadBottomRight] - a[4 * q + kQuadBottomLeft];
-    d[4 * q + kQuadTopLeft] = d[4 * q + kQuadTopRight] = top;
-    d[4 * q + kQuadBottomLeft] = d[4 * q + kQuadBottomRight] = bottom;
-  }
-  return Float::load_aligned(d);
-}
-
-inline Float pixel_ddy(const Float& v) {
-  alignas(64) float a[kLanes], d[kLanes];
-  v.store_aligned(a);
-  for (int q = 0; q < kQuadsPerBatch; ++q) {
-    const float left = a[4 * q + kQuadBottomLeft] - a[4 * q + kQuadTopLeft];
-    const float right = a[4 * q + kQuadBottomRight] - a[4 * q + kQuadTopRight];
-    d[4 * q + kQuadTopLeft] = d[4 * q + kQuadBottomLeft] = left;
-    d[4 * q + kQuadTopRight] = d[4 * q + kQuadBottomRight] = right;
-  }
-  return Float::load_aligned(d);
-}
+inline Float pixel_ddx(const Float& v) { return from_quad_corners<1, 1, 3, 3>(v) - from_quad_corners<0, 0, 2, 2>(v); }
+inline Float pixel_ddy(const Float& v) { return from_quad_corners<2, 3, 2, 3>(v) - from_quad_corners<0, 1, 0, 1>(v); }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE::simd

@@ -34,8 +34,13 @@ struct TileDepth {
   float* at(int x, int y) const { return data + std::size_t(y - y0) * stride + std::size_t(x - x0); }
 };
 
+using Int64 = xsimd::batch<std::int64_t, simd::Arch>;  // half a batch's lanes
+using Double = xsimd::batch<double, simd::Arch>;
+constexpr int kHalf = kLanes / 2;
+static_assert(int(Int64::size) == kHalf && int(Double::size) == kHalf);
+
 struct EdgeSteps {
-  std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
+  alignas(64) std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
 };
 
 EdgeSteps edge_steps(const TriangleSetup& s) {
@@ -47,12 +52,15 @@ EdgeSteps edge_steps(const TriangleSetup& s) {
   return e;
 }
 
-// w as the nearest float, as float(w) rounds it, in operations a compiler vectorises (no int64 -> float
-// instruction before AVX-512): w + 1.5 * 2^52 as a double is exact for |w| < 2^51, and rounding that exact double
-// to float is the one rounding float(w) makes. Edge values stay below 2^50 (limits::kGuardBandPixels).
-inline float edge_to_float(std::int64_t w) {
+// w as the nearest float, as float(w) rounds it, for every lane (low: lanes 0 .. kHalf - 1), in vector operations
+// (no int64 -> float instruction before AVX-512): w + 1.5 * 2^52 as a double is exact for |w| < 2^51, and rounding
+// that exact double to float is the one rounding float(w) makes. Edge values stay below 2^50
+// (limits::kGuardBandPixels).
+Float edges_to_float(const Int64& low, const Int64& high) {
   constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52, bits 0x4338000000000000
-  return float(std::bit_cast<double>(std::uint64_t(w) + std::bit_cast<std::uint64_t>(kMagic)) - kMagic);
+  const Int64 magic_bits(std::bit_cast<std::int64_t>(kMagic));
+  return simd::narrow(xsimd::bitwise_cast<Double>(low + magic_bits) - Double(kMagic),
+                      xsimd::bitwise_cast<Double>(high + magic_bits) - Double(kMagic));
 }
 
 // Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside.
@@ -284,10 +292,10 @@ private:
     PendingBatch& p = slots_[slot];
     const TriangleSetup& s = *setup_;
     const std::int64_t X = pixel_centre_fixed(x), Y = pixel_centre_fixed(y);
-    alignas(64) std::int64_t w[3][kLanes];
+    Int64 w[3][2];  // each edge's value at every lane, in halves
     for (int i = 0; i < 3; ++i) {
-      const std::int64_t base = s.edge(i, X, Y);
-      for (int l = 0; l < kLanes; ++l) w[i][l] = base + steps_.lane[i][l];
+      const Int64 base(s.edge(i, X, Y));
+      for (int h = 0; h < 2; ++h) w[i][h] = base + Int64::load_aligned(&steps_.lane[i][h * kHalf]);
     }
     // Batches that lie wholly in the tile (all but those on its right or bottom edge) skip the per-lane bounds.
     const bool whole = x + kBatchWidth - 1 <= tile_.x1 && y + 1 <= tile_.y1;
@@ -295,10 +303,13 @@ private:
     if (full && whole) {
       inside = kAllLanes;
     } else {
+      alignas(64) std::int64_t lane_w[3][kLanes];
+      for (int i = 0; i < 3; ++i)
+        for (int h = 0; h < 2; ++h) w[i][h].store_aligned(&lane_w[i][h * kHalf]);
       for (int l = 0; l < kLanes; ++l) {
         const int px = x + lane_dx(l), py = y + lane_dy(l);
         if (px > tile_.x1 || py > tile_.y1) continue;
-        const bool in = full || ((w[0][l] + s.bias[0]) | (w[1][l] + s.bias[1]) | (w[2][l] + s.bias[2])) >= 0;
+        const bool in = full || ((lane_w[0][l] + s.bias[0]) | (lane_w[1][l] + s.bias[1]) | (lane_w[2][l] + s.bias[2])) >= 0;
         inside |= std::uint32_t(in) << l;
       }
       if (inside == 0) return false;
@@ -308,9 +319,6 @@ private:
     if (packed_quads_ > 0 && writes_any_of(slots_[packing_], x, y, inside)) flush_packed(slot);
     if (waiting_ >= 0 && writes_any_of(slots_[waiting_], x, y, inside)) shade_waiting();
 
-    alignas(64) float e[3][kLanes];
-    for (int i = 0; i < 3; ++i)
-      for (int l = 0; l < kLanes; ++l) e[i][l] = edge_to_float(w[i][l]);
     Float stored;
     if (whole) {
       // Lanes outside the triangle read their pixel's depth too: harmless, every test below is masked by inside.
@@ -322,7 +330,8 @@ private:
         p.stored_depth[l] = (inside >> l) & 1u ? *depth_.at(x + lane_dx(l), y + lane_dy(l)) : 0.0f;
       stored = Float::load_aligned(p.stored_depth);
     }
-    const Float e0 = Float::load_aligned(e[0]), e1 = Float::load_aligned(e[1]), e2 = Float::load_aligned(e[2]);
+    const Float e0 = edges_to_float(w[0][0], w[0][1]), e1 = edges_to_float(w[1][0], w[1][1]),
+                e2 = edges_to_float(w[2][0], w[2][1]);
     const Float z = e0 * Float(s.z_over_area[0]) + e1 * Float(s.z_over_area[1]) + e2 * Float(s.z_over_area[2]);
     const std::uint32_t pass = inside & simd::to_bits(z < stored);
     counters_.pixels_depth_failed += std::popcount(inside) - std::popcount(pass);
