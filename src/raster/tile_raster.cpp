@@ -382,17 +382,17 @@ private:
   }
 
   void write(const PendingBatch& p, std::uint32_t pass, const Float& z, const ShadeOutput& out) {
-    alignas(64) float zs[kLanes], color[3][kLanes];
-    for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
     std::size_t index[kLanes];
     lane_pixels(p, index);
     float* const rgb = fb_.color.data();
     if (pass == kAllLanes && p.side_by_side) {  // the usual batch inside a large triangle: no test per lane
       float* const depth = depth_.at(p.quad_x[0], p.quad_y[0]);
       simd::store_quad_rows(z, depth, depth + depth_.stride);
-      for (int l = 0; l < kLanes; ++l)
-        for (int c = 0; c < 3; ++c) rgb[3 * index[l] + std::size_t(c)] = color[c][l];
+      float* const row0 = rgb + 3 * index[0];
+      simd::store_quad_rows_rgb(out.color[0], out.color[1], out.color[2], row0, row0 + 3 * std::size_t(fb_.width));
     } else {
+      alignas(64) float zs[kLanes], color[3][kLanes];
+      for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
       z.store_aligned(zs);
       for (int l = 0; l < kLanes; ++l) {
         if (!((pass >> l) & 1u)) continue;

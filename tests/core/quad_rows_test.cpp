@@ -52,5 +52,25 @@ TEST(QuadRows, StoreWritesEachLaneToItsPixelAndNothingElse) {
   for (int l = 0; l < kLanes; ++l) EXPECT_EQ(again[l], lanes[l]);
 }
 
+TEST(QuadRows, RgbStoreWritesEachLanesThreeChannelsToItsPixelAndNothingElse) {
+  // Two rows of interleaved RGB at an odd float offset (unaligned stores), with guard values around them.
+  constexpr int kStride = 3 * 40;
+  std::vector<float> buffer(5 + 2 * kStride, -1.0f);
+  float* row0 = buffer.data() + 5;
+  float* row1 = row0 + kStride;
+  alignas(64) float lanes[3][kLanes];
+  for (int c = 0; c < 3; ++c)
+    for (int l = 0; l < kLanes; ++l) lanes[c][l] = float(100 * c + l);
+  simd::store_quad_rows_rgb(Float::load_aligned(lanes[0]), Float::load_aligned(lanes[1]),
+                            Float::load_aligned(lanes[2]), row0, row1);
+  for (int l = 0; l < kLanes; ++l) {
+    const int q = l / 4, r = (l % 4) / 2, x = 2 * q + l % 2;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ((r == 0 ? row0 : row1)[3 * x + c], lanes[c][l]) << "lane " << l << " channel " << c;
+  }
+  int untouched = 0;
+  for (float v : buffer) untouched += v == -1.0f;
+  EXPECT_EQ(untouched, int(buffer.size()) - 3 * kLanes);
+}
+
 }  // namespace
 }  // namespace qdmr
