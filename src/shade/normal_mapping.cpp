@@ -17,6 +17,25 @@ Float NormalMappingProgram::albedo_lod(const Fragments& in) const {
   return textures_.first().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
+// Two batches' LODs. Per quad, a quad's derivatives are the same in its four lanes, so one evaluation serves
+// both batches: each quad's top lanes carry a's derivatives and its bottom lanes b's, and each batch takes its LOD
+// back from its own lanes (the computation is lane by lane: the bits are those of two evaluations).
+void NormalMappingProgram::albedo_lods(const Fragments& a, const Fragments& b, Float& lod_a, Float& lod_b) const {
+  if (lod_mode_ != LodMode::PerQuad) {
+    lod_a = albedo_lod(a);
+    lod_b = albedo_lod(b);
+    return;
+  }
+  const UvDerivatives da = UvDerivatives::from(a.varyings[kU], a.varyings[kV], lod_mode_);
+  const UvDerivatives db = UvDerivatives::from(b.varyings[kU], b.varyings[kV], lod_mode_);
+  const simd::Mask b_lanes = simd::from_bits(0xccccccccu);  // lanes 2 and 3 of every quad
+  const auto pick = [&](const Float& of_a, const Float& of_b) { return xsimd::select(b_lanes, of_b, of_a); };
+  const Float both = textures_.first().lod(pick(da.dudx, db.dudx), pick(da.dvdx, db.dvdx), pick(da.dudy, db.dudy),
+                                           pick(da.dvdy, db.dvdy));
+  lod_a = simd::from_quad_corners<0, 0, 0, 0>(both);
+  lod_b = simd::from_quad_corners<2, 2, 2, 2>(both);
+}
+
 Float NormalMappingProgram::normal_lod(const Fragments& in, const Float& albedo_lod) const {
   if (textures_.second().same_lod_as(textures_.first())) return albedo_lod;
   const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
@@ -53,7 +72,8 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
 void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                       ShadeOutput& out_b) const {
   Samples sa, sb;
-  const Float lod_a = albedo_lod(a), lod_b = albedo_lod(b);
+  Float lod_a, lod_b;
+  albedo_lods(a, b, lod_a, lod_b);
   textures_.sample(a.varyings[kU], a.varyings[kV], lod_a, normal_lod(a, lod_a), sa.albedo, sa.tangent_normal);
   textures_.sample(b.varyings[kU], b.varyings[kV], lod_b, normal_lod(b, lod_b), sb.albedo, sb.tangent_normal);
   light(a, sa, out_a);

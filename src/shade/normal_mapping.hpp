@@ -21,6 +21,7 @@ public:
 private:
   struct Samples;
   simd::Float albedo_lod(const Fragments& in) const;
+  void albedo_lods(const Fragments& a, const Fragments& b, simd::Float& lod_a, simd::Float& lod_b) const;
   simd::Float normal_lod(const Fragments& in, const simd::Float& albedo_lod) const;
   void light(const Fragments& in, const Samples& samples, ShadeOutput& out) const;
 
