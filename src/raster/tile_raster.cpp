@@ -382,13 +382,14 @@ private:
   }
 
   void write(const PendingBatch& p, std::uint32_t pass, const Float& z, const ShadeOutput& out) {
+    const bool whole_rows = pass == kAllLanes && p.side_by_side;  // the usual batch inside a large triangle
     std::size_t index[kLanes];
-    lane_pixels(p, index);
+    if (!whole_rows || any_aov_) lane_pixels(p, index);
     float* const rgb = fb_.color.data();
-    if (pass == kAllLanes && p.side_by_side) {  // the usual batch inside a large triangle: no test per lane
+    if (whole_rows) {  // no test per lane: two rows of pixels, written by row
       float* const depth = depth_.at(p.quad_x[0], p.quad_y[0]);
       simd::store_quad_rows(z, depth, depth + depth_.stride);
-      float* const row0 = rgb + 3 * index[0];
+      float* const row0 = rgb + 3 * fb_.index(p.quad_x[0], p.quad_y[0]);
       simd::store_quad_rows_rgb(out.color[0], out.color[1], out.color[2], row0, row0 + 3 * std::size_t(fb_.width));
     } else {
       alignas(64) float zs[kLanes], color[3][kLanes];
