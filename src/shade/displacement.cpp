@@ -242,10 +242,11 @@ void layer_colour(const TwinSampler& textures, const UvDerivatives& d, const Flo
   const TextureSampler &albedo_texture = textures.first(), &normal_texture = textures.second();
   const Float albedo_lod = albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
   Float n[4];
+  const UvAhead ahead = d.quad_below();
   textures.sample(u, v, albedo_lod,
                   normal_texture.same_lod_as(albedo_texture) ? albedo_lod
                                                              : normal_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy),
-                  albedo, n);
+                  albedo, n, &ahead);
   for (int c = 0; c < 3; ++c) normal[c] = n[c] * Float(2.0f) - Float(1.0f);
 }
 

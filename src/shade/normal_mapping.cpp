@@ -12,22 +12,24 @@ struct NormalMappingProgram::Samples {
   Float albedo[4], tangent_normal[4];
 };
 
-Float NormalMappingProgram::albedo_lod(const Fragments& in) const {
-  const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
+UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
+  return UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
+}
+
+Float NormalMappingProgram::albedo_lod(const UvDerivatives& d) const {
   return textures_.first().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
 // Two batches' LODs. Per quad, a quad's derivatives are the same in its four lanes, so one evaluation serves
 // both batches: each quad's top lanes carry a's derivatives and its bottom lanes b's, and each batch takes its LOD
 // back from its own lanes (the computation is lane by lane: the bits are those of two evaluations).
-void NormalMappingProgram::albedo_lods(const Fragments& a, const Fragments& b, Float& lod_a, Float& lod_b) const {
+void NormalMappingProgram::albedo_lods(const UvDerivatives& da, const UvDerivatives& db, Float& lod_a,
+                                       Float& lod_b) const {
   if (lod_mode_ != LodMode::PerQuad) {
-    lod_a = albedo_lod(a);
-    lod_b = albedo_lod(b);
+    lod_a = albedo_lod(da);
+    lod_b = albedo_lod(db);
     return;
   }
-  const UvDerivatives da = UvDerivatives::from(a.varyings[kU], a.varyings[kV], lod_mode_);
-  const UvDerivatives db = UvDerivatives::from(b.varyings[kU], b.varyings[kV], lod_mode_);
   const simd::Mask b_lanes = simd::from_bits(0xccccccccu);  // lanes 2 and 3 of every quad
   const auto pick = [&](const Float& of_a, const Float& of_b) { return xsimd::select(b_lanes, of_b, of_a); };
   const Float both = textures_.first().lod(pick(da.dudx, db.dudx), pick(da.dvdx, db.dvdx), pick(da.dudy, db.dudy),
@@ -36,10 +38,16 @@ void NormalMappingProgram::albedo_lods(const Fragments& a, const Fragments& b, F
   lod_b = simd::from_quad_corners<2, 2, 2, 2>(both);
 }
 
-Float NormalMappingProgram::normal_lod(const Fragments& in, const Float& albedo_lod) const {
+Float NormalMappingProgram::normal_lod(const UvDerivatives& d, const Float& albedo_lod) const {
   if (textures_.second().same_lod_as(textures_.first())) return albedo_lod;
-  const UvDerivatives d = UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
   return textures_.second().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+}
+
+void NormalMappingProgram::sample(const Fragments& in, const UvDerivatives& d, const Float& albedo_lod,
+                                  Samples& out) const {
+  const UvAhead ahead = d.quad_below();
+  textures_.sample(in.varyings[kU], in.varyings[kV], albedo_lod, normal_lod(d, albedo_lod), out.albedo,
+                   out.tangent_normal, &ahead);
 }
 
 void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOutput& out) const {
@@ -61,8 +69,8 @@ void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOut
 
 void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   Samples s;
-  const Float lod = albedo_lod(in);
-  textures_.sample(in.varyings[kU], in.varyings[kV], lod, normal_lod(in, lod), s.albedo, s.tangent_normal);
+  const UvDerivatives d = derivatives(in);
+  sample(in, d, albedo_lod(d), s);
   light(in, s, out);
 }
 
@@ -72,10 +80,11 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
 void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                       ShadeOutput& out_b) const {
   Samples sa, sb;
+  const UvDerivatives da = derivatives(a), db = derivatives(b);
   Float lod_a, lod_b;
-  albedo_lods(a, b, lod_a, lod_b);
-  textures_.sample(a.varyings[kU], a.varyings[kV], lod_a, normal_lod(a, lod_a), sa.albedo, sa.tangent_normal);
-  textures_.sample(b.varyings[kU], b.varyings[kV], lod_b, normal_lod(b, lod_b), sb.albedo, sb.tangent_normal);
+  albedo_lods(da, db, lod_a, lod_b);
+  sample(a, da, lod_a, sa);
+  sample(b, db, lod_b, sb);
   light(a, sa, out_a);
   light(b, sb, out_b);
 }

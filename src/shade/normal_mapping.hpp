@@ -3,6 +3,7 @@
 // (lighting_models.hpp) from directional lights plus ambient.
 #include "program/light_rig.hpp"
 #include "program/batch.hpp"
+#include "shade/shading_math.hpp"
 #include "texture/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -20,9 +21,13 @@ public:
 
 private:
   struct Samples;
-  simd::Float albedo_lod(const Fragments& in) const;
-  void albedo_lods(const Fragments& a, const Fragments& b, simd::Float& lod_a, simd::Float& lod_b) const;
-  simd::Float normal_lod(const Fragments& in, const simd::Float& albedo_lod) const;
+  shading::UvDerivatives derivatives(const Fragments& in) const;
+  simd::Float albedo_lod(const shading::UvDerivatives& d) const;
+  void albedo_lods(const shading::UvDerivatives& a, const shading::UvDerivatives& b, simd::Float& lod_a,
+                   simd::Float& lod_b) const;
+  simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  void sample(const Fragments& in, const shading::UvDerivatives& d, const simd::Float& albedo_lod,
+              Samples& out) const;
   void light(const Fragments& in, const Samples& samples, ShadeOutput& out) const;
 
   TwinSampler textures_;  // albedo first, normal map second

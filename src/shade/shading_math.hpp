@@ -6,6 +6,7 @@
 #include "qdmr/scene/scene.hpp"
 #include "program/light_rig.hpp"
 #include "program/batch.hpp"
+#include "texture/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 
@@ -51,6 +52,8 @@ struct UvDerivatives {
     if (mode == LodMode::PerQuad) return {simd::quad_ddx(u), simd::quad_ddx(v), simd::quad_ddy(u), simd::quad_ddy(v)};
     return {simd::pixel_ddx(u), simd::pixel_ddx(v), simd::pixel_ddy(u), simd::pixel_ddy(v)};
   }
+  // The UV offset to the same lane of the quad below (two pixel rows down), a prefetch hint for samplers.
+  UvAhead quad_below() const { return {dudy + dudy, dvdy + dvdy}; }
 };
 
 inline Vec3 view_vector(const Fragments& in, const LightRig& lights) {

@@ -87,8 +87,8 @@ constexpr SamplerKey twin_second_key(std::size_t i) {
 
 template <SamplerKey KA, SamplerKey KB>
 void sample_twin_fixed(const TextureView& a, const TextureView& b, const SamplerState& s, const Float& u,
-                       const Float& v, const Float& lod, Float* out_a, Float* out_b) {
-  sample_twin_with(KA, KB, a, b, s, u, v, lod, out_a, out_b);
+                       const Float& v, const Float& lod, const UvAhead* ahead, Float* out_a, Float* out_b) {
+  sample_twin_with(KA, KB, a, b, s, u, v, lod, ahead, out_a, out_b);
 }
 
 struct TwinEntry {

@@ -138,9 +138,17 @@ private:
   LoadFunction load_, load_wrapped_;
 };
 
+// Where the rasterizer samples next near a sample: each lane's UV offset to the same lane of the quad below
+// (2 pixel rows down, twice the UV's derivative along y), whose batch comes a few batches later. A sample given
+// one prefetches the texels there on its finest level, so that the quad below finds them in cache instead of
+// waiting on memory. A hint only: no result depends on it.
+struct UvAhead {
+  simd::Float du, dv;
+};
+
 using TwinSampleFunction = void (*)(const TextureView& a, const TextureView& b, const SamplerState&,
                                     const simd::Float& u, const simd::Float& v, const simd::Float& lod,
-                                    simd::Float* out_a, simd::Float* out_b);
+                                    const UvAhead* ahead, simd::Float* out_a, simd::Float* out_b);
 
 // Two textures a program samples at the same coordinates under one sampler state, such as its albedo and its
 // normal map. Where both are RGBA8 chains of one size and the key is a common one, a texel sits at the same offset
@@ -153,11 +161,12 @@ public:
   const TextureSampler& first() const { return first_; }
   const TextureSampler& second() const { return second_; }
   bool shares_addresses() const { return twin_ != nullptr; }
-  // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as).
+  // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as);
+  // ahead, if given, where the quad below will sample (a prefetch hint where the two share addresses).
   void sample(const simd::Float& u, const simd::Float& v, const simd::Float& first_lod, const simd::Float& second_lod,
-              simd::Float* first_out, simd::Float* second_out) const {
+              simd::Float* first_out, simd::Float* second_out, const UvAhead* ahead = nullptr) const {
     if (twin_ != nullptr && !fetch_recorder_listens()) {
-      twin_(first_.view(), second_.view(), first_.state(), u, v, first_lod, first_out, second_out);
+      twin_(first_.view(), second_.view(), first_.state(), u, v, first_lod, ahead, first_out, second_out);
       return;
     }
     first_.sample(u, v, first_lod, first_out);

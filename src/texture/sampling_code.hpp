@@ -307,6 +307,30 @@ QDMR_SAMPLER_INLINE void fetch_rgba8_pair_at(const TextureView& view, const Samp
     fetch_texel_pair_at(t, k, o, first, second);
 }
 
+// Prefetches, in each lane, the bilinear footprint's row that a sample at (u, v) on `info`'s level reads and a
+// sample at (u - du, v - dv) does not (its top row if dv < 0, its bottom row otherwise), in both twin textures (a's
+// decoded copy where its samples read that): a hint for a later sample there (UvAhead), made where the rasterizer
+// moves by (du, dv) per quad row. u and v reduced by the address mode. Plain float arithmetic: a prefetch changes
+// no result, and a texel off by one costs at most a miss.
+QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
+                                              const Float& u, const Float& v, const Float& dv, const LevelInfo& info) {
+  const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
+  const Int x = xsimd::to_int(xsimd::floor(u * w - Float(0.5f)));
+  const Int y = xsimd::to_int(xsimd::floor(v * h + xsimd::select(dv > Float(0.0f), Float(0.5f), Float(-0.5f))));
+  alignas(64) std::int32_t o[kLanes];
+  (info.offset + (address(y, info.height, ka.address) * info.width + address(x, info.width, ka.address)) * Int(4))
+      .store_aligned(o);
+  const Texture &a = va.texture(), &b = vb.texture();
+  const bool a_decoded = ka.srgb && !a.linear.empty();
+  for (int lane = 0; lane < kLanes; ++lane) {
+    if (a_decoded)
+      __builtin_prefetch(a.linear.data() + o[lane]);
+    else
+      __builtin_prefetch(a.storage.data() + o[lane]);
+    __builtin_prefetch(b.storage.data() + o[lane]);
+  }
+}
+
 // sample_level() of two textures (twin_keys) at once: out[0..3] texture a's channels, out[4..7] texture b's. Never
 // recorded: the caller knows no texture-cache recorder listens.
 QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
@@ -397,19 +421,30 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
 }
 
 // sample_with() of two textures alike (twin_keys, one chain layout) at the same coordinates and LOD: out_a and
-// out_b get what sample_with() gives each, from one address computation. Never recorded.
+// out_b get what sample_with() gives each, from one address computation. Never recorded. ahead (optional): where
+// the quad below samples, prefetched on the finest level this sample reads.
 QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey& kb, const TextureView& va,
                                           const TextureView& vb, const SamplerState& s, const Float& u,
-                                          const Float& v, const Float& lod, Float* out_a, Float* out_b) {
+                                          const Float& v, const Float& lod, const UvAhead* ahead, Float* out_a,
+                                          Float* out_b) {
   float first_texel[8];
   for (int c = 0; c < 4; ++c) {
     first_texel[c] = va.first_texel()[std::size_t(c)];
     first_texel[4 + c] = vb.first_texel()[std::size_t(c)];
   }
   Float out[8];
+  bool finest = true;  // sample_levels() reads the finer level first
   sample_levels(ka, va, s, u, v, lod, 8, first_texel, false,
                 [&](const Float& ru, const Float& rv, const LevelInfo& info, bool linear,
                     Float* level_out) __attribute__((always_inline)) {
+                  if (finest && ahead != nullptr) {
+                    const Float au = u + ahead->du, av = v + ahead->dv;
+                    const Mask finite = is_finite(au) & is_finite(av);
+                    prefetch_twin_texels(va, ka, vb, reduce(xsimd::select(finite, au, Float(0.0f)), ka.address),
+                                         reduce(xsimd::select(finite, av, Float(0.0f)), ka.address), ahead->dv,
+                                         info);
+                  }
+                  finest = false;
                   sample_level_twin(va, ka, vb, kb, ru, rv, info, linear, level_out);
                 },
                 out);

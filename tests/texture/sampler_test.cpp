@@ -584,9 +584,10 @@ TEST(TextureSampler, CellMaxIsLoadWrapped) {
 
 // A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler, for
 // every sampler state, on both fetch paths, with and without the albedo's decoded sRGB copy, power-of-two and
-// other sizes, lanes with non-finite coordinates, lanes at the wrap and clamp edges, and batches that skip the
-// coarse level. It shares addresses exactly where sampler.cpp instantiates a twin: RGBA8 chains of one size, the
-// second not sRGB, bilinear or trilinear with wrap, exact or 8-bit weights, on the default fetch path.
+// other sizes, lanes with non-finite coordinates, lanes at the wrap and clamp edges, batches that skip the coarse
+// level, and with and without a prefetch hint (UvAhead). It shares addresses exactly where sampler.cpp
+// instantiates a twin: RGBA8 chains of one size, the second not sRGB, bilinear or trilinear with wrap, exact or
+// 8-bit weights, on the default fetch path.
 TEST(TwinSampler, GivesEachTextureTheBitsOfItsOwnSampler) {
   std::mt19937 rng(29);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-3.0f, 4.0f), lod(-1.0f, 9.0f);
@@ -627,8 +628,17 @@ TEST(TwinSampler, GivesEachTextureTheBitsOfItsOwnSampler) {
         first.sample(load(u), load(v), load(l), a);
         second.sample(load(u), load(v), load(l), b);
         twin.sample(load(u), load(v), load(l), load(l), twin_a, twin_b);
+        // A prefetch hint, however odd (non-finite, huge, pointing off the texture), changes no bit.
+        Lanes du, dv;
+        for (int i = 0; i < kLanes; ++i) du[i] = coord(rng), dv[i] = -coord(rng);
+        if (round == 0) du[0] = kNaN, dv[1 % kLanes] = kInf, du[2 % kLanes] = -1e30f, dv[3 % kLanes] = 3e38f;
+        const UvAhead ahead{load(du), load(dv)};
+        Float hinted_a[4], hinted_b[4];
+        twin.sample(load(u), load(v), load(l), load(l), hinted_a, hinted_b, &ahead);
         for (int ch = 0; ch < 4; ++ch)
           for (int i = 0; i < kLanes; ++i) {
+            ASSERT_EQ(bits(lanes(hinted_a[ch])[i]), bits(lanes(twin_a[ch])[i])) << "hinted, channel " << ch;
+            ASSERT_EQ(bits(lanes(hinted_b[ch])[i]), bits(lanes(twin_b[ch])[i])) << "hinted, channel " << ch;
             ASSERT_EQ(bits(lanes(twin_a[ch])[i]), bits(lanes(a[ch])[i]))
                 << filter_name(state.filter) << " first, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
             ASSERT_EQ(bits(lanes(twin_b[ch])[i]), bits(lanes(b[ch])[i]))
