@@ -24,12 +24,12 @@ constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
-// Recorded false: for callers that know no texture-cache recorder listens (without its tests, the compiler need
-// not keep the fetches' vector values in memory around the calls they guard).
-template <SamplerKey K, bool Recorded>
+// For when no texture-cache recorder listens (without its tests, the compiler need not keep the fetches' vector
+// values in memory around the calls they guard).
+template <SamplerKey K>
 void sample_fixed(const TextureView& view, const SamplerState& s, const Float& u, const Float& v, const Float& lod,
                   Float* out) {
-  sample_with(K, view, s, u, v, lod, out, Recorded);
+  sample_with(K, view, s, u, v, lod, out, false);
 }
 
 template <SamplerKey K, bool Wrap>
@@ -119,12 +119,12 @@ TwinSampleFunction twin_sample_function(const TextureSampler& a, const TextureSa
 
 struct SampleEntry {
   SamplerKey key;
-  SampleFunction recorded, unrecorded;
+  SampleFunction sample;
 };
 
 template <std::size_t... I>
 constexpr std::array<SampleEntry, sizeof...(I)> common_samplers(std::index_sequence<I...>) {
-  return {{{common_key(I), &sample_fixed<common_key(I), true>, &sample_fixed<common_key(I), false>}...}};
+  return {{{common_key(I), &sample_fixed<common_key(I)>}...}};
 }
 constexpr std::array<SampleEntry, kCommonKeys> kCommonSamplers = common_samplers(std::make_index_sequence<kCommonKeys>());
 
@@ -215,12 +215,16 @@ void load(const TextureView& view, const Int& level, const Int& x, const Int& y,
 }
 
 SampleFunction sample_function(const SamplerKey& key, bool recorded) {
+  // Recording costs 15-30 times the sample (docs/architecture.md, "Specialised samplers"), so a listening
+  // recorder takes the generic sampler: instantiations with the recorder's tests would gain nothing measurable
+  // and cost a fifth of this file's compile time.
+  if (recorded) return &sample;
   for (const SampleEntry& e : kCommonSamplers)
-    if (e.key == key) return recorded ? e.recorded : e.unrecorded;
+    if (e.key == key) return e.sample;
   return &sample;
 }
 
-bool is_specialised(const SamplerKey& key) { return sample_function(key) != &sample; }
+bool is_specialised(const SamplerKey& key) { return sample_function(key, false) != &sample; }
 
 TextureSampler::TextureSampler(const Texture& texture, const SamplerState& state)
     : view_(texture), state_(state), sample_(sample_function(sampler_key(view_, state_))),

@@ -94,9 +94,10 @@ using SampleFunction = void (*)(const TextureView&, const SamplerState&, const s
 using LoadFunction = void (*)(const TextureView&, const simd::Int& level, const simd::Int& x, const simd::Int& y,
                               simd::FetchPath fetch, simd::Float* out);
 
-// The sampling code for a key: an instantiation where sampler.cpp lists the key as common (docs/architecture.md,
-// "Specialised samplers"), the generic sampler otherwise. Both give the same bits. recorded false: an
-// instantiation without the texture-cache recorder's tests, for when none listens.
+// The sampling code for a key: when no texture-cache recorder listens (recorded false), an instantiation without
+// the recorder's tests where sampler.cpp lists the key as common (docs/architecture.md, "Specialised samplers"),
+// the generic sampler otherwise; for a listening recorder (recorded true), the generic sampler, which reports
+// every fetch. All give the same bits.
 SampleFunction sample_function(const SamplerKey& key, bool recorded = true);
 bool is_specialised(const SamplerKey& key);
 
