@@ -49,7 +49,12 @@ bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path,
       input->set_ioproxy(reader.proxy.get());
     }
   }
-  if (!input->open(path, header)) {
+  // A texture's channels are data: alpha is one more channel (often a height or a roughness packed beside colour
+  // or a normal), read as stored. OpenImageIO's PNG and TIFF readers would otherwise multiply the other channels
+  // by it ("associate" it), as for a colour image with coverage.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  if (!input->open(path, header, config)) {
     error = input->geterror();
     return false;
   }

@@ -74,6 +74,38 @@ TEST(TextureImage, Reads16BitPngExactly) {
   for (std::size_t i = 0; i < data.size(); ++i) ASSERT_EQ(img.texels[i], data[i] / 65535.0f) << i;
 }
 
+// RGBA texels whose alpha is data (a height, a roughness): written as stored, with every alpha from 0 to 255
+// beside colours that premultiplying would change.
+std::vector<std::uint8_t> rgba_with_data_in_alpha() {
+  std::vector<std::uint8_t> data;
+  for (int i = 0; i < 256; ++i) data.insert(data.end(), {200, std::uint8_t(i), 77, std::uint8_t(255 - i)});
+  return data;
+}
+
+// Alpha is read as stored and the other channels are not multiplied by it: OpenImageIO's PNG and TIFF readers
+// do that unless asked not to, which darkened an albedo by the height packed in its alpha (real_terrain.json).
+TEST(TextureImage, AlphaIsDataNotCoverage) {
+  test::TempDir dir;
+  const auto data = rgba_with_data_in_alpha();
+  for (const char* name : {"a.png", "a.tif"}) {
+    const std::filesystem::path file = dir / name;
+    auto out = OIIO::ImageOutput::create(file.string());
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(16, 16, 4, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:UnassociatedAlpha", 1);  // the values as given, unassociated, as PNG defines them
+    ASSERT_TRUE(out->open(file.string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, data.data()));
+    ASSERT_TRUE(out->close());
+    const Image img = read_image(file, "test");
+    ASSERT_EQ(img.channels, 4);
+    // Rows come back bottom-up: the file's row r is texel row 15 - r.
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x)
+        for (int c = 0; c < 4; ++c)
+          ASSERT_EQ(img.at(x, 15 - y, c), data[std::size_t((16 * y + x) * 4 + c)] / 255.0f) << name << " " << x << "," << y << "," << c;
+  }
+}
+
 // A TIFF of 8-bit samples, `channels` per pixel (the second and later ones unspecified extra samples), whose
 // photometric interpretation is "min is white", in deflate-compressed strips of `rows_per_strip` rows (zlib streams
 // of stored blocks: valid deflate without a compressor). `top_first` holds the samples as the file stores them.
