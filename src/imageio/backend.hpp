@@ -1,9 +1,12 @@
 #pragma once
 // Image files go through one narrow interface to OpenImageIO, so that the `qdmr` command can load OpenImageIO
 // (and the ~260 shared libraries it pulls in, about 0.3 s of dynamic linking) only when a job reads or writes an
-// image. The library and the tests link the backend directly (imageio/direct.cpp); the command loads it from
-// libqdmr_imageio.so on first use (imageio/lazy.cpp). Both run the same code (imageio/oiio_backend.cpp).
+// image that qdmr does not handle itself: PNG and JPEG are read in process (imageio/native_reader.hpp), PNG
+// written so too (io/png_writer.hpp). The library and the tests link the backend directly (imageio/direct.cpp);
+// the command loads it from libqdmr_imageio.so on first use (imageio/lazy.cpp). Both run the same code
+// (imageio/oiio_backend.cpp).
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,27 +53,27 @@ const Backend& backend();
 // The OpenImageIO implementation, which backend() returns or the module exports.
 const Backend& oiio_backend();
 
-// An open file, closed when it goes.
+class NativeReader;  // imageio/native_reader.hpp
+
+// An open file, closed when it goes: a PNG or JPEG read by the native readers (imageio/native_reader.hpp), any
+// other file by the backend, loaded only then.
 class ReadFile {
 public:
-  // Null reader (and `error` set) when the file cannot be opened.
-  ReadFile(const std::string& path, std::string& error) : backend_(&backend()), reader_(backend_->open(path, spec_, error)) {}
-  ~ReadFile() {
-    if (reader_) backend_->close(reader_);
-  }
+  // Not open (and `error` set) when the file cannot be opened.
+  ReadFile(const std::string& path, std::string& error);
+  ~ReadFile();
   ReadFile(const ReadFile&) = delete;
   ReadFile& operator=(const ReadFile&) = delete;
 
-  explicit operator bool() const { return reader_ != nullptr; }
+  explicit operator bool() const { return native_ != nullptr || reader_ != nullptr; }
   const ReadSpec& spec() const { return spec_; }
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {
-    return backend_->read(reader_, type, first_row, row_stride, error);
-  }
+  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error);
 
 private:
-  const Backend* backend_;
   ReadSpec spec_;
-  Reader* reader_;
+  std::unique_ptr<NativeReader> native_;
+  const Backend* backend_ = nullptr;
+  Reader* reader_ = nullptr;
 };
 
 }  // namespace qdmr::imageio

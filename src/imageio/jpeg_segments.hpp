@@ -1,9 +1,10 @@
 #pragma once
-// A JPEG file's marker segments, walked before OpenImageIO's JPEG reader opens the file. OpenImageIO 2.4 decodes
-// the metadata segments (Exif, XMP, IPTC, ICC profile, comments) when it opens a JPEG, and its IPTC decoder
-// reads past the segment it is given (found by fuzz_image: a heap-buffer-overflow in decode_iptc_iim; fixed
-// upstream after 2.4). qdmr uses none of that metadata, so the segments that only carry it are dropped from the
-// bytes the reader sees; the pixels do not depend on them.
+// A JPEG file's marker segments, walked before libjpeg reads the file (imageio/jpeg_reader.cpp). Damaged segments
+// before the first scan are refused with what is wrong. The segments that only carry metadata (Exif, XMP, IPTC,
+// ICC profile, comments) are dropped from the bytes the decoder sees: qdmr uses none of it and the pixels do not
+// depend on it. (This began in front of OpenImageIO's JPEG reader, which decodes that metadata when it opens a
+// file, and whose 2.4 IPTC decoder read past the segment it was given: found by fuzz_image, fixed upstream after
+// 2.4. JPEG files no longer reach OpenImageIO.)
 #include <string>
 #include <vector>
 

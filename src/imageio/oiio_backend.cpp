@@ -13,15 +13,10 @@
 #include <vector>
 
 #include "imageio/backend.hpp"
-#include "imageio/jpeg_segments.hpp"
 
 namespace qdmr::imageio {
 
 struct Reader {
-  // A JPEG without its metadata segments (imageio/jpeg_segments.hpp) is read from memory: the bytes and their
-  // proxy outlive the input (members are destroyed last to first).
-  std::vector<unsigned char> bytes;
-  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
   std::unique_ptr<OIIO::ImageInput> input;
 };
 
@@ -36,19 +31,9 @@ OIIO::TypeDesc type_desc(PixelType type) {
   return OIIO::TypeDesc::FLOAT;
 }
 
-// Opens `input` on `path`, a JPEG through imageio/jpeg_segments.hpp: from memory without its metadata segments,
-// or refused when its segments before the first scan are damaged.
+// Opens `input` on `path`.
 bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path, Reader& reader, std::string& error) {
   OIIO::ImageSpec header;
-  if (input->format_name() == std::string_view("jpeg")) {
-    std::vector<unsigned char> stripped;
-    if (!jpeg_without_metadata(path, stripped, error)) return false;
-    if (!stripped.empty()) {
-      reader.bytes = std::move(stripped);
-      reader.proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(reader.bytes.data(), reader.bytes.size());
-      input->set_ioproxy(reader.proxy.get());
-    }
-  }
   // A texture's channels are data: alpha is one more channel (often a height or a roughness packed beside colour
   // or a normal), read as stored. OpenImageIO's PNG and TIFF readers would otherwise multiply the other channels
   // by it ("associate" it), as for a colour image with coverage.
@@ -63,7 +48,8 @@ bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path,
 }
 
 // The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads
-// textures from, each of which checks the magic number first (valid_file). OpenImageIO's own fallback
+// textures from that it does not read itself (PNG and JPEG never get here: imageio/read_file.cpp), each of which
+// checks the magic number first (valid_file). OpenImageIO's own fallback
 // (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file:
 // each a decoder run on an untrusted file for a format qdmr refuses anyway, and a few milliseconds.
 bool open_input(const std::string& path, Reader& reader, std::string& error) {
@@ -90,7 +76,7 @@ bool open_input(const std::string& path, Reader& reader, std::string& error) {
       if (open_file(std::move(input), path, reader, error)) return true;
     }
   }
-  for (const char* format : {"png", "jpeg", "openexr", "tiff", "pnm"}) {
+  for (const char* format : {"openexr", "tiff", "pnm"}) {
     if (format == tried) continue;
     auto input = OIIO::ImageInput::create(format);
     if (!input || !input->valid_file(path)) continue;

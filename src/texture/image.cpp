@@ -220,7 +220,7 @@ std::string check_exr(const std::filesystem::path& file, std::uint64_t size) {
 // PNG: libpng allocates and clears a buffer of each chunk's declared length (up to 8 MB) before it reads the
 // chunk's data. The chunks are walked here first, without reading their data: each (length, type, data, CRC)
 // must fit in the file, and the walk must reach IEND, so the decoder never reads past the end of the file
-// (OpenImageIO 2.4 leaks its error string when it does: fuzz/lsan.supp). Returns what is wrong, or "".
+// (and the whole chunk is there to check). Returns what is wrong, or "".
 std::string check_png_chunks(const std::filesystem::path& file, std::uint64_t size) {
   const std::string no_end = "truncated PNG (it does not end with an IEND chunk)";
   std::ifstream in(file, std::ios::binary);

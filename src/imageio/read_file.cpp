@@ -1,0 +1,23 @@
+#include "imageio/backend.hpp"
+#include "imageio/native_reader.hpp"
+
+namespace qdmr::imageio {
+
+ReadFile::ReadFile(const std::string& path, std::string& error) {
+  bool claimed = false;
+  native_ = open_native(path, spec_, error, claimed);
+  if (claimed) return;
+  backend_ = &backend();
+  reader_ = backend_->open(path, spec_, error);
+}
+
+ReadFile::~ReadFile() {
+  if (reader_) backend_->close(reader_);
+}
+
+bool ReadFile::read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {
+  if (native_) return native_->read(type, first_row, row_stride, error);
+  return backend_->read(reader_, type, first_row, row_stride, error);
+}
+
+}  // namespace qdmr::imageio
