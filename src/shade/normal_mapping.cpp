@@ -50,12 +50,19 @@ void NormalMappingProgram::sample(const Fragments& in, const UvDerivatives& d, c
                    out.tangent_normal, &ahead);
 }
 
-void NormalMappingProgram::light(const Fragments& in, const Samples& s, ShadeOutput& out) const {
-  const TangentFrame frame = TangentFrame::from(in);
-  const Vec3 shading_normal = normalize(frame.to_world({s.tangent_normal[0] * Float(2.0f) - Float(1.0f),
-                                                        s.tangent_normal[1] * Float(2.0f) - Float(1.0f),
-                                                        s.tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
-  shade_lights(shading_normal, frame.n, view_vector(in, lights_),
+namespace {
+
+// The tangent-space normal (an RGB sample in [0, 1]) to world space, unit length.
+Vec3 shading_normal_of(const TangentFrame& frame, const Float* tangent_normal) {
+  return normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f), tangent_normal[1] * Float(2.0f) - Float(1.0f),
+                                   tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
+}
+
+}  // namespace
+
+void NormalMappingProgram::light(const Fragments& in, const Samples& s, const TangentFrame& frame,
+                                 const Vec3& shading_normal, const Vec3& view, ShadeOutput& out) const {
+  shade_lights(shading_normal, frame.n, view,
                SurfaceSample{s.albedo, specular_from_albedo(s.albedo, specular_, lighting_.specular), Float(1.0f)},
                nullptr, lighting_, lights_, out.color);
   out.normal[0] = shading_normal.x;
@@ -71,7 +78,8 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
   Samples s;
   const UvDerivatives d = derivatives(in);
   sample(in, d, albedo_lod(d), s);
-  light(in, s, out);
+  const TangentFrame frame = TangentFrame::from(in);
+  light(in, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(in, lights_), out);
 }
 
 // Stage by stage, a's and b's work side by side: each stage of one batch is a chain of dependent operations
@@ -85,8 +93,13 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
   albedo_lods(da, db, lod_a, lod_b);
   sample(a, da, lod_a, sa);
   sample(b, db, lod_b, sb);
-  light(a, sa, out_a);
-  light(b, sb, out_b);
+  // Each frame is a chain of three normalisations (a square root, then a division, each), and the shading normal
+  // one more: a's and b's side by side, so one chain's arithmetic fills the other's waits.
+  const TangentFrame frame_a = TangentFrame::from(a), frame_b = TangentFrame::from(b);
+  const Vec3 normal_a = shading_normal_of(frame_a, sa.tangent_normal), normal_b = shading_normal_of(frame_b, sb.tangent_normal);
+  const Vec3 view_a = view_vector(a, lights_), view_b = view_vector(b, lights_);
+  light(a, sa, frame_a, normal_a, view_a, out_a);
+  light(b, sb, frame_b, normal_b, view_b, out_b);
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

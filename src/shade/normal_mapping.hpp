@@ -28,7 +28,10 @@ private:
   simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
   void sample(const Fragments& in, const shading::UvDerivatives& d, const simd::Float& albedo_lod,
               Samples& out) const;
-  void light(const Fragments& in, const Samples& samples, ShadeOutput& out) const;
+  // Lights a batch whose frame, shading normal and view vector are computed (shade_pair computes two batches'
+  // side by side).
+  void light(const Fragments& in, const Samples& samples, const shading::TangentFrame& frame,
+             const shading::Vec3& shading_normal, const shading::Vec3& view, ShadeOutput& out) const;
 
   TwinSampler textures_;  // albedo first, normal map second
   LodMode lod_mode_;
