@@ -29,6 +29,9 @@ public:
 // in, or null with `error` set. For any other file `claimed` is false and nothing is read but its signature.
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed);
 
+// Whether open_native claims `path` (it starts with PNG's or JPEG's signature): reading it loads no image module.
+bool read_natively(const std::string& path);
+
 // The two readers open_native chooses from, by signature.
 std::unique_ptr<NativeReader> open_png(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_jpeg(const std::string& path, ReadSpec& spec, std::string& error);

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "imageio/native_reader.hpp"
 #include "program/variant.hpp"
 #include "raster/framebuffer.hpp"
 #include "qdmr/bake/ao_map.hpp"
@@ -513,8 +514,12 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
 }
 
 // Whether building the frame reads an image file (the `qdmr` command then loads its image module).
+// Whether building the frame reads an image file through the image module: PNG and JPEG files are read in
+// process (imageio/native_reader.hpp).
 bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
-  const auto file = [](const TextureDesc& d) { return d.source == TextureSource::File; };
+  const auto file = [](const TextureDesc& d) {
+    return d.source == TextureSource::File && !imageio::read_natively(d.file.string());
+  };
   for (const TextureRequest& t : plan.textures)
     if (file(t.desc) || (t.desc.source == TextureSource::FromHeight && file(t.layer.height))) return true;
   for (const ObjectDesc& object : scene.objects)
@@ -522,7 +527,9 @@ bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
   for (const MaterialPlan& m : plan.materials) {
     if (!m.blend) continue;
     const WeightsDesc& w = m.desc.blend.weights;
-    if (w.source == WeightSource::File || (w.source == WeightSource::Terrain && file(w.height))) return true;
+    if ((w.source == WeightSource::File && !imageio::read_natively(w.file.string())) ||
+        (w.source == WeightSource::Terrain && file(w.height)))
+      return true;
   }
   return false;
 }
