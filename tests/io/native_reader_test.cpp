@@ -9,6 +9,7 @@
 
 #include <jpeglib.h>
 
+#include <cmath>
 #include <csetjmp>
 #include <cstdint>
 #include <cstring>
@@ -365,6 +366,63 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
     ++cases;
   }
   EXPECT_EQ(cases, 4);
+}
+
+// Every sample of `file` as `type` (one channel's width per value: 1, 2 or 4 bytes), top row first.
+std::vector<unsigned char> read_as(const fs::path& file, imageio::PixelType type, int value_bytes) {
+  imageio::ReadSpec spec;
+  std::string error;
+  bool claimed = false;
+  const auto reader = imageio::open_native(file.string(), spec, error, claimed);
+  EXPECT_TRUE(reader) << error;
+  if (!reader) return {};
+  const std::size_t row = std::size_t(spec.width) * std::size_t(spec.channels) * std::size_t(value_bytes);
+  std::vector<unsigned char> out(row * std::size_t(spec.height));
+  EXPECT_TRUE(reader->read(type, out.data(), std::ptrdiff_t(row), error)) << error;
+  return out;
+}
+
+// Asked for another type than the file's, a reader converts: k of b bits stands for k / (2^b - 1), as a float
+// correctly rounded, as an integer of the other width the nearest one.
+TEST(NativeReader, OtherSampleTypesAreTheFilesValuesConverted) {
+  TempDir dir;
+  write_png_file(dir / "g16.png", {"g16", PNG_COLOR_TYPE_GRAY, 16, false, false}, {});
+  write_png_file(dir / "rgb8.png", {"rgb8", PNG_COLOR_TYPE_RGB, 8, false, false}, {});
+  using imageio::PixelType;
+  const auto wide = read_as(dir / "g16.png", PixelType::UInt16, 2);
+  const auto wide_f = read_as(dir / "g16.png", PixelType::Float, 4);
+  const auto wide_8 = read_as(dir / "g16.png", PixelType::UInt8, 1);
+  ASSERT_EQ(wide.size(), std::size_t(kWidth) * kHeight * 2);
+  ASSERT_EQ(wide_f.size(), wide.size() * 2);
+  for (std::size_t i = 0; i < wide.size() / 2; ++i) {
+    std::uint16_t k;
+    float f;
+    std::memcpy(&k, wide.data() + 2 * i, 2);
+    std::memcpy(&f, wide_f.data() + 4 * i, 4);
+    ASSERT_EQ(f, float(k) / 65535.0f) << i;
+    ASSERT_EQ(int(wide_8[i]), int(std::lround(k * 255.0 / 65535.0))) << i;
+  }
+  const auto narrow = read_as(dir / "rgb8.png", PixelType::UInt8, 1);
+  const auto narrow_f = read_as(dir / "rgb8.png", PixelType::Float, 4);
+  const auto narrow_16 = read_as(dir / "rgb8.png", PixelType::UInt16, 2);
+  ASSERT_EQ(narrow.size(), std::size_t(kWidth) * kHeight * 3);
+  for (std::size_t i = 0; i < narrow.size(); ++i) {
+    float f;
+    std::uint16_t k16;
+    std::memcpy(&f, narrow_f.data() + 4 * i, 4);
+    std::memcpy(&k16, narrow_16.data() + 2 * i, 2);
+    ASSERT_EQ(f, float(narrow[i]) / 255.0f) << i;
+    ASSERT_EQ(int(k16), narrow[i] * 257) << i;
+  }
+  write_jpeg_file(dir / "j.jpg", kJpegLayouts[3]);
+  const auto jpeg = read_as(dir / "j.jpg", PixelType::UInt8, 1);
+  const auto jpeg_f = read_as(dir / "j.jpg", PixelType::Float, 4);
+  ASSERT_EQ(jpeg.size(), std::size_t(kWidth) * kHeight * 3);
+  for (std::size_t i = 0; i < jpeg.size(); ++i) {
+    float f;
+    std::memcpy(&f, jpeg_f.data() + 4 * i, 4);
+    ASSERT_EQ(f, float(jpeg[i]) / 255.0f) << i;
+  }
 }
 
 // A file of neither format is not claimed (the backend reads it); nothing is decoded.
