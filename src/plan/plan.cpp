@@ -517,18 +517,18 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
 // Whether building the frame reads an image file through the image module: PNG and JPEG files are read in
 // process (imageio/native_reader.hpp).
 bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
-  const auto file = [](const TextureDesc& d) {
+  const auto through_module = [](const TextureDesc& d) {
     return d.source == TextureSource::File && !imageio::read_natively(d.file.string());
   };
   for (const TextureRequest& t : plan.textures)
-    if (file(t.desc) || (t.desc.source == TextureSource::FromHeight && file(t.layer.height))) return true;
+    if (through_module(t.desc) || (t.desc.source == TextureSource::FromHeight && through_module(t.layer.height))) return true;
   for (const ObjectDesc& object : scene.objects)
-    if (file(object.mesh.height_map)) return true;
+    if (through_module(object.mesh.height_map)) return true;
   for (const MaterialPlan& m : plan.materials) {
     if (!m.blend) continue;
     const WeightsDesc& w = m.desc.blend.weights;
     if ((w.source == WeightSource::File && !imageio::read_natively(w.file.string())) ||
-        (w.source == WeightSource::Terrain && file(w.height)))
+        (w.source == WeightSource::Terrain && through_module(w.height)))
       return true;
   }
   return false;
