@@ -8,10 +8,11 @@ namespace qdmr::imageio {
 
 namespace {
 
-enum class Signature { Png, Jpeg, Other };
+enum class Signature { Png, Jpeg, Tiff, Other };
 
 // The checks of OpenImageIO's readers (valid_file), so no PNG or JPEG ever reaches theirs: PNG's first seven
-// bytes (libpng then checks the eighth), JPEG's SOI marker.
+// bytes (libpng then checks the eighth), JPEG's SOI marker; TIFF's byte order and version (42, or 43 for
+// BigTIFF).
 Signature signature_of(const std::string& path) {
   unsigned char bytes[8] = {};
   std::size_t got = 0;
@@ -21,18 +22,29 @@ Signature signature_of(const std::string& path) {
   }
   if (got == sizeof bytes && png_sig_cmp(bytes, 0, 7) == 0) return Signature::Png;
   if (got >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8) return Signature::Jpeg;
+  if (got >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' && (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
+                   (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43))))
+    return Signature::Tiff;
   return Signature::Other;
 }
 
 }  // namespace
 
-bool read_natively(const std::string& path) { return signature_of(path) != Signature::Other; }
+bool read_natively(const std::string& path) {
+  const Signature signature = signature_of(path);
+  if (signature != Signature::Tiff) return signature != Signature::Other;
+  ReadSpec spec;
+  bool claimed = false;
+  open_tiff(path, spec, claimed);
+  return claimed;
+}
 
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed) {
   const Signature signature = signature_of(path);
-  claimed = signature != Signature::Other;
+  claimed = signature == Signature::Png || signature == Signature::Jpeg;
   if (signature == Signature::Png) return open_png(path, spec, error);
   if (signature == Signature::Jpeg) return open_jpeg(path, spec, error);
+  if (signature == Signature::Tiff) return open_tiff(path, spec, claimed);
   return nullptr;
 }
 

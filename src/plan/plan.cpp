@@ -513,9 +513,8 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
   return plan;
 }
 
-// Whether building the frame reads an image file (the `qdmr` command then loads its image module).
-// Whether building the frame reads an image file through the image module: PNG and JPEG files are read in
-// process (imageio/native_reader.hpp).
+// Whether building the frame reads an image file through the image module (the `qdmr` command then loads it):
+// PNG, JPEG and most TIFF files are read in process (imageio/native_reader.hpp).
 bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
   const auto through_module = [](const TextureDesc& d) {
     return d.source == TextureSource::File && !imageio::read_natively(d.file.string());

@@ -57,22 +57,22 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
-  // PNG and JPEG textures are read in process (imageio/native_reader.hpp): planned and rendered without the
-  // module. A TIFF texture needs it, and says so.
+  // PNG, JPEG and TIFF (of the layouts OpenImageIO passes through) textures are read in process
+  // (imageio/native_reader.hpp): planned and rendered without the module. An OpenEXR texture needs it, and says so.
   const std::filesystem::path images = source_dir() / "tests/bad_inputs/files/images";
   const auto albedo = [&](const char* file) { return "/materials/bricks/layers/0/albedo=" + (images / file).string(); };
-  for (const char* file : {"good.png", "noise.jpg"}) {
+  for (const char* file : {"good.png", "noise.jpg", "noise.tif"}) {
     const CommandResult textured_plan = run(cli(), {"plan", plane, "--set", albedo(file)});
     EXPECT_EQ(textured_plan.exit_code, 0) << file << ": " << textured_plan.output;
     const CommandResult textured = run(cli(), {"render", plane, "-o", (dir / "t.png").string(), "--width", "32",
                                                "--height", "18", "--set", albedo(file)});
     EXPECT_EQ(textured.exit_code, 0) << file << ": " << textured.output;
   }
-  const CommandResult tiff = run(cli(), {"render", plane, "-o", (dir / "tif.png").string(), "--width", "32",
-                                         "--height", "18", "--set", albedo("noise.tif")});
-  EXPECT_EQ(tiff.exit_code, 2) << tiff.output;
-  EXPECT_NE(tiff.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << tiff.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "tif.png"));
+  const CommandResult exr = run(cli(), {"render", plane, "-o", (dir / "exr.png").string(), "--width", "32",
+                                        "--height", "18", "--set", albedo("noise.exr")});
+  EXPECT_EQ(exr.exit_code, 2) << exr.output;
+  EXPECT_NE(exr.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << exr.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "exr.png"));
 }
 
 // The PNG written without the module holds what qdmr means to write: every byte the sRGB code of the linear

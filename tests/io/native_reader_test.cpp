@@ -15,7 +15,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -29,14 +28,6 @@ namespace fs = std::filesystem;
 
 // Odd sizes: partial bytes of 1- to 4-bit rows, partial JPEG blocks and chroma pairs.
 constexpr int kWidth = 37, kHeight = 23;
-
-std::uint32_t hash(std::uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7FEB352Du;
-  x ^= x >> 15;
-  x *= 0x846CA68Bu;
-  return x ^ (x >> 16);
-}
 
 struct Decoded {
   int width = 0, height = 0, channels = 0;
@@ -154,7 +145,8 @@ void write_png_file(const fs::path& file, const PngLayout& layout, const std::ve
   // Palettes of 8-bit indices hold fewer entries than the depth could address (3 of 4 bits' 16, 253 of 256).
   const int max = (1 << layout.bit_depth) - (layout.color_type == PNG_COLOR_TYPE_PALETTE && layout.bit_depth >= 4 ? 3 : 1);
   std::vector<std::uint32_t> samples(std::size_t(kWidth) * kHeight * channels);
-  for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = hash(std::uint32_t(i) * 2654435761u + 17u) % std::uint32_t(max + 1);
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    samples[i] = sample_hash(std::uint32_t(i) * 2654435761u + 17u) % std::uint32_t(max + 1);
   // Rows packed as PNG stores them: big-endian 16-bit samples, sub-byte samples from the high bits.
   const std::size_t row_bytes = (std::size_t(kWidth) * channels * layout.bit_depth + 7) / 8;
   std::vector<unsigned char> rows(row_bytes * kHeight, 0);
@@ -175,8 +167,8 @@ void write_png_file(const fs::path& file, const PngLayout& layout, const std::ve
   std::vector<png_color> palette(std::size_t(max) + 1);
   std::vector<png_byte> palette_alpha(palette.size());
   for (std::size_t i = 0; i < palette.size(); ++i) {
-    palette[i] = {static_cast<png_byte>(hash(std::uint32_t(i))), static_cast<png_byte>(hash(std::uint32_t(i) + 99)),
-                  static_cast<png_byte>(i * 37)};
+    palette[i] = {static_cast<png_byte>(sample_hash(std::uint32_t(i))),
+                  static_cast<png_byte>(sample_hash(std::uint32_t(i) + 99)), static_cast<png_byte>(i * 37)};
     palette_alpha[i] = static_cast<png_byte>(255 - i * 29);
   }
   std::vector<png_text> text(texts.size());
@@ -291,7 +283,8 @@ void write_jpeg_file(const fs::path& file, const JpegLayout& layout) {
     for (int x = 0; x < kWidth; ++x)
       for (int c = 0; c < layout.components; ++c)
         pixels[(std::size_t(y) * kWidth + std::size_t(x)) * std::size_t(layout.components) + std::size_t(c)] =
-            static_cast<unsigned char>((x * 6 + y * (3 + c * 2) + c * 50 + int(hash(std::uint32_t(x * 131 + y * 7 + c)) % 24)) & 255);
+            static_cast<unsigned char>(
+                (x * 6 + y * (3 + c * 2) + c * 50 + int(sample_hash(std::uint32_t(x * 131 + y * 7 + c)) % 24)) & 255);
   std::FILE* out = std::fopen(file.string().c_str(), "wb");
   ASSERT_NE(out, nullptr);
   jpeg_compress_struct cinfo{};
@@ -324,11 +317,6 @@ TEST(NativeReader, JpegOfEveryLayoutReadsAsOpenImageIOReadsIt) {
 
 // --- damaged files -------------------------------------------------------------------------------------------
 
-std::string bytes_of(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 void write_bytes(const fs::path& file, const std::string& bytes) {
   std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
@@ -343,7 +331,7 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
   int cases = 0;
   for (const char* name : {"p.png", "i.png"}) {
     // The IDAT's zlib data overwritten from its middle on (the CRC then fails too).
-    std::string bytes = bytes_of(dir / name);
+    std::string bytes = read_file(dir / name);
     const std::size_t idat = bytes.find("IDAT");
     ASSERT_NE(idat, std::string::npos);
     for (std::size_t i = idat + 30; i < idat + 60 && i < bytes.size(); ++i) bytes[i] = char(0xA5 ^ i);
@@ -351,7 +339,7 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
   }
   for (const char* name : {"j.jpg", "pj.jpg"}) {
     // The entropy-coded data cut after its first half and the end marker put back: libjpeg warns and pads.
-    std::string bytes = bytes_of(dir / name);
+    std::string bytes = read_file(dir / name);
     const std::size_t scan = bytes.find("\xFF\xDA");
     ASSERT_NE(scan, std::string::npos);
     bytes = bytes.substr(0, scan + (bytes.size() - scan) / 2) + "\xFF\xD9";

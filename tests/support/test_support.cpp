@@ -141,6 +141,14 @@ std::uint64_t resident_bytes() {
   return resident * std::uint64_t(::sysconf(_SC_PAGESIZE));
 }
 
+std::uint32_t sample_hash(std::uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7FEB352Du;
+  x ^= x >> 15;
+  x *= 0x846CA68Bu;
+  return x ^ (x >> 16);
+}
+
 std::string read_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::ostringstream s;

@@ -52,6 +52,9 @@ int spawn(const std::filesystem::path& program, const std::vector<std::string>& 
 std::uint64_t resident_bytes();
 
 std::string read_file(const std::filesystem::path& file);
+
+// A 32-bit integer hash (Chris Wellons' "lowbias32"): well-mixed sample values for the files tests write.
+std::uint32_t sample_hash(std::uint32_t x);
 void write_file(const std::filesystem::path& file, const std::string& text);
 
 }  // namespace qdmr::test

@@ -1,0 +1,336 @@
+// imageio/tiff_reader.cpp: a TIFF whose layout OpenImageIO passes through as stored is read by libtiff in process
+// and gives what OpenImageIO's reader gives (with oiio:UnassociatedAlpha, as the backend opens files): the same
+// size, channels, sample type, Software tag and every sample's bits, over strips and tiles, interleaved and planar
+// samples, every compression but JPEG, both byte orders and extra channels. The layouts OpenImageIO converts are
+// left to it, and damaged pixel data fails in both readers.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+#include <tiffio.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "imageio/native_reader.hpp"
+#include "support/test_support.hpp"
+
+namespace qdmr::test {
+namespace {
+
+namespace fs = std::filesystem;
+using imageio::PixelType;
+
+// Odd sizes: partial strips and partial tiles on the right and at the bottom.
+constexpr std::uint32_t kWidth = 37, kHeight = 23;
+
+struct TiffLayout {
+  const char* name;
+  std::uint16_t channels, photometric, bits, format;
+  std::uint16_t compression = COMPRESSION_NONE, predictor = PREDICTOR_NONE;
+  bool separate = false;
+  std::uint32_t rows_per_strip = 1;  // 0: tiled, 16 x 16
+  bool big_endian = false;
+  std::uint16_t extra = EXTRASAMPLE_UNASSALPHA;  // what the channels after the colour ones are
+  const char* software = nullptr;
+};
+
+std::size_t sample_bytes(std::uint16_t bits) { return bits <= 8 ? 1 : bits / 8; }
+
+// Samples from a hash: every value of the sample type occurs, floats of any bits (NaNs, infinities, denormals)
+// included. Written in host order, libtiff swapping them for a big-endian file.
+void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
+  TIFF* tiff = TIFFOpen(file.string().c_str(), layout.big_endian ? "wb" : "wl");
+  ASSERT_NE(tiff, nullptr) << layout.name;
+  TIFFSetField(tiff, TIFFTAG_IMAGEWIDTH, kWidth);
+  TIFFSetField(tiff, TIFFTAG_IMAGELENGTH, kHeight);
+  TIFFSetField(tiff, TIFFTAG_SAMPLESPERPIXEL, layout.channels);
+  TIFFSetField(tiff, TIFFTAG_BITSPERSAMPLE, layout.bits);
+  TIFFSetField(tiff, TIFFTAG_SAMPLEFORMAT, layout.format);
+  TIFFSetField(tiff, TIFFTAG_PHOTOMETRIC, layout.photometric);
+  TIFFSetField(tiff, TIFFTAG_PLANARCONFIG, layout.separate ? PLANARCONFIG_SEPARATE : PLANARCONFIG_CONTIG);
+  TIFFSetField(tiff, TIFFTAG_COMPRESSION, layout.compression);
+  if (layout.predictor != PREDICTOR_NONE) TIFFSetField(tiff, TIFFTAG_PREDICTOR, layout.predictor);
+  if (layout.software) TIFFSetField(tiff, TIFFTAG_SOFTWARE, layout.software);
+  const std::uint16_t colour = layout.photometric == PHOTOMETRIC_RGB || layout.photometric == PHOTOMETRIC_YCBCR ? 3
+                               : layout.photometric == PHOTOMETRIC_SEPARATED                                   ? 4
+                                                                                                               : 1;
+  if (layout.channels > colour) {
+    const std::vector<std::uint16_t> extra(layout.channels - colour, layout.extra);
+    TIFFSetField(tiff, TIFFTAG_EXTRASAMPLES, std::uint16_t(extra.size()), extra.data());
+  }
+  if (layout.photometric == PHOTOMETRIC_PALETTE) {
+    std::vector<std::uint16_t> r(256), g(256), b(256);
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      r[i] = std::uint16_t(sample_hash(i));
+      g[i] = std::uint16_t(sample_hash(i + 300));
+      b[i] = std::uint16_t(i * 257);
+    }
+    TIFFSetField(tiff, TIFFTAG_COLORMAP, r.data(), g.data(), b.data());
+  }
+  const bool tiled = layout.rows_per_strip == 0;
+  const std::uint32_t tile = 16;
+  if (tiled) {
+    TIFFSetField(tiff, TIFFTAG_TILEWIDTH, tile);
+    TIFFSetField(tiff, TIFFTAG_TILELENGTH, tile);
+  } else {
+    TIFFSetField(tiff, TIFFTAG_ROWSPERSTRIP, layout.rows_per_strip);
+  }
+  const std::size_t per_pixel = layout.separate ? 1 : layout.channels;
+  const std::size_t bytes = sample_bytes(layout.bits);
+  // The sample at (x, y) of `plane` (or of channel c of an interleaved pixel), its bytes in host order.
+  const auto sample = [&](std::uint32_t x, std::uint32_t y, std::size_t c, unsigned char* out) {
+    const std::uint32_t h = sample_hash((y * kWidth + x) * 8 + std::uint32_t(c) + 977u * layout.bits);
+    if (layout.bits < 8) {
+      const std::size_t bit = (x * per_pixel + (layout.separate ? 0 : c)) * layout.bits;
+      out[bit / 8 - (x * per_pixel * layout.bits) / 8] |=
+          static_cast<unsigned char>((h & ((1u << layout.bits) - 1)) << (8 - layout.bits - bit % 8));
+    } else {
+      std::memcpy(out, &h, bytes);
+    }
+  };
+  const std::uint16_t planes = layout.separate ? layout.channels : 1;
+  bool written = true;
+  if (tiled) {
+    std::vector<unsigned char> buffer(std::size_t(TIFFTileSize64(tiff)));
+    for (std::uint16_t plane = 0; plane < planes; ++plane)
+      for (std::uint32_t y = 0; y < kHeight; y += tile)
+        for (std::uint32_t x = 0; x < kWidth; x += tile) {
+          std::fill(buffer.begin(), buffer.end(), 0);
+          for (std::uint32_t r = 0; r < tile && y + r < kHeight; ++r)
+            for (std::uint32_t col = 0; col < tile && x + col < kWidth; ++col)
+              for (std::size_t c = 0; c < per_pixel; ++c)
+                sample(x + col, y + r, layout.separate ? plane : c,
+                       buffer.data() + ((std::size_t(r) * tile + col) * per_pixel + c) * bytes);
+          written = written && TIFFWriteTile(tiff, buffer.data(), x, y, 0, plane) >= 0;
+        }
+  } else {
+    std::vector<unsigned char> row(std::size_t(TIFFScanlineSize64(tiff)));
+    for (std::uint16_t plane = 0; plane < planes; ++plane)
+      for (std::uint32_t y = 0; y < kHeight; ++y) {
+        std::fill(row.begin(), row.end(), 0);
+        for (std::uint32_t x = 0; x < kWidth; ++x)
+          for (std::size_t c = 0; c < per_pixel; ++c)
+            sample(x, y, layout.separate ? plane : c,
+                   layout.bits < 8 ? row.data() + (x * per_pixel * layout.bits) / 8
+                                   : row.data() + (x * per_pixel + c) * bytes);
+        written = written && TIFFWriteScanline(tiff, row.data(), y, plane) >= 0;
+      }
+  }
+  TIFFClose(tiff);
+  EXPECT_TRUE(written) << layout.name;
+}
+
+struct Decoded {
+  int width = 0, height = 0, channels = 0;
+  PixelType type = PixelType::UInt8;
+  std::vector<unsigned char> bytes;  // top row first
+  std::string software;
+};
+
+// OpenImageIO's reading, as the backend opens files; false if it fails or reports an error.
+bool read_with_oiio(const fs::path& file, Decoded& out) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(file.string(), &config);
+  if (!in) return false;
+  const OIIO::ImageSpec& spec = in->spec();
+  out.width = spec.width;
+  out.height = spec.height;
+  out.channels = spec.nchannels;
+  out.type = spec.format == OIIO::TypeDesc::UINT8    ? PixelType::UInt8
+             : spec.format == OIIO::TypeDesc::UINT16 ? PixelType::UInt16
+                                                     : PixelType::Float;
+  const OIIO::TypeDesc as = out.type == PixelType::Float ? OIIO::TypeDesc::FLOAT : spec.format;
+  out.software = spec.get_string_attribute("Software");
+  out.bytes.resize(spec.image_pixels() * std::size_t(spec.nchannels) * as.size());
+  return in->read_image(0, 0, 0, spec.nchannels, as, out.bytes.data()) && !in->has_error();
+}
+
+std::size_t size_of(PixelType type) { return type == PixelType::UInt8 ? 1 : type == PixelType::UInt16 ? 2 : 4; }
+
+// The native reader's, as `type` (the file's own by default); false if it does not claim the file, cannot open
+// it or fails to read it.
+bool read_natively(const fs::path& file, Decoded& out, std::string& error, const PixelType* type = nullptr) {
+  imageio::ReadSpec spec;
+  bool claimed = false;
+  const auto reader = imageio::open_native(file.string(), spec, error, claimed);
+  if (!claimed || !reader) return false;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.channels = spec.channels;
+  out.type = type ? *type : spec.type;
+  out.software = spec.software;
+  EXPECT_EQ(spec.format, "tiff");
+  EXPECT_TRUE(spec.bits_version.empty());
+  const std::size_t row = std::size_t(spec.width) * std::size_t(spec.channels) * size_of(out.type);
+  out.bytes.resize(row * std::size_t(spec.height));
+  return reader->read(out.type, out.bytes.data(), std::ptrdiff_t(row), error);
+}
+
+const TiffLayout kClaimed[] = {
+    {"grey8", 1, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_UINT},
+    {"grey16_be", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 1, true},
+    {"grey_float", 1, PHOTOMETRIC_MINISBLACK, 32, SAMPLEFORMAT_IEEEFP, COMPRESSION_NONE, PREDICTOR_NONE, false, 5},
+    {"grey_alpha8", 2, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_HORIZONTAL},
+    {"grey_two_data16", 2, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_UINT, COMPRESSION_ADOBE_DEFLATE,
+     PREDICTOR_NONE, true, 4, false, EXTRASAMPLE_UNSPECIFIED},
+    {"rgb8", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 23, false,
+     EXTRASAMPLE_UNASSALPHA, "qdmr 0.1.0 (bits version 5)"},
+    {"rgb8_lzw", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_HORIZONTAL, false, 8},
+    {"rgb8_packbits_planar", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_PACKBITS, PREDICTOR_NONE, true, 3},
+    {"rgb16_deflate_be", 3, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_UINT, COMPRESSION_ADOBE_DEFLATE,
+     PREDICTOR_HORIZONTAL, false, 7, true},
+    {"rgb16_zstd_tiled", 3, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_UINT, COMPRESSION_ZSTD, PREDICTOR_NONE, false, 0},
+    {"rgb_float_predictor", 3, PHOTOMETRIC_RGB, 32, SAMPLEFORMAT_IEEEFP, COMPRESSION_ADOBE_DEFLATE,
+     PREDICTOR_FLOATINGPOINT, false, 6},
+    {"rgb_float_lzma_tiled_be", 3, PHOTOMETRIC_RGB, 32, SAMPLEFORMAT_IEEEFP, COMPRESSION_LZMA, PREDICTOR_NONE,
+     false, 0, true},
+    {"rgba8_assoc", 4, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 2, false,
+     EXTRASAMPLE_ASSOCALPHA},
+    {"rgba8_unassoc_tiled_planar", 4, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_NONE, true,
+     0},
+    {"rgba16_planar_be", 4, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, true, 23, true},
+    {"rgba_float_tiled_planar", 4, PHOTOMETRIC_RGB, 32, SAMPLEFORMAT_IEEEFP, COMPRESSION_ZSTD,
+     PREDICTOR_FLOATINGPOINT, true, 0},
+    {"five_channels16", 5, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_HORIZONTAL, false, 9,
+     false, EXTRASAMPLE_UNSPECIFIED},
+};
+
+TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
+  TempDir dir;
+  int compared = 0;
+  for (const TiffLayout& layout : kClaimed) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    Decoded oiio, native;
+    std::string error;
+    ASSERT_TRUE(read_with_oiio(file, oiio)) << OIIO::geterror();
+    EXPECT_TRUE(imageio::read_natively(file.string()));
+    ASSERT_TRUE(read_natively(file, native, error)) << error;
+    EXPECT_EQ(native.width, oiio.width);
+    EXPECT_EQ(native.height, oiio.height);
+    EXPECT_EQ(native.channels, oiio.channels);
+    EXPECT_EQ(int(native.type), int(oiio.type));
+    EXPECT_EQ(native.software, oiio.software);
+    ASSERT_EQ(native.bytes.size(), oiio.bytes.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < native.bytes.size(); ++i) differ += native.bytes[i] != oiio.bytes[i];
+    EXPECT_EQ(differ, 0u) << "bytes that differ of " << native.bytes.size();
+    ++compared;
+  }
+  EXPECT_EQ(compared, int(std::size(kClaimed)));
+}
+
+// What OpenImageIO converts (palette to RGB, min-is-white inverted, 1-bit to 8, CMYK to RGB, JPEG through the RGBA
+// interface) or reads in a type the readers do not have (signed, half float, 32-bit integers) is not claimed:
+// the backend reads it, as before.
+TEST(TiffReader, LayoutsOpenImageIOConvertsAreLeftToIt) {
+  const TiffLayout kLeft[] = {
+      {"palette8", 1, PHOTOMETRIC_PALETTE, 8, SAMPLEFORMAT_UINT},
+      {"min_is_white8", 1, PHOTOMETRIC_MINISWHITE, 8, SAMPLEFORMAT_UINT},
+      {"bilevel", 1, PHOTOMETRIC_MINISBLACK, 1, SAMPLEFORMAT_UINT},
+      {"grey4", 1, PHOTOMETRIC_MINISBLACK, 4, SAMPLEFORMAT_UINT},
+      {"cmyk8", 4, PHOTOMETRIC_SEPARATED, 8, SAMPLEFORMAT_UINT},
+      {"rgb8_jpeg", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_JPEG, PREDICTOR_NONE, false, 16},
+      {"grey_int16", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_INT},
+      {"grey_half", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_IEEEFP},
+      {"grey_uint32", 1, PHOTOMETRIC_MINISBLACK, 32, SAMPLEFORMAT_UINT},
+  };
+  TempDir dir;
+  int left = 0;
+  for (const TiffLayout& layout : kLeft) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    Decoded oiio;
+    EXPECT_TRUE(read_with_oiio(file, oiio)) << OIIO::geterror();  // a real file, which the backend reads
+    EXPECT_FALSE(imageio::read_natively(file.string()));
+    imageio::ReadSpec spec;
+    std::string error = "untouched";
+    bool claimed = true;
+    EXPECT_EQ(imageio::open_native(file.string(), spec, error, claimed), nullptr);
+    EXPECT_FALSE(claimed);
+    EXPECT_EQ(error, "untouched");
+    EXPECT_TRUE(spec.format.empty());
+    ++left;
+  }
+  EXPECT_EQ(left, int(std::size(kLeft)));
+}
+
+// Asked for another type, the samples are converted as the PNG and JPEG readers convert them (k of b bits as
+// k / (2^b - 1)), from planes and partial tiles too; a float file is read as floats only.
+TEST(TiffReader, OtherSampleTypesAreTheFilesValuesConverted) {
+  TempDir dir;
+  const TiffLayout planar = kClaimed[13];  // rgba8_unassoc_tiled_planar
+  const TiffLayout wide = kClaimed[14];    // rgba16_planar_be
+  for (const TiffLayout& layout : {planar, wide}) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    Decoded stored, as_float;
+    std::string error;
+    const PixelType float_type = PixelType::Float;
+    ASSERT_TRUE(read_natively(file, stored, error)) << error;
+    ASSERT_TRUE(read_natively(file, as_float, error, &float_type)) << error;
+    const std::size_t bytes = size_of(stored.type);
+    ASSERT_EQ(as_float.bytes.size(), stored.bytes.size() / bytes * 4);
+    const float max = bytes == 1 ? 255.0f : 65535.0f;
+    for (std::size_t i = 0; i < stored.bytes.size() / bytes; ++i) {
+      std::uint16_t k = 0;
+      std::memcpy(&k, stored.bytes.data() + i * bytes, bytes);
+      float f;
+      std::memcpy(&f, as_float.bytes.data() + 4 * i, 4);
+      ASSERT_EQ(f, float(k) / max) << i;
+    }
+  }
+  const fs::path floats = dir / "f.tif";
+  write_tiff_file(floats, kClaimed[2]);
+  Decoded narrow;
+  std::string error;
+  const PixelType byte_type = PixelType::UInt8;
+  EXPECT_FALSE(read_natively(floats, narrow, error, &byte_type));
+  EXPECT_NE(error.find("read as floats only"), std::string::npos) << error;
+}
+
+// Compressed pixel data overwritten (the header intact, so libtiff opens the file): both readers fail, neither
+// crashes, and the native one says what libtiff said.
+TEST(TiffReader, DamagedPixelDataFailsInBothReaders) {
+  TempDir dir;
+  int cases = 0;
+  for (const TiffLayout& layout : {kClaimed[4], kClaimed[6], kClaimed[9]}) {  // deflate, LZW strips; zstd tiles
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    // Where the first strip or tile is, from the file's own offsets.
+    TIFF* tiff = TIFFOpen(file.string().c_str(), "r");
+    ASSERT_NE(tiff, nullptr);
+    std::uint64_t* offsets = nullptr;
+    std::uint64_t* counts = nullptr;
+    const bool tiled = TIFFIsTiled(tiff);
+    ASSERT_EQ(TIFFGetField(tiff, tiled ? TIFFTAG_TILEOFFSETS : TIFFTAG_STRIPOFFSETS, &offsets), 1);
+    ASSERT_EQ(TIFFGetField(tiff, tiled ? TIFFTAG_TILEBYTECOUNTS : TIFFTAG_STRIPBYTECOUNTS, &counts), 1);
+    const std::uint64_t at = offsets[0], count = counts[0];
+    TIFFClose(tiff);
+    std::string bytes = read_file(file);
+    ASSERT_LE(at + count, bytes.size());
+    for (std::uint64_t i = at; i < at + count; ++i) bytes[i] = char(0xA5 ^ (i * 7));
+    const fs::path bad = dir / (std::string("bad_") + layout.name + ".tif");
+    write_file(bad, bytes);
+    Decoded oiio, native;
+    std::string error;
+    EXPECT_FALSE(read_with_oiio(bad, oiio));
+    EXPECT_TRUE(imageio::read_natively(bad.string()));  // the header is intact
+    EXPECT_FALSE(read_natively(bad, native, error));
+    EXPECT_FALSE(error.empty());
+    EXPECT_EQ(error.find("could not decode"), std::string::npos) << error;  // libtiff's own words
+    ++cases;
+  }
+  EXPECT_EQ(cases, 3);
+}
+
+}  // namespace
+}  // namespace qdmr::test
