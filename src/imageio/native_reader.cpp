@@ -8,11 +8,11 @@ namespace qdmr::imageio {
 
 namespace {
 
-enum class Signature { Png, Jpeg, Tiff, Other };
+enum class Signature { Png, Jpeg, Tiff, Exr, Other };
 
 // The checks of OpenImageIO's readers (valid_file), so no PNG or JPEG ever reaches theirs: PNG's first seven
 // bytes (libpng then checks the eighth), JPEG's SOI marker; TIFF's byte order and version (42, or 43 for
-// BigTIFF).
+// BigTIFF); OpenEXR's magic number.
 Signature signature_of(const std::string& path) {
   unsigned char bytes[8] = {};
   std::size_t got = 0;
@@ -25,6 +25,7 @@ Signature signature_of(const std::string& path) {
   if (got >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' && (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
                    (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43))))
     return Signature::Tiff;
+  if (got >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2F && bytes[2] == 0x31 && bytes[3] == 0x01) return Signature::Exr;
   return Signature::Other;
 }
 
@@ -41,9 +42,10 @@ bool read_natively(const std::string& path) {
 
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed) {
   const Signature signature = signature_of(path);
-  claimed = signature == Signature::Png || signature == Signature::Jpeg;
+  claimed = signature == Signature::Png || signature == Signature::Jpeg || signature == Signature::Exr;
   if (signature == Signature::Png) return open_png(path, spec, error);
   if (signature == Signature::Jpeg) return open_jpeg(path, spec, error);
+  if (signature == Signature::Exr) return open_exr(path, spec, error);
   if (signature == Signature::Tiff) return open_tiff(path, spec, claimed);
   return nullptr;
 }

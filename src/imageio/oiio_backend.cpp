@@ -48,7 +48,7 @@ bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path,
 }
 
 // The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads
-// textures from that it does not read itself (PNG, JPEG and the TIFF layouts it reads never get here:
+// textures from that it does not read itself (PNG, JPEG, OpenEXR and the TIFF layouts it reads never get here:
 // imageio/read_file.cpp), each of which
 // checks the magic number first (valid_file). OpenImageIO's own fallback
 // (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file:

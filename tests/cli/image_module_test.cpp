@@ -57,22 +57,24 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
-  // PNG, JPEG and TIFF (of the layouts OpenImageIO passes through) textures are read in process
-  // (imageio/native_reader.hpp): planned and rendered without the module. An OpenEXR texture needs it, and says so.
+  // PNG, JPEG, OpenEXR and TIFF (of the layouts OpenImageIO passes through) textures are read in process
+  // (imageio/native_reader.hpp): planned and rendered without the module. A PGM texture needs it, and says so.
   const std::filesystem::path images = source_dir() / "tests/bad_inputs/files/images";
   const auto albedo = [&](const char* file) { return "/materials/bricks/layers/0/albedo=" + (images / file).string(); };
-  for (const char* file : {"good.png", "noise.jpg", "noise.tif"}) {
+  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr"}) {
     const CommandResult textured_plan = run(cli(), {"plan", plane, "--set", albedo(file)});
     EXPECT_EQ(textured_plan.exit_code, 0) << file << ": " << textured_plan.output;
     const CommandResult textured = run(cli(), {"render", plane, "-o", (dir / "t.png").string(), "--width", "32",
                                                "--height", "18", "--set", albedo(file)});
     EXPECT_EQ(textured.exit_code, 0) << file << ": " << textured.output;
   }
-  const CommandResult exr = run(cli(), {"render", plane, "-o", (dir / "exr.png").string(), "--width", "32",
-                                        "--height", "18", "--set", albedo("noise.exr")});
-  EXPECT_EQ(exr.exit_code, 2) << exr.output;
-  EXPECT_NE(exr.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << exr.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "exr.png"));
+  write_file(dir / "t.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
+  const CommandResult pgm = run(cli(), {"render", plane, "-o", (dir / "pgm.png").string(), "--width", "32",
+                                        "--height", "18", "--set",
+                                        "/materials/bricks/layers/0/albedo=" + (dir / "t.pgm").string()});
+  EXPECT_EQ(pgm.exit_code, 2) << pgm.output;
+  EXPECT_NE(pgm.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << pgm.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "pgm.png"));
 }
 
 // The PNG written without the module holds what qdmr means to write: every byte the sRGB code of the linear

@@ -214,8 +214,8 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
 
 // The image library's own memory (kImageModuleBytes, measured by bench/image_module_memory.sh) is counted when,
 // and only when, building the frame reads an image file through it: an albedo, a height behind from_height normals,
-// a grid's height map or a weight map, each a file other than PNG, JPEG or TIFF; procedural and constant textures
-// and PNG, JPEG and TIFF files (read in process) load no library.
+// a grid's height map or a weight map, each a PNM file (or a TIFF OpenImageIO converts); procedural and constant
+// textures and PNG, JPEG, OpenEXR and TIFF files (read in process) load no library.
 TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
   TempDir dir;
   write_file(dir / "t.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
@@ -250,9 +250,9 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
     EXPECT_NE(plan.describe().find("image library 48.00 MiB (to read image files)"), std::string::npos)
         << plan.describe();
   }
-  // PNG, JPEG and TIFF files are read in process (imageio/native_reader.hpp): no image library to count.
+  // PNG, JPEG, OpenEXR and TIFF files are read in process (imageio/native_reader.hpp): no image library to count.
   const std::filesystem::path images = std::filesystem::path(QDMR_SOURCE_DIR) / "tests/bad_inputs/files/images";
-  for (const char* file : {"good.png", "noise.jpg", "noise.tif"}) {
+  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr"}) {
     std::filesystem::copy_file(images / file, dir / file);
     const FramePlan plan = plan_with(std::string(R"({"layers": [{"albedo": ")") + file + R"("}]})", plane);
     EXPECT_EQ(plan.image_module_bytes, 0u) << file;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "imageio/native_reader.hpp"
+#include "io/read_both_ways.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -28,64 +29,6 @@ namespace fs = std::filesystem;
 
 // Odd sizes: partial bytes of 1- to 4-bit rows, partial JPEG blocks and chroma pairs.
 constexpr int kWidth = 37, kHeight = 23;
-
-struct Decoded {
-  int width = 0, height = 0, channels = 0;
-  bool wide = false;  // 16-bit samples
-  std::vector<unsigned char> bytes;  // top row first
-  std::string software, bits_version;
-};
-
-// OpenImageIO's reading, as the backend opens files; false if it fails or reports an error.
-bool read_with_oiio(const fs::path& file, Decoded& out) {
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(file.string(), &config);
-  if (!in) return false;
-  const OIIO::ImageSpec& spec = in->spec();
-  out.width = spec.width;
-  out.height = spec.height;
-  out.channels = spec.nchannels;
-  out.wide = spec.format == OIIO::TypeDesc::UINT16;
-  out.software = spec.get_string_attribute("Software");
-  out.bits_version = spec.get_string_attribute("qdmr:bits_version");
-  out.bytes.resize(spec.image_bytes());
-  return in->read_image(0, 0, 0, spec.nchannels, spec.format, out.bytes.data()) && !in->has_error();
-}
-
-// The native reader's; false if it does not claim the file, cannot open it or fails to read it.
-bool read_natively(const fs::path& file, Decoded& out, std::string& error) {
-  imageio::ReadSpec spec;
-  bool claimed = false;
-  const auto reader = imageio::open_native(file.string(), spec, error, claimed);
-  if (!claimed || !reader) return false;
-  out.width = spec.width;
-  out.height = spec.height;
-  out.channels = spec.channels;
-  out.wide = spec.type == imageio::PixelType::UInt16;
-  out.software = spec.software;
-  out.bits_version = spec.bits_version;
-  const std::size_t row = std::size_t(spec.width) * std::size_t(spec.channels) * (out.wide ? 2 : 1);
-  out.bytes.resize(row * std::size_t(spec.height));
-  return reader->read(spec.type, out.bytes.data(), std::ptrdiff_t(row), error);
-}
-
-void expect_same_as_oiio(const fs::path& file) {
-  Decoded oiio, native;
-  std::string error;
-  ASSERT_TRUE(read_with_oiio(file, oiio)) << file.filename() << ": " << OIIO::geterror();
-  ASSERT_TRUE(read_natively(file, native, error)) << file.filename() << ": " << error;
-  EXPECT_EQ(native.width, oiio.width) << file.filename();
-  EXPECT_EQ(native.height, oiio.height) << file.filename();
-  EXPECT_EQ(native.channels, oiio.channels) << file.filename();
-  EXPECT_EQ(native.wide, oiio.wide) << file.filename();
-  EXPECT_EQ(native.software, oiio.software) << file.filename();
-  EXPECT_EQ(native.bits_version, oiio.bits_version) << file.filename();
-  ASSERT_EQ(native.bytes.size(), oiio.bytes.size()) << file.filename();
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < native.bytes.size(); ++i) differ += native.bytes[i] != oiio.bytes[i];
-  EXPECT_EQ(differ, 0u) << file.filename() << ": bytes that differ of " << native.bytes.size();
-}
 
 // --- PNG files, written by libpng ---------------------------------------------------------------------------
 
@@ -356,18 +299,12 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
   EXPECT_EQ(cases, 4);
 }
 
-// Every sample of `file` as `type` (one channel's width per value: 1, 2 or 4 bytes), top row first.
-std::vector<unsigned char> read_as(const fs::path& file, imageio::PixelType type, int value_bytes) {
-  imageio::ReadSpec spec;
+// Every sample of `file` as `type`, top row first.
+std::vector<unsigned char> read_as(const fs::path& file, imageio::PixelType type) {
+  Decoded decoded;
   std::string error;
-  bool claimed = false;
-  const auto reader = imageio::open_native(file.string(), spec, error, claimed);
-  EXPECT_TRUE(reader) << error;
-  if (!reader) return {};
-  const std::size_t row = std::size_t(spec.width) * std::size_t(spec.channels) * std::size_t(value_bytes);
-  std::vector<unsigned char> out(row * std::size_t(spec.height));
-  EXPECT_TRUE(reader->read(type, out.data(), std::ptrdiff_t(row), error)) << error;
-  return out;
+  EXPECT_TRUE(read_natively(file, decoded, error, &type)) << error;
+  return decoded.bytes;
 }
 
 // Asked for another type than the file's, a reader converts: k of b bits stands for k / (2^b - 1), as a float
@@ -377,9 +314,9 @@ TEST(NativeReader, OtherSampleTypesAreTheFilesValuesConverted) {
   write_png_file(dir / "g16.png", {"g16", PNG_COLOR_TYPE_GRAY, 16, false, false}, {});
   write_png_file(dir / "rgb8.png", {"rgb8", PNG_COLOR_TYPE_RGB, 8, false, false}, {});
   using imageio::PixelType;
-  const auto wide = read_as(dir / "g16.png", PixelType::UInt16, 2);
-  const auto wide_f = read_as(dir / "g16.png", PixelType::Float, 4);
-  const auto wide_8 = read_as(dir / "g16.png", PixelType::UInt8, 1);
+  const auto wide = read_as(dir / "g16.png", PixelType::UInt16);
+  const auto wide_f = read_as(dir / "g16.png", PixelType::Float);
+  const auto wide_8 = read_as(dir / "g16.png", PixelType::UInt8);
   ASSERT_EQ(wide.size(), std::size_t(kWidth) * kHeight * 2);
   ASSERT_EQ(wide_f.size(), wide.size() * 2);
   for (std::size_t i = 0; i < wide.size() / 2; ++i) {
@@ -390,9 +327,9 @@ TEST(NativeReader, OtherSampleTypesAreTheFilesValuesConverted) {
     ASSERT_EQ(f, float(k) / 65535.0f) << i;
     ASSERT_EQ(int(wide_8[i]), int(std::lround(k * 255.0 / 65535.0))) << i;
   }
-  const auto narrow = read_as(dir / "rgb8.png", PixelType::UInt8, 1);
-  const auto narrow_f = read_as(dir / "rgb8.png", PixelType::Float, 4);
-  const auto narrow_16 = read_as(dir / "rgb8.png", PixelType::UInt16, 2);
+  const auto narrow = read_as(dir / "rgb8.png", PixelType::UInt8);
+  const auto narrow_f = read_as(dir / "rgb8.png", PixelType::Float);
+  const auto narrow_16 = read_as(dir / "rgb8.png", PixelType::UInt16);
   ASSERT_EQ(narrow.size(), std::size_t(kWidth) * kHeight * 3);
   for (std::size_t i = 0; i < narrow.size(); ++i) {
     float f;
@@ -403,8 +340,8 @@ TEST(NativeReader, OtherSampleTypesAreTheFilesValuesConverted) {
     ASSERT_EQ(int(k16), narrow[i] * 257) << i;
   }
   write_jpeg_file(dir / "j.jpg", kJpegLayouts[3]);
-  const auto jpeg = read_as(dir / "j.jpg", PixelType::UInt8, 1);
-  const auto jpeg_f = read_as(dir / "j.jpg", PixelType::Float, 4);
+  const auto jpeg = read_as(dir / "j.jpg", PixelType::UInt8);
+  const auto jpeg_f = read_as(dir / "j.jpg", PixelType::Float);
   ASSERT_EQ(jpeg.size(), std::size_t(kWidth) * kHeight * 3);
   for (std::size_t i = 0; i < jpeg.size(); ++i) {
     float f;

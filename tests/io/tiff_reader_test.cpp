@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "imageio/native_reader.hpp"
+#include "io/read_both_ways.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -123,53 +124,6 @@ void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
   EXPECT_TRUE(written) << layout.name;
 }
 
-struct Decoded {
-  int width = 0, height = 0, channels = 0;
-  PixelType type = PixelType::UInt8;
-  std::vector<unsigned char> bytes;  // top row first
-  std::string software;
-};
-
-// OpenImageIO's reading, as the backend opens files; false if it fails or reports an error.
-bool read_with_oiio(const fs::path& file, Decoded& out) {
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(file.string(), &config);
-  if (!in) return false;
-  const OIIO::ImageSpec& spec = in->spec();
-  out.width = spec.width;
-  out.height = spec.height;
-  out.channels = spec.nchannels;
-  out.type = spec.format == OIIO::TypeDesc::UINT8    ? PixelType::UInt8
-             : spec.format == OIIO::TypeDesc::UINT16 ? PixelType::UInt16
-                                                     : PixelType::Float;
-  const OIIO::TypeDesc as = out.type == PixelType::Float ? OIIO::TypeDesc::FLOAT : spec.format;
-  out.software = spec.get_string_attribute("Software");
-  out.bytes.resize(spec.image_pixels() * std::size_t(spec.nchannels) * as.size());
-  return in->read_image(0, 0, 0, spec.nchannels, as, out.bytes.data()) && !in->has_error();
-}
-
-std::size_t size_of(PixelType type) { return type == PixelType::UInt8 ? 1 : type == PixelType::UInt16 ? 2 : 4; }
-
-// The native reader's, as `type` (the file's own by default); false if it does not claim the file, cannot open
-// it or fails to read it.
-bool read_natively(const fs::path& file, Decoded& out, std::string& error, const PixelType* type = nullptr) {
-  imageio::ReadSpec spec;
-  bool claimed = false;
-  const auto reader = imageio::open_native(file.string(), spec, error, claimed);
-  if (!claimed || !reader) return false;
-  out.width = spec.width;
-  out.height = spec.height;
-  out.channels = spec.channels;
-  out.type = type ? *type : spec.type;
-  out.software = spec.software;
-  EXPECT_EQ(spec.format, "tiff");
-  EXPECT_TRUE(spec.bits_version.empty());
-  const std::size_t row = std::size_t(spec.width) * std::size_t(spec.channels) * size_of(out.type);
-  out.bytes.resize(row * std::size_t(spec.height));
-  return reader->read(out.type, out.bytes.data(), std::ptrdiff_t(row), error);
-}
-
 const TiffLayout kClaimed[] = {
     {"grey8", 1, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_UINT},
     {"grey16_be", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 1, true},
@@ -206,20 +160,8 @@ TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
     SCOPED_TRACE(layout.name);
     const fs::path file = dir / (std::string(layout.name) + ".tif");
     write_tiff_file(file, layout);
-    Decoded oiio, native;
-    std::string error;
-    ASSERT_TRUE(read_with_oiio(file, oiio)) << OIIO::geterror();
     EXPECT_TRUE(imageio::read_natively(file.string()));
-    ASSERT_TRUE(read_natively(file, native, error)) << error;
-    EXPECT_EQ(native.width, oiio.width);
-    EXPECT_EQ(native.height, oiio.height);
-    EXPECT_EQ(native.channels, oiio.channels);
-    EXPECT_EQ(int(native.type), int(oiio.type));
-    EXPECT_EQ(native.software, oiio.software);
-    ASSERT_EQ(native.bytes.size(), oiio.bytes.size());
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < native.bytes.size(); ++i) differ += native.bytes[i] != oiio.bytes[i];
-    EXPECT_EQ(differ, 0u) << "bytes that differ of " << native.bytes.size();
+    expect_same_as_oiio(file);
     ++compared;
   }
   EXPECT_EQ(compared, int(std::size(kClaimed)));
