@@ -2,8 +2,8 @@
 """The whole-process targets of issue #12 (docs/performance.md, section 5), measured side by side in one run:
 
   - `qdmr --help` and `qdmr plan` of a procedural scene, of one whose textures are PNG and JPEG files, of one
-    with a TIFF and of one with an OpenEXR texture (all read in process), and of one with a PGM texture (which
-    loads the image module): each at most 50 ms;
+    with a TIFF, an OpenEXR and a PGM texture (all read in process), and of one with a PFM texture (which loads
+    the image module): each at most 50 ms;
   - a whole `qdmr render` of the canonical scene (bench/llvmpipe/canonical.json, normal mapping, 1920x1080) to
     PNG: at most 2 x its warm frame + 50 ms, by wall time and by its stats' time_ms.total; its PNG written in at
     most 40 ms (time_ms.write); its frame (time_ms.draw, cold: the process's first) within 1.2 x the warm one;
@@ -58,9 +58,12 @@ def main():
     threads = ["--threads", str(args.threads)]
     tmp_dir = tempfile.TemporaryDirectory()
     tmp = tmp_dir.name
-    pgm = os.path.join(tmp, "grey.pgm")  # a 4x4 binary PGM: PNM files are read through the image module
+    pgm = os.path.join(tmp, "grey.pgm")  # a 4x4 binary PGM, read in process
     with open(pgm, "wb") as f:
         f.write(b"P5\n4 4\n255\n" + bytes([100] * 16))
+    pfm = os.path.join(tmp, "grey.pfm")  # a 4x4 PFM, read through the image module
+    with open(pfm, "wb") as f:
+        f.write(b"Pf\n4 4\n-1.0\n" + bytes(64))
     plans = {
         "plan, procedural textures": [qdmr, "plan", PLANE],
         "plan, PNG and JPEG textures": [qdmr, "plan", PLANE, "--set", f"{ALBEDO}={IMAGES}/noise.jpg", "--set",
@@ -68,6 +71,7 @@ def main():
         "plan, a TIFF texture": [qdmr, "plan", PLANE, "--set", f"{ALBEDO}={IMAGES}/noise.tif"],
         "plan, an OpenEXR texture": [qdmr, "plan", PLANE, "--set", f"{ALBEDO}={IMAGES}/noise.exr"],
         "plan, a PGM texture": [qdmr, "plan", PLANE, "--set", f"{ALBEDO}={pgm}"],
+        "plan, a PFM texture": [qdmr, "plan", PLANE, "--set", f"{ALBEDO}={pfm}"],
     }
     rounds = {name: [] for name in ["help", *plans, "render wall", "render total", "render draw", "render write",
                                     "warm frame"]}

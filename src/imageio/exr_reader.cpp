@@ -192,9 +192,7 @@ private:
 }  // namespace
 
 std::unique_ptr<NativeReader> open_exr(const std::string& path, ReadSpec& spec, std::string& error) {
-  auto reader = std::make_unique<ExrReader>();
-  if (!reader->open(path, spec, error)) return nullptr;
-  return reader;
+  return opened<ExrReader>(path, spec, error);
 }
 
 }  // namespace qdmr::imageio

@@ -187,9 +187,7 @@ private:
 }  // namespace
 
 std::unique_ptr<NativeReader> open_jpeg(const std::string& path, ReadSpec& spec, std::string& error) {
-  auto reader = std::make_unique<JpegReader>();
-  if (!reader->open(path, spec, error)) return nullptr;
-  return reader;
+  return opened<JpegReader>(path, spec, error);
 }
 
 }  // namespace qdmr::imageio

@@ -8,11 +8,11 @@ namespace qdmr::imageio {
 
 namespace {
 
-enum class Signature { Png, Jpeg, Tiff, Exr, Other };
+enum class Signature { Png, Jpeg, Tiff, Exr, Pnm, Other };
 
 // The checks of OpenImageIO's readers (valid_file), so no PNG or JPEG ever reaches theirs: PNG's first seven
 // bytes (libpng then checks the eighth), JPEG's SOI marker; TIFF's byte order and version (42, or 43 for
-// BigTIFF); OpenEXR's magic number.
+// BigTIFF); OpenEXR's magic number; "P1" to "P6" of PBM, PGM and PPM.
 Signature signature_of(const std::string& path) {
   unsigned char bytes[8] = {};
   std::size_t got = 0;
@@ -26,6 +26,7 @@ Signature signature_of(const std::string& path) {
                    (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43))))
     return Signature::Tiff;
   if (got >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2F && bytes[2] == 0x31 && bytes[3] == 0x01) return Signature::Exr;
+  if (got >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') return Signature::Pnm;
   return Signature::Other;
 }
 
@@ -42,10 +43,12 @@ bool read_natively(const std::string& path) {
 
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed) {
   const Signature signature = signature_of(path);
-  claimed = signature == Signature::Png || signature == Signature::Jpeg || signature == Signature::Exr;
+  claimed = signature == Signature::Png || signature == Signature::Jpeg || signature == Signature::Exr ||
+            signature == Signature::Pnm;
   if (signature == Signature::Png) return open_png(path, spec, error);
   if (signature == Signature::Jpeg) return open_jpeg(path, spec, error);
   if (signature == Signature::Exr) return open_exr(path, spec, error);
+  if (signature == Signature::Pnm) return open_pnm(path, spec, error);
   if (signature == Signature::Tiff) return open_tiff(path, spec, claimed);
   return nullptr;
 }

@@ -1,9 +1,10 @@
 #pragma once
 // PNG, JPEG, OpenEXR and most TIFF files decoded in this process by libpng, libjpeg-turbo, OpenEXR and libtiff, the
-// libraries OpenImageIO's own readers call, in the same way: the same pixels, refusals and header. They are the
-// formats of textures, and reading them without OpenImageIO spares a job the loading of the image module (~260
+// libraries OpenImageIO's own readers call, in the same way: the same pixels, refusals and header; and PBM, PGM and
+// PPM files as Netpbm defines them (imageio/pnm_reader.cpp: where OpenImageIO's reader got them wrong). They are
+// the formats of textures, and reading them without OpenImageIO spares a job the loading of the image module (~260
 // shared libraries, 0.3-0.5 s: docs/performance.md). Every other file goes to the backend (imageio/backend.hpp):
-// PNM files, and the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says which).
+// PFM files, and the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says which).
 //
 // What OpenImageIO 2.4 does and these readers do too: libpng expands palettes, low bit depths and tRNS to 8-bit
 // channels (and alpha), 16-bit samples in host order, an interlaced file read whole, a JPEG's CMYK or YCCK
@@ -14,6 +15,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "imageio/backend.hpp"
 
@@ -23,22 +25,33 @@ class NativeReader {
 public:
   virtual ~NativeReader() = default;
   // As Backend::read. `type` other than the file's own converts k to k / (2^bits - 1), correctly rounded; a file
-  // of float samples (a TIFF's, an OpenEXR file) is read as floats only.
+  // of float samples (a TIFF's, an OpenEXR file, a PNM file of a maxval other than 255 and 65535) is read as floats
+  // only.
   virtual bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) = 0;
 };
 
-// For a file that starts with PNG's, JPEG's or OpenEXR's signature, or a TIFF that libtiff opens in a layout
-// OpenImageIO reads as stored: `claimed` is true, and the reader with `spec` filled in, or null with `error` set. For
-// any other file `claimed` is false, `error` is left as it was and the backend is the file's reader.
+// For a file that starts with PNG's, JPEG's, OpenEXR's or PBM/PGM/PPM's signature, or a TIFF that libtiff opens in
+// a layout OpenImageIO reads as stored: `claimed` is true, and the reader with `spec` filled in, or null with
+// `error` set. For any other file `claimed` is false, `error` is left as it was and the backend is the file's
+// reader.
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed);
 
 // Whether open_native claims `path`: reading it loads no image module.
 bool read_natively(const std::string& path);
+
+// A new reader of type R, opened with `arguments`; null when its open() fails (having said why).
+template <class R, class... Arguments>
+std::unique_ptr<NativeReader> opened(Arguments&&... arguments) {
+  auto reader = std::make_unique<R>();
+  if (!reader->open(std::forward<Arguments>(arguments)...)) return nullptr;
+  return reader;
+}
 
 // The readers open_native chooses from, by signature. A TIFF is claimed only after libtiff read its header.
 std::unique_ptr<NativeReader> open_png(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_jpeg(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_tiff(const std::string& path, ReadSpec& spec, bool& claimed);
 std::unique_ptr<NativeReader> open_exr(const std::string& path, ReadSpec& spec, std::string& error);
+std::unique_ptr<NativeReader> open_pnm(const std::string& path, ReadSpec& spec, std::string& error);
 
 }  // namespace qdmr::imageio

@@ -144,9 +144,7 @@ private:
 }  // namespace
 
 std::unique_ptr<NativeReader> open_png(const std::string& path, ReadSpec& spec, std::string& error) {
-  auto reader = std::make_unique<PngReader>();
-  if (!reader->open(path, spec, error)) return nullptr;
-  return reader;
+  return opened<PngReader>(path, spec, error);
 }
 
 }  // namespace qdmr::imageio

@@ -204,9 +204,7 @@ private:
 }  // namespace
 
 std::unique_ptr<NativeReader> open_tiff(const std::string& path, ReadSpec& spec, bool& claimed) {
-  auto reader = std::make_unique<TiffReader>();
-  if (!reader->open(path, spec, claimed)) return nullptr;
-  return reader;
+  return opened<TiffReader>(path, spec, claimed);
 }
 
 }  // namespace qdmr::imageio

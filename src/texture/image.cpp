@@ -35,15 +35,17 @@ std::string bytes_of(const std::filesystem::path& file, std::int64_t offset, std
   return out;
 }
 
-// PGM/PPM/PBM: OpenImageIO takes a maxval of 0 or a pixel array shorter than the header promises without an
-// error. Returns what is wrong, or "".
+// PBM/PGM/PPM (and PFM): the header's fields and the pixel data's length, checked before a reader opens the file
+// (OpenImageIO's PFM reader takes a pixel array shorter than the header promises without an error). Returns what
+// is wrong, or "".
 std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   const std::string head = bytes_of(file, 0, 4096);
   std::size_t at = 2;
   std::vector<std::uint64_t> fields;
   const char magic = head.size() > 1 ? head[1] : '?';
   const bool bitmap = magic == '1' || magic == '4';
-  const std::size_t wanted = bitmap ? 2 : 3;
+  const bool floats = magic == 'f' || magic == 'F';  // PFM: width, height, then a scale whose sign is the byte order
+  const std::size_t wanted = bitmap || floats ? 2 : 3;
   while (fields.size() < wanted) {
     while (at < head.size() && (std::isspace(static_cast<unsigned char>(head[at])) || head[at] == '#')) {
       if (head[at] == '#')
@@ -56,6 +58,14 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
     while (at < head.size() && std::isdigit(static_cast<unsigned char>(head[at])) && v < (1ull << 40))
       v = v * 10 + std::uint64_t(head[at++] - '0');
     fields.push_back(v);
+  }
+  if (floats) {
+    while (at < head.size() && std::isspace(static_cast<unsigned char>(head[at]))) ++at;
+    const std::size_t scale = at;
+    while (at < head.size() && std::string_view("+-.0123456789eE").find(head[at]) != std::string_view::npos) ++at;
+    if (at == scale || at >= head.size() || !std::isspace(static_cast<unsigned char>(head[at])))
+      return "PFM header is malformed (no scale)";
+    fields.push_back(1);  // stands for the maxval below
   }
   if (fields[0] == 0 || fields[1] == 0) return "PNM size " + std::to_string(fields[0]) + "x" + std::to_string(fields[1]) + " is empty";
   if (!bitmap && (fields[2] == 0 || fields[2] > 65535))
@@ -74,10 +84,10 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
              std::to_string(least) + " bytes at least, the file has " + std::to_string(room);
   }
   // Binary variants: exactly one whitespace byte after the header, then the pixels.
-  if (magic == '4' || magic == '5' || magic == '6') {
-    const std::uint64_t channels = magic == '6' ? 3 : 1;
-    const std::uint64_t bytes = magic == '4' ? (fields[0] + 7) / 8 * fields[1]
-                                             : fields[0] * fields[1] * channels * (fields[2] > 255 ? 2 : 1);
+  if (magic == '4' || magic == '5' || magic == '6' || floats) {
+    const std::uint64_t channels = magic == '6' || magic == 'F' ? 3 : 1;
+    const std::uint64_t sample = floats ? 4 : fields[2] > 255 ? 2 : 1;
+    const std::uint64_t bytes = magic == '4' ? (fields[0] + 7) / 8 * fields[1] : fields[0] * fields[1] * channels * sample;
     if (size < at + 1 + bytes)
       return "truncated: the header promises " + std::to_string(bytes) + " bytes of pixels, the file has " +
              std::to_string(size > at + 1 ? size - at - 1 : 0);
@@ -267,6 +277,10 @@ std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& fil
     if (const std::string problem = check_exr(file, size); !problem.empty()) throw fail(problem);
   if (bytes_of(file, 0, 8) == "\x89PNG\r\n\x1A\n")
     if (const std::string problem = check_png_chunks(file, size); !problem.empty()) throw fail(problem);
+  // PBM, PGM, PPM and PFM: the header's fields and the pixel data's length.
+  if (const std::string magic = bytes_of(file, 0, 2);
+      magic.size() == 2 && magic[0] == 'P' && std::string_view("123456fF").find(magic[1]) != std::string_view::npos)
+    if (const std::string problem = check_pnm(file, size); !problem.empty()) throw fail(problem);
   std::string error;
   auto in = std::make_unique<imageio::ReadFile>(file.string(), error);
   if (!*in) throw fail(error);
@@ -274,8 +288,6 @@ std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& fil
   const std::string& format = spec.format;
   if (std::find(std::begin(kFormats), std::end(kFormats), format) == std::end(kFormats))
     throw fail("unsupported image format '" + format + "' (textures are PNG, JPEG, OpenEXR, TIFF or PGM/PPM)");
-  if (format == "pnm")
-    if (const std::string problem = check_pnm(file, size); !problem.empty()) throw fail(problem);
   // A JPEG ends with the EOI marker FF D9 (which cannot occur inside entropy-coded data); libjpeg pads a
   // truncated file with grey and only warns.
   if (format == "jpeg" && bytes_of(file, -std::int64_t(std::min<std::uint64_t>(size, 64)), 64).find("\xFF\xD9") ==

@@ -57,8 +57,8 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
-  // PNG, JPEG, OpenEXR and TIFF (of the layouts OpenImageIO passes through) textures are read in process
-  // (imageio/native_reader.hpp): planned and rendered without the module. A PGM texture needs it, and says so.
+  // PNG, JPEG, OpenEXR, PGM and TIFF (of the layouts OpenImageIO passes through) textures are read in process
+  // (imageio/native_reader.hpp): planned and rendered without the module. A PFM texture needs it, and says so.
   const std::filesystem::path images = source_dir() / "tests/bad_inputs/files/images";
   const auto albedo = [&](const char* file) { return "/materials/bricks/layers/0/albedo=" + (images / file).string(); };
   for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr"}) {
@@ -72,9 +72,14 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   const CommandResult pgm = run(cli(), {"render", plane, "-o", (dir / "pgm.png").string(), "--width", "32",
                                         "--height", "18", "--set",
                                         "/materials/bricks/layers/0/albedo=" + (dir / "t.pgm").string()});
-  EXPECT_EQ(pgm.exit_code, 2) << pgm.output;
-  EXPECT_NE(pgm.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << pgm.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "pgm.png"));
+  EXPECT_EQ(pgm.exit_code, 0) << pgm.output;
+  write_file(dir / "t.pfm", "Pf\n4 4\n-1.0\n" + std::string(64, char(0)));
+  const CommandResult pfm = run(cli(), {"render", plane, "-o", (dir / "pfm.png").string(), "--width", "32",
+                                        "--height", "18", "--set",
+                                        "/materials/bricks/layers/0/albedo=" + (dir / "t.pfm").string()});
+  EXPECT_EQ(pfm.exit_code, 2) << pfm.output;
+  EXPECT_NE(pfm.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << pfm.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "pfm.png"));
 }
 
 // The PNG written without the module holds what qdmr means to write: every byte the sRGB code of the linear

@@ -202,9 +202,9 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
       EXPECT_GT(cones.working_bytes, 4 * cones.bytes);  // the grid of doubles alone is 4 times the map
       EXPECT_EQ(field_plan.working_bytes, 0u);
       EXPECT_EQ(plan.working_bytes, cones.working_bytes);
-      EXPECT_EQ(plan.image_module_bytes, kImageModuleBytes);  // h.pgm is read
+      EXPECT_EQ(plan.image_module_bytes, 0u);  // h.pgm is read in process
       EXPECT_EQ(plan.total_bytes(), plan.framebuffer_bytes + plan.texture_bytes + plan.mesh_bytes + plan.derived_bytes +
-                                        cones.working_bytes + kImageModuleBytes);
+                                        cones.working_bytes);
       // And --max-memory is checked against it: refused one byte short, before anything is built.
       RenderOptions tight;
       tight.max_memory_bytes = plan.total_bytes() - 1;
@@ -214,11 +214,11 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
 
 // The image library's own memory (kImageModuleBytes, measured by bench/image_module_memory.sh) is counted when,
 // and only when, building the frame reads an image file through it: an albedo, a height behind from_height normals,
-// a grid's height map or a weight map, each a PNM file (or a TIFF OpenImageIO converts); procedural and constant
-// textures and PNG, JPEG, OpenEXR and TIFF files (read in process) load no library.
+// a grid's height map or a weight map, each a PFM file (or a TIFF OpenImageIO converts); procedural and constant
+// textures and PNG, JPEG, OpenEXR, PGM and TIFF files (read in process) load no library.
 TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
   TempDir dir;
-  write_file(dir / "t.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
+  write_file(dir / "t.pfm", "Pf\n4 4\n-1.0\n" + std::string(64, char(0)));
   const auto plan_with = [&](const std::string& material, const std::string& mesh) {
     write_file(dir / "scene.json", R"({"output": {"width": 16, "height": 16},
   "camera": {"position": [0, -2, 1.5], "target": [0, 0, 0], "up": [0, 0, 1]},
@@ -235,13 +235,13 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
   EXPECT_EQ(none.total_bytes(), none.framebuffer_bytes + none.texture_bytes + none.mesh_bytes + none.derived_bytes +
                                     none.working_bytes);
   for (const auto& [material, mesh] : std::vector<std::pair<std::string, std::string>>{
-           {R"({"layers": [{"albedo": "t.pgm"}]})", plane},
-           {R"({"layers": [{"albedo": {"constant": 0.5}, "height": "t.pgm", "normal": "from_height"}]})", plane},
+           {R"({"layers": [{"albedo": "t.pfm"}]})", plane},
+           {R"({"layers": [{"albedo": {"constant": 0.5}, "height": "t.pfm", "normal": "from_height"}]})", plane},
            {R"({"layers": [{"albedo": {"constant": 0.5}}]})",
-            R"({"type": "grid", "size": [2, 2], "resolution": 4, "height": 0.1, "height_map": "t.pgm"})"},
+            R"({"type": "grid", "size": [2, 2], "resolution": 4, "height": 0.1, "height_map": "t.pfm"})"},
            {R"({"layers": [{"albedo": {"constant": 0.2}, "height": {"procedural": "cobbles", "size": 16}},
                            {"albedo": {"constant": 0.8}, "height": {"procedural": "bricks", "size": 16}}],
-               "blend": {"weights": {"source": "file", "file": "t.pgm"}}})", plane}}) {
+               "blend": {"weights": {"source": "file", "file": "t.pfm"}}})", plane}}) {
     SCOPED_TRACE(material + " on " + mesh);
     const FramePlan plan = plan_with(material, mesh);
     EXPECT_EQ(plan.image_module_bytes, kImageModuleBytes);
@@ -250,10 +250,12 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
     EXPECT_NE(plan.describe().find("image library 48.00 MiB (to read image files)"), std::string::npos)
         << plan.describe();
   }
-  // PNG, JPEG, OpenEXR and TIFF files are read in process (imageio/native_reader.hpp): no image library to count.
+  // PNG, JPEG, OpenEXR, PGM and TIFF files are read in process (imageio/native_reader.hpp): no image library to
+  // count.
   const std::filesystem::path images = std::filesystem::path(QDMR_SOURCE_DIR) / "tests/bad_inputs/files/images";
-  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr"}) {
-    std::filesystem::copy_file(images / file, dir / file);
+  write_file(dir / "grey.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
+  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr", "grey.pgm"}) {
+    if (!std::filesystem::exists(dir / file)) std::filesystem::copy_file(images / file, dir / file);
     const FramePlan plan = plan_with(std::string(R"({"layers": [{"albedo": ")") + file + R"("}]})", plane);
     EXPECT_EQ(plan.image_module_bytes, 0u) << file;
     EXPECT_EQ(plan.describe().find("image library"), std::string::npos) << plan.describe();

@@ -8,7 +8,7 @@
 // differences. See docs/checks.md.
 namespace qdmr {
 
-inline constexpr int kBitsVersion = 5;
+inline constexpr int kBitsVersion = 6;
 
 const char* version();  // "0.1.0", the project version of CMakeLists.txt
 

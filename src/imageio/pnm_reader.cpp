@@ -1,0 +1,205 @@
+// A PBM, PGM or PPM file (P1 to P6) read as Netpbm defines it: a header of whitespace-separated decimal fields with
+// comments from '#' to the end of a line, one whitespace byte, then the samples, big-endian when maxval > 255. A
+// sample k stands for k / maxval, kept as stored when maxval is 255 or 65535 (8- and 16-bit samples) and given as
+// that value correctly rounded to a float for any other maxval; a sample above maxval counts as maxval. A bitmap's
+// 1 is black: 0, and its 0 white: 255.
+//
+// Where this differs from OpenImageIO 2.4's reader (pnm.imageio/pnminput.cpp), which read these files before:
+// that reader scaled k to k · (2^b - 1) / maxval in int arithmetic, which truncates (maxval 100: 1 became 2/255)
+// and overflows from k = 32769 on (16-bit samples above 32768 came out one lower: 65535 as 65534), and it read
+// a plain PBM's "0110" as one sample. The float maps (PFM, "Pf" and "PF") are left to it.
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "imageio/native_reader.hpp"
+#include "imageio/pixel_conversion.hpp"
+
+namespace qdmr::imageio {
+namespace {
+
+constexpr std::uint64_t kMaxField = std::uint64_t(1) << 31;  // larger sizes are refused later by every caller
+
+class PnmReader final : public NativeReader {
+public:
+  ~PnmReader() override {
+    if (file_) std::fclose(file_);
+  }
+
+  bool open(const std::string& path, ReadSpec& spec, std::string& error) {
+    file_ = std::fopen(path.c_str(), "rb");
+    if (!file_) {
+      error = "cannot open the file";
+      return false;
+    }
+    char magic[2] = {};
+    if (std::fread(magic, 1, 2, file_) != 2 || magic[0] != 'P' || magic[1] < '1' || magic[1] > '6') {
+      error = "not a PBM, PGM or PPM file";
+      return false;
+    }
+    kind_ = magic[1] - '0';
+    const bool bitmap = kind_ == 1 || kind_ == 4;
+    std::uint64_t width = 0, height = 0, maxval = 1;
+    if (!header_field(width) || !header_field(height) || (!bitmap && !header_field(maxval))) {
+      error = "PNM header is malformed";
+      return false;
+    }
+    // Exactly one whitespace byte ends the header (read with the last field's end).
+    if (!std::isspace(last_)) {
+      error = "PNM header is malformed (no whitespace after its last field)";
+      return false;
+    }
+    if (width == 0 || height == 0 || width > kMaxField || height > kMaxField || maxval == 0 || maxval > 65535) {
+      error = "PNM header fields out of range (" + std::to_string(width) + "x" + std::to_string(height) +
+              ", maxval " + std::to_string(maxval) + ")";
+      return false;
+    }
+    width_ = width;
+    height_ = height;
+    maxval_ = std::uint32_t(maxval);
+    channels_ = kind_ == 3 || kind_ == 6 ? 3 : 1;
+    stored_ = bitmap || maxval_ == 255 ? PixelType::UInt8 : maxval_ == 65535 ? PixelType::UInt16 : PixelType::Float;
+    spec.width = int(width_);
+    spec.height = int(height_);
+    spec.depth = 1;
+    spec.channels = int(channels_);
+    spec.format = "pnm";
+    spec.uniform = true;
+    spec.type = stored_;
+    return true;
+  }
+
+  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
+    if (read_) {
+      error = "the PNM file was read already";
+      return false;
+    }
+    read_ = true;
+    if (type != stored_ && stored_ == PixelType::Float) {
+      error = "a PNM file of maxval " + std::to_string(maxval_) + " is read as floats only";
+      return false;
+    }
+    const std::size_t values = std::size_t(width_) * channels_;
+    std::vector<std::uint32_t> samples(values);  // one row's k, clamped to maxval
+    const std::size_t stored_size = stored_ == PixelType::UInt8 ? 1 : stored_ == PixelType::UInt16 ? 2 : 4;
+    std::vector<unsigned char> row(values * stored_size);
+    std::vector<unsigned char> raw;
+    for (std::uint64_t y = 0; y < height_; ++y) {
+      if (!read_row(samples, raw, error)) {
+        if (error.empty()) error = "truncated PNM pixel data (row " + std::to_string(y) + " of " + std::to_string(height_) + ")";
+        return false;
+      }
+      for (std::size_t i = 0; i < values; ++i) {
+        const std::uint32_t k = samples[i];
+        if (kind_ == 1 || kind_ == 4) {
+          row[i] = k ? 0 : 255;
+        } else if (stored_ == PixelType::UInt8) {
+          row[i] = std::uint8_t(k);
+        } else if (stored_ == PixelType::UInt16) {
+          const auto sample = std::uint16_t(k);
+          std::memcpy(row.data() + 2 * i, &sample, 2);
+        } else {
+          const float value = float(k) / float(maxval_);  // both exact in float: one correctly rounded division
+          std::memcpy(row.data() + 4 * i, &value, 4);
+        }
+      }
+      void* out = static_cast<char*>(first_row) + row_stride * std::ptrdiff_t(y);
+      if (type == stored_)
+        std::memcpy(out, row.data(), row.size());
+      else
+        convert_values(stored_, row.data(), type, out, values);
+    }
+    return true;
+  }
+
+private:
+  // The next byte of the file, or EOF.
+  int next() { return last_ = std::getc(file_); }
+
+  // Skips whitespace and comments; the first byte of what follows is in last_ (EOF at the end).
+  void skip_separators() {
+    next();
+    while (last_ != EOF && (std::isspace(last_) || last_ == '#')) {
+      if (last_ == '#')
+        while (last_ != EOF && last_ != '\n') next();
+      else
+        next();
+    }
+  }
+
+  // A decimal field of the header (leading whitespace and comments skipped); false when there is none. Reads one
+  // byte past it, into last_.
+  bool header_field(std::uint64_t& value) {
+    skip_separators();
+    if (last_ == EOF || !std::isdigit(last_)) return false;
+    value = 0;
+    for (; last_ != EOF && std::isdigit(last_); next())
+      if (value <= kMaxField) value = value * 10 + std::uint64_t(last_ - '0');
+    return true;
+  }
+
+  // One row's samples as numbers k (clamped to maxval; a bitmap's bits), from the plain (P1-P3) or binary (P4-P6)
+  // encoding. False with `error` set for malformed plain data, false alone when the file ends first.
+  bool read_row(std::vector<std::uint32_t>& samples, std::vector<unsigned char>& raw, std::string& error) {
+    const std::size_t values = samples.size();
+    if (kind_ == 4) {
+      raw.resize((width_ + 7) / 8);
+      if (std::fread(raw.data(), 1, raw.size(), file_) != raw.size()) return false;
+      for (std::size_t i = 0; i < values; ++i) samples[i] = (raw[i / 8] >> (7 - i % 8)) & 1u;
+      return true;
+    }
+    if (kind_ >= 5) {
+      const std::size_t bytes = maxval_ > 255 ? 2 : 1;
+      raw.resize(values * bytes);
+      if (std::fread(raw.data(), 1, raw.size(), file_) != raw.size()) return false;
+      for (std::size_t i = 0; i < values; ++i) {
+        const std::uint32_t k = bytes == 2 ? std::uint32_t(raw[2 * i]) << 8 | raw[2 * i + 1] : raw[i];
+        samples[i] = std::min(k, maxval_);
+      }
+      return true;
+    }
+    for (std::size_t i = 0; i < values; ++i) {
+      skip_separators();
+      if (last_ == EOF) return false;
+      if (!std::isdigit(last_)) {
+        error = "PNM pixel data is malformed (a byte " + std::to_string(last_) + " where a sample was expected)";
+        return false;
+      }
+      if (kind_ == 1) {  // every 0 or 1 is a pixel of its own, with or without whitespace between them
+        samples[i] = last_ == '1' ? 1 : 0;
+        if (last_ > '1') {
+          error = "PBM pixel data is malformed (a '" + std::string(1, char(last_)) + "' where 0 or 1 was expected)";
+          return false;
+        }
+        continue;
+      }
+      std::uint64_t k = 0;
+      for (; last_ != EOF && std::isdigit(last_); next())
+        if (k <= maxval_) k = k * 10 + std::uint64_t(last_ - '0');
+      samples[i] = std::uint32_t(std::min<std::uint64_t>(k, maxval_));
+      if (last_ != EOF) std::ungetc(last_, file_);  // the separator is read again by the next sample's skip
+    }
+    return true;
+  }
+
+  std::FILE* file_ = nullptr;
+  int last_ = 0;  // the byte read last
+  int kind_ = 0;  // the N of "PN"
+  std::uint64_t width_ = 0, height_ = 0;
+  std::uint32_t maxval_ = 1, channels_ = 1;
+  PixelType stored_ = PixelType::UInt8;
+  bool read_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<NativeReader> open_pnm(const std::string& path, ReadSpec& spec, std::string& error) {
+  return opened<PnmReader>(path, spec, error);
+}
+
+}  // namespace qdmr::imageio
