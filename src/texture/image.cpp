@@ -86,7 +86,7 @@ std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   // Binary variants: exactly one whitespace byte after the header, then the pixels.
   if (magic == '4' || magic == '5' || magic == '6' || floats) {
     const std::uint64_t channels = magic == '6' || magic == 'F' ? 3 : 1;
-    const std::uint64_t sample = floats ? 4 : fields[2] > 255 ? 2 : 1;
+    const std::uint64_t sample = floats ? 4 : bitmap || fields[2] <= 255 ? 1 : 2;  // a bitmap has no maxval
     const std::uint64_t bytes = magic == '4' ? (fields[0] + 7) / 8 * fields[1] : fields[0] * fields[1] * channels * sample;
     if (size < at + 1 + bytes)
       return "truncated: the header promises " + std::to_string(bytes) + " bytes of pixels, the file has " +
