@@ -1,7 +1,7 @@
 #pragma once
 // Image files go through one narrow interface to OpenImageIO, so that the `qdmr` command can load OpenImageIO
 // (and the ~260 shared libraries it pulls in, about 0.3 s of dynamic linking) only when a job reads or writes an
-// image that qdmr does not handle itself: PNG, JPEG, OpenEXR and most TIFF are read in process
+// image that qdmr does not handle itself: PNG, JPEG, OpenEXR, PBM/PGM/PPM and most TIFF are read in process
 // (imageio/native_reader.hpp), PNG written so too (io/png_writer.hpp). The library and the tests link the backend
 // directly (imageio/direct.cpp); the command loads it from libqdmr_imageio.so on first use (imageio/lazy.cpp).
 // Both run the same code (imageio/oiio_backend.cpp).
@@ -55,8 +55,8 @@ const Backend& oiio_backend();
 
 class NativeReader;  // imageio/native_reader.hpp
 
-// An open file, closed when it goes: a PNG, JPEG, OpenEXR or TIFF read by the native readers
-// (imageio/native_reader.hpp), any other file by the backend, loaded only then.
+// An open file, closed when it goes: one the native readers claim (imageio/native_reader.hpp) read by them, any
+// other file by the backend, loaded only then.
 class ReadFile {
 public:
   // Not open (and `error` set) when the file cannot be opened.

@@ -47,12 +47,11 @@ bool open_file(std::unique_ptr<OIIO::ImageInput> input, const std::string& path,
   return true;
 }
 
-// The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads
-// textures from that it does not read itself (PNG, JPEG, OpenEXR and the TIFF layouts it reads never get here:
-// imageio/read_file.cpp), each of which
-// checks the magic number first (valid_file). OpenImageIO's own fallback
-// (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file:
-// each a decoder run on an untrusted file for a format qdmr refuses anyway, and a few milliseconds.
+// The reader of the file's extension, then, for a file it does not open, the readers of the formats qdmr reads textures
+// from that it does not read itself (PNG, JPEG, OpenEXR, PBM/PGM/PPM and the TIFF layouts it reads never get here:
+// imageio/read_file.cpp), each of which checks the magic number first (valid_file). OpenImageIO's own fallback
+// (ImageInput::open) tries every reader it has, ~30 of them (LibRaw, FFmpeg, DICOM, ...), on any damaged file: each a
+// decoder run on an untrusted file for a format qdmr refuses anyway, and a few milliseconds.
 bool open_input(const std::string& path, Reader& reader, std::string& error) {
   // OpenImageIO's "extension_list": "tiff:tif,tiff;jpeg:jpg,jpe,jpeg;..." (every reader's and writer's).
   static const std::map<std::string, std::string> formats = [] {
