@@ -514,7 +514,7 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
 }
 
 // Whether building the frame reads an image file through the image module (the `qdmr` command then loads it):
-// PNG, JPEG, OpenEXR and most TIFF files are read in process (imageio/native_reader.hpp).
+// PNG, JPEG, OpenEXR, PBM/PGM/PPM and most TIFF files are read in process (imageio/native_reader.hpp).
 bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
   const auto through_module = [](const TextureDesc& d) {
     return d.source == TextureSource::File && !imageio::read_natively(d.file.string());

@@ -36,8 +36,8 @@ std::string bytes_of(const std::filesystem::path& file, std::int64_t offset, std
 }
 
 // PBM/PGM/PPM (and PFM): the header's fields and the pixel data's length, checked before a reader opens the file
-// (OpenImageIO's PFM reader takes a pixel array shorter than the header promises without an error). Returns what
-// is wrong, or "".
+// (OpenImageIO's PFM reader stops on a pixel array shorter than the header promises without saying why). Returns
+// what is wrong, or "".
 std::string check_pnm(const std::filesystem::path& file, std::uint64_t size) {
   const std::string head = bytes_of(file, 0, 4096);
   std::size_t at = 2;

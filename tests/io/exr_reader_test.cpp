@@ -1,14 +1,17 @@
 // imageio/exr_reader.cpp: an OpenEXR file read by the OpenEXR library in process gives what OpenImageIO's reader
 // gives: the same size, channels in the same order, every sample's bits as floats, and the Software and
 // qdmr:bits_version attributes, over scanline and tiled files, every compression, half, float and 32-bit integer
-// channels (mixed too), layers, data windows away from the origin and multi-part files; what OpenImageIO refuses
-// (subsampled channels) and damaged files fail in both.
+// channels (mixed too), layers, data windows away from the origin, MIP-mapped and multi-part files; what OpenImageIO
+// refuses (subsampled channels) and damaged files fail in both, and deep data is refused.
 #include <gtest/gtest.h>
 
 #include <ImfChannelList.h>
+#include <ImfDeepFrameBuffer.h>
+#include <ImfDeepScanLineOutputFile.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
+#include <ImfPartType.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -39,6 +42,7 @@ struct ExrLayout {
   int x = 0, y = 0;  // the data window's corner
   std::vector<std::pair<std::string, std::string>> strings = {};
   int parts = 1;
+  bool mipmapped = false;  // tiled, with every MIP level (level 0 is the image; the others other samples)
 };
 
 // Samples from a hash, written as floats and 32-bit integers (OpenImageIO stores them as each channel's type):
@@ -58,6 +62,7 @@ void write_exr_file(const fs::path& file, const ExrLayout& layout) {
     spec.tile_width = layout.tile;
     spec.tile_height = layout.tile;
   }
+  if (layout.mipmapped) spec.attribute("textureformat", "Plain Texture");  // OpenImageIO then writes MIP levels
   for (const auto& [name, value] : layout.strings) spec.attribute(name, value);
   const std::size_t channels = layout.channels.size();
   const std::size_t pixel = 4 * channels;  // every sample 4 bytes: a float or a 32-bit integer
@@ -114,6 +119,18 @@ void write_exr_file(const fs::path& file, const ExrLayout& layout) {
       ASSERT_TRUE(out->write_image(OIIO::TypeUnknown, native.data())) << out->geterror();
     }
   }
+  // The smaller levels, as OpenEXR rounds them down (18x11, 9x5, 4x2, 2x1, 1x1), each from the end of the
+  // samples: not level 0's.
+  for (int width = kWidth, height = kHeight; layout.mipmapped && (width > 1 || height > 1);) {
+    width = std::max(1, width / 2);
+    height = std::max(1, height / 2);
+    OIIO::ImageSpec level = spec;
+    level.width = level.full_width = width;
+    level.height = level.full_height = height;
+    ASSERT_TRUE(out->open(file.string(), level, OIIO::ImageOutput::AppendMIPLevel)) << out->geterror();
+    ASSERT_TRUE(out->write_image(buffer_types[0], pixels.data() + pixels.size() - pixel * std::size_t(width * height)))
+        << out->geterror();
+  }
   ASSERT_TRUE(out->close());
 }
 
@@ -135,6 +152,7 @@ TEST(ExrReader, FilesReadAsOpenImageIOReadsThem) {
       {"metadata", {"R", "G", "B"}, {kFloat}, "zip", 0, 0, 0,
        {{"Software", "qdmr 0.1.0"}, {"qdmr:bits_version", "5"}}},
       {"two_parts", {"R", "G", "B"}, {kHalf}, "zip", 0, 0, 0, {}, 2},
+      {"mipmapped", {"R", "G", "B", "A"}, {kHalf}, "zip", 16, 0, 0, {}, 1, true},
   };
   TempDir dir;
   int compared = 0;
@@ -142,6 +160,11 @@ TEST(ExrReader, FilesReadAsOpenImageIOReadsThem) {
     SCOPED_TRACE(layout.name);
     const fs::path file = dir / (std::string(layout.name) + ".exr");
     write_exr_file(file, layout);
+    if (layout.mipmapped) {  // the file has the levels the test is about
+      auto in = OIIO::ImageInput::open(file.string());
+      ASSERT_TRUE(in && in->seek_subimage(0, 5)) << "no sixth MIP level";
+      EXPECT_EQ(in->spec().width, 1);
+    }
     EXPECT_TRUE(imageio::read_natively(file.string()));
     expect_same_as_oiio(file);
     ++compared;
@@ -161,6 +184,26 @@ void write_subsampled_exr(const fs::path& file) {
   Imf::OutputFile out(file.string().c_str(), header);
   out.setFrameBuffer(frame);
   out.writePixels(kHeight + 1);
+}
+
+// Deep data, one Z sample in every pixel of a 4x4 scanline file.
+void write_deep_exr(const fs::path& file) {
+  Imf::Header header(4, 4);
+  header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+  header.setType(Imf::DEEPSCANLINE);
+  header.compression() = Imf::ZIPS_COMPRESSION;
+  std::vector<unsigned int> counts(16, 1);
+  std::vector<float> z(16, 1.0f);
+  std::vector<float*> samples(16);
+  for (std::size_t i = 0; i < 16; ++i) samples[i] = &z[i];
+  Imf::DeepFrameBuffer frame;
+  frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data()), sizeof(unsigned int),
+                                          4 * sizeof(unsigned int)));
+  frame.insert("Z", Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(samples.data()), sizeof(float*),
+                                   4 * sizeof(float*), sizeof(float)));
+  Imf::DeepScanLineOutputFile out(file.string().c_str(), header);
+  out.setFrameBuffer(frame);
+  out.writePixels(4);
 }
 
 // What OpenImageIO refuses (subsampled channels) and damaged files (cut in half; pixel data overwritten) fail in
@@ -191,6 +234,11 @@ TEST(ExrReader, RefusedAndDamagedFilesFailInBothReaders) {
   EXPECT_NE(error.find("subsampled OpenEXR channels are not supported (channel 'C' has sampling 2,2)"),
             std::string::npos)
       << error;
+  // Deep data is not an image of one value per channel and pixel: refused, not flattened.
+  write_deep_exr(dir / "deep.exr");
+  error.clear();
+  EXPECT_FALSE(read_natively(dir / "deep.exr", native, error));
+  EXPECT_NE(error.find("deep"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -130,7 +130,7 @@ struct FramePlan {
   // (derived data is built one item at a time, after the textures). Counted on top of everything kept.
   std::uint64_t working_bytes = 0;
   // kImageModuleBytes when building the frame reads an image file (a texture, height or weight map) through the
-  // image module (a PNM file or a TIFF OpenImageIO converts; the others are read in process), else 0.
+  // image module (a PFM file or a TIFF OpenImageIO converts; the others are read in process), else 0.
   std::uint64_t image_module_bytes = 0;
   // The estimate --max-memory is checked against: everything kept, plus the most working memory held at once.
   std::uint64_t total_bytes() const {
