@@ -105,14 +105,9 @@ public:
         error = "the OpenEXR data window is empty or too large";
         return false;
       }
-      spec.width = int(width_);
-      spec.height = int(height_);
-      spec.depth = 1;
-      spec.channels = int(channels_.size());
-      spec.format = "openexr";
-      spec.uniform = std::all_of(channels_.begin(), channels_.end(),
-                                 [&](const Channel& c) { return c.type == channels_[0].type; });
-      spec.type = PixelType::Float;
+      set_image(spec, int(width_), int(height_), int(channels_.size()), "openexr", PixelType::Float,
+                std::all_of(channels_.begin(), channels_.end(),
+                            [&](const Channel& c) { return c.type == channels_[0].type; }));
       for (auto it = header.begin(); it != header.end(); ++it) {
         const auto* text = dynamic_cast<const Imf::StringAttribute*>(&it.attribute());
         if (!text || text->value().empty()) continue;

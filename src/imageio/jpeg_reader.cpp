@@ -111,13 +111,8 @@ public:
               std::to_string(cinfo_.output_components);
       return false;
     }
-    spec.width = int(cinfo_.output_width);
-    spec.height = int(cinfo_.output_height);
-    spec.depth = 1;
-    spec.channels = cmyk_ ? 3 : cinfo_.num_components;
-    spec.format = "jpeg";
-    spec.uniform = true;
-    spec.type = PixelType::UInt8;
+    set_image(spec, int(cinfo_.output_width), int(cinfo_.output_height), cmyk_ ? 3 : cinfo_.num_components, "jpeg",
+              PixelType::UInt8);
     return true;
   }
 

@@ -39,6 +39,18 @@ std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spe
 // Whether open_native claims `path`: reading it loads no image module.
 bool read_natively(const std::string& path);
 
+// `spec` of a 2D image as a native reader found it (its metadata left as it was).
+inline void set_image(ReadSpec& spec, int width, int height, int channels, const char* format, PixelType type,
+                      bool uniform = true) {
+  spec.width = width;
+  spec.height = height;
+  spec.depth = 1;
+  spec.channels = channels;
+  spec.format = format;
+  spec.uniform = uniform;
+  spec.type = type;
+}
+
 // A new reader of type R, opened with `arguments`; null when its open() fails (having said why).
 template <class R, class... Arguments>
 std::unique_ptr<NativeReader> opened(Arguments&&... arguments) {

@@ -66,13 +66,7 @@ public:
       error = "PNG rows of an unexpected size";
       return false;
     }
-    spec.width = int(width_);
-    spec.height = int(height_);
-    spec.depth = 1;
-    spec.channels = channels_;
-    spec.format = "png";
-    spec.uniform = true;
-    spec.type = stored_type();
+    set_image(spec, int(width_), int(height_), channels_, "png", stored_type());
     // OpenImageIO's spec attributes are found case-insensitively, a later chunk replacing an earlier one.
     png_textp text = nullptr;
     const int texts = png_get_text(png_, info_, &text, nullptr);

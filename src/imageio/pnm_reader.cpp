@@ -64,13 +64,7 @@ public:
     maxval_ = std::uint32_t(maxval);
     channels_ = kind_ == 3 || kind_ == 6 ? 3 : 1;
     stored_ = bitmap || maxval_ == 255 ? PixelType::UInt8 : maxval_ == 65535 ? PixelType::UInt16 : PixelType::Float;
-    spec.width = int(width_);
-    spec.height = int(height_);
-    spec.depth = 1;
-    spec.channels = int(channels_);
-    spec.format = "pnm";
-    spec.uniform = true;
-    spec.type = stored_;
+    set_image(spec, int(width_), int(height_), int(channels_), "pnm", stored_);
     return true;
   }
 
@@ -91,7 +85,8 @@ public:
     std::vector<unsigned char> raw;
     for (std::uint64_t y = 0; y < height_; ++y) {
       if (!read_row(samples, raw, error)) {
-        if (error.empty()) error = "truncated PNM pixel data (row " + std::to_string(y) + " of " + std::to_string(height_) + ")";
+        if (error.empty())
+          error = "truncated PNM pixel data (row " + std::to_string(y) + " of " + std::to_string(height_) + ")";
         return false;
       }
       for (std::size_t i = 0; i < values; ++i) {

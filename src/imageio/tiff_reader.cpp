@@ -40,13 +40,8 @@ public:
     TIFFOpenOptionsFree(options);
     if (!tiff_ || !passes_through()) return false;
     claimed = true;
-    spec.width = int(width_);
-    spec.height = int(height_);
-    spec.depth = 1;
-    spec.channels = int(channels_);
-    spec.format = "tiff";
-    spec.uniform = true;  // libtiff keeps one SampleFormat and one BitsPerSample for every channel
-    spec.type = stored_;
+    // Uniform: libtiff keeps one SampleFormat and one BitsPerSample for every channel.
+    set_image(spec, int(width_), int(height_), int(channels_), "tiff", stored_);
     // OpenImageIO's TIFF writer keeps no metadata of its own names, so a "qdmr:bits_version" is never found.
     if (char* software = nullptr; TIFFGetField(tiff_, TIFFTAG_SOFTWARE, &software) == 1 && software)
       spec.software = software;
