@@ -12,7 +12,7 @@ enum class Signature { Png, Jpeg, Tiff, Exr, Pnm, Other };
 
 // The checks of OpenImageIO's readers (valid_file), so no PNG or JPEG ever reaches theirs: PNG's first seven
 // bytes (libpng then checks the eighth), JPEG's SOI marker; TIFF's byte order and version (42, or 43 for
-// BigTIFF); OpenEXR's magic number; "P1" to "P6" of PBM, PGM and PPM.
+// BigTIFF); OpenEXR's magic number; "P1" to "P6" of PBM, PGM and PPM, "Pf" and "PF" of PFM.
 Signature signature_of(const std::string& path) {
   unsigned char bytes[8] = {};
   std::size_t got = 0;
@@ -26,7 +26,8 @@ Signature signature_of(const std::string& path) {
                    (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43))))
     return Signature::Tiff;
   if (got >= 4 && bytes[0] == 0x76 && bytes[1] == 0x2F && bytes[2] == 0x31 && bytes[3] == 0x01) return Signature::Exr;
-  if (got >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') return Signature::Pnm;
+  if (got >= 2 && bytes[0] == 'P' && ((bytes[1] >= '1' && bytes[1] <= '6') || bytes[1] == 'f' || bytes[1] == 'F'))
+    return Signature::Pnm;
   return Signature::Other;
 }
 

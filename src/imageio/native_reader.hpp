@@ -1,10 +1,11 @@
 #pragma once
 // PNG, JPEG, OpenEXR and most TIFF files decoded in this process by libpng, libjpeg-turbo, OpenEXR and libtiff, the
-// libraries OpenImageIO's own readers call, in the same way: the same pixels, refusals and header; and PBM, PGM and
-// PPM files as Netpbm defines them (imageio/pnm_reader.cpp: where OpenImageIO's reader got them wrong). They are
-// the formats of textures, and reading them without OpenImageIO spares a job the loading of the image module (~260
-// shared libraries, 0.3-0.5 s: docs/performance.md). Every other file goes to the backend (imageio/backend.hpp):
-// PFM files, and the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says which).
+// libraries OpenImageIO's own readers call, in the same way: the same pixels, refusals and header; PBM, PGM and
+// PPM files as Netpbm defines them (imageio/pnm_reader.cpp: where OpenImageIO's reader got them wrong), and PFM
+// files as OpenImageIO read them. They are the formats of textures, and reading them without OpenImageIO spares a
+// job the loading of the image module (~260 shared libraries, 0.3-0.5 s: docs/performance.md). Every other file
+// goes to the backend (imageio/backend.hpp): the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says
+// which), and formats qdmr does not take as textures (refused after the backend names them).
 //
 // What OpenImageIO 2.4 does and these readers do too: libpng expands palettes, low bit depths and tRNS to 8-bit
 // channels (and alpha), 16-bit samples in host order, an interlaced file read whole, a JPEG's CMYK or YCCK
@@ -25,13 +26,13 @@ class NativeReader {
 public:
   virtual ~NativeReader() = default;
   // As Backend::read. `type` other than the file's own converts k to k / (2^bits - 1), correctly rounded; a file
-  // of float samples (a TIFF's, an OpenEXR file, a PNM file of a maxval other than 255 and 65535) is read as floats
-  // only.
+  // of float samples (a TIFF's, an OpenEXR file, a PFM file, a PNM file of a maxval other than 255 and 65535) is
+  // read as floats only.
   virtual bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) = 0;
 };
 
-// For a file that starts with PNG's, JPEG's, OpenEXR's or PBM/PGM/PPM's signature, or a TIFF that libtiff opens in
-// a layout OpenImageIO reads as stored: `claimed` is true, and the reader with `spec` filled in, or null with
+// For a file that starts with PNG's, JPEG's, OpenEXR's or PBM/PGM/PPM/PFM's signature, or a TIFF that libtiff opens
+// in a layout OpenImageIO reads as stored: `claimed` is true, and the reader with `spec` filled in, or null with
 // `error` set. For any other file `claimed` is false, `error` is left as it was and the backend is the file's
 // reader.
 std::unique_ptr<NativeReader> open_native(const std::string& path, ReadSpec& spec, std::string& error, bool& claimed);

@@ -7,9 +7,18 @@
 // Where this differs from OpenImageIO 2.4's reader (pnm.imageio/pnminput.cpp), which read these files before:
 // that reader scaled k to k · (2^b - 1) / maxval in int arithmetic, which truncates (maxval 100: 1 became 2/255)
 // and overflows from k = 32769 on (16-bit samples above 32768 came out one lower: 65535 as 65534), and it read
-// a plain PBM's "0110" as one sample. The float maps (PFM, "Pf" and "PF") are left to it.
+// a plain PBM's "0110" as one sample.
+//
+// And a PFM file ("Pf" grey, "PF" RGB) as that reader read it, which is the format as Netpbm describes it but for
+// the scale: a header of width, height and a nonzero scale whose sign gives the byte order (negative: little-endian),
+// then 32-bit float samples, rows from the bottom up. Every sample is multiplied by the scale's magnitude, as
+// OpenImageIO does (Netpbm leaves the scale's meaning to the reader; files are written with 1 or -1, where the
+// product is the sample itself, but for a signalling NaN, which comes out quiet). A scale of 0, which OpenImageIO
+// read as little-endian zeros, is refused.
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -38,17 +47,20 @@ public:
       return false;
     }
     char magic[2] = {};
-    if (std::fread(magic, 1, 2, file_) != 2 || magic[0] != 'P' || magic[1] < '1' || magic[1] > '6') {
-      error = "not a PBM, PGM or PPM file";
+    if (std::fread(magic, 1, 2, file_) != 2 || magic[0] != 'P' ||
+        !((magic[1] >= '1' && magic[1] <= '6') || magic[1] == 'f' || magic[1] == 'F')) {
+      error = "not a PBM, PGM, PPM or PFM file";
       return false;
     }
-    kind_ = magic[1] - '0';
+    floats_ = magic[1] == 'f' || magic[1] == 'F';
+    kind_ = floats_ ? 0 : magic[1] - '0';
     const bool bitmap = kind_ == 1 || kind_ == 4;
-    std::uint64_t width = 0, height = 0, maxval = 1;
-    if (!header_field(width) || !header_field(height) || (!bitmap && !header_field(maxval))) {
+    std::uint64_t width = 0, height = 0, maxval = floats_ ? 65535 : 1;  // a PFM has no maxval: any in range
+    if (!header_field(width) || !header_field(height) || (!bitmap && !floats_ && !header_field(maxval))) {
       error = "PNM header is malformed";
       return false;
     }
+    if (floats_ && !scale_field(error)) return false;
     // Exactly one whitespace byte ends the header (read with the last field's end).
     if (!std::isspace(last_)) {
       error = "PNM header is malformed (no whitespace after its last field)";
@@ -62,8 +74,11 @@ public:
     width_ = width;
     height_ = height;
     maxval_ = std::uint32_t(maxval);
-    channels_ = kind_ == 3 || kind_ == 6 ? 3 : 1;
-    stored_ = bitmap || maxval_ == 255 ? PixelType::UInt8 : maxval_ == 65535 ? PixelType::UInt16 : PixelType::Float;
+    channels_ = kind_ == 3 || kind_ == 6 || magic[1] == 'F' ? 3 : 1;
+    stored_ = floats_                        ? PixelType::Float
+              : bitmap || maxval_ == 255     ? PixelType::UInt8
+              : maxval_ == 65535             ? PixelType::UInt16
+                                             : PixelType::Float;
     set_image(spec, int(width_), int(height_), int(channels_), "pnm", stored_);
     return true;
   }
@@ -75,9 +90,11 @@ public:
     }
     read_ = true;
     if (type != stored_ && stored_ == PixelType::Float) {
-      error = "a PNM file of maxval " + std::to_string(maxval_) + " is read as floats only";
+      error = floats_ ? "a PFM file is read as floats only"
+                      : "a PNM file of maxval " + std::to_string(maxval_) + " is read as floats only";
       return false;
     }
+    if (floats_) return read_floats(first_row, row_stride, error);
     const std::size_t values = std::size_t(width_) * channels_;
     std::vector<std::uint32_t> samples(values);  // one row's k, clamped to maxval
     const std::size_t stored_size = stored_ == PixelType::UInt8 ? 1 : stored_ == PixelType::UInt16 ? 2 : 4;
@@ -113,6 +130,51 @@ public:
   }
 
 private:
+  // A PFM's rows: the file's first row is the image's last.
+  bool read_floats(void* first_row, std::ptrdiff_t row_stride, std::string& error) {
+    const std::size_t values = std::size_t(width_) * channels_;
+    std::vector<unsigned char> raw(values * 4);
+    for (std::uint64_t r = 0; r < height_; ++r) {
+      if (std::fread(raw.data(), 1, raw.size(), file_) != raw.size()) {
+        error = "truncated PFM pixel data (row " + std::to_string(r) + " of " + std::to_string(height_) +
+                " from the bottom)";
+        return false;
+      }
+      auto* out = reinterpret_cast<unsigned char*>(first_row) + row_stride * std::ptrdiff_t(height_ - 1 - r);
+      for (std::size_t i = 0; i < values; ++i) {
+        const unsigned char* b = raw.data() + 4 * i;
+        const std::uint32_t bits = little_endian_ ? std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
+                                                        std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24
+                                                  : std::uint32_t(b[3]) | std::uint32_t(b[2]) << 8 |
+                                                        std::uint32_t(b[1]) << 16 | std::uint32_t(b[0]) << 24;
+        float sample;
+        std::memcpy(&sample, &bits, 4);
+        const float value = scale_ * sample;
+        std::memcpy(out + 4 * i, &value, 4);
+      }
+    }
+    return true;
+  }
+
+  // A PFM's scale (leading whitespace and comments skipped, as for the other fields): a decimal number, not 0, whose
+  // sign is the byte order; scale_ keeps its magnitude. Reads one byte past it, into last_.
+  bool scale_field(std::string& error) {
+    skip_separators();
+    std::string text;
+    for (; last_ != EOF && !std::isspace(last_) && text.size() < 64; next()) text += char(last_);
+    const char* first = text.data() + (!text.empty() && text[0] == '+' ? 1 : 0);  // from_chars takes no '+'
+    float scale = 0.0f;
+    const auto [end, problem] = std::from_chars(first, text.data() + text.size(), scale);
+    if (text.empty() || problem != std::errc() || end != text.data() + text.size() || !std::isfinite(scale) ||
+        scale == 0.0f) {
+      error = "PFM header is malformed (its scale '" + text.substr(0, 24) + "' is not a finite nonzero number)";
+      return false;
+    }
+    little_endian_ = scale < 0.0f;
+    scale_ = std::fabs(scale);
+    return true;
+  }
+
   // The next byte of the file, or EOF.
   int next() { return last_ = std::getc(file_); }
 
@@ -184,7 +246,9 @@ private:
 
   std::FILE* file_ = nullptr;
   int last_ = 0;  // the byte read last
-  int kind_ = 0;  // the N of "PN"
+  int kind_ = 0;  // the N of "PN" (0: a PFM)
+  bool floats_ = false, little_endian_ = false;
+  float scale_ = 1.0f;  // a PFM's: its magnitude
   std::uint64_t width_ = 0, height_ = 0;
   std::uint32_t maxval_ = 1, channels_ = 1;
   PixelType stored_ = PixelType::UInt8;

@@ -147,6 +147,10 @@ images = [
     ("pbm_truncated.pbm", b"P4\n64 64\n" + bytes(10), "truncated"),
     ("pgm_huge.pgm", b"P5\n100000 100000\n255\n" + bytes(16), "outside 1..16384"),
     ("pgm_garbage_header.pgm", b"P5\nfoo bar\n255\n", "cannot read"),
+    ("pfm_zero_scale.pfm", b"Pf\n4 4\n0\n" + bytes(64), "its scale '0' is not a finite nonzero number"),
+    ("pfm_scale_overflows.pfm", b"Pf\n4 4\n-1e99\n" + bytes(64), "its scale '-1e99' is not a finite nonzero number"),
+    ("pfm_no_scale.pfm", b"PF\n4 4\n", "PFM header is malformed (no scale)"),
+    ("pfm_truncated.pfm", b"PF\n16 16\n-1.0\n" + bytes(16 * 16 * 12 - 1), "truncated"),
 ]
 for name, data, _ in images:
     if data is not None:

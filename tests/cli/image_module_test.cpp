@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli/cli_test_util.hpp"
+#include "support/converted_tiff.hpp"
 #include "imageio/backend.hpp"
 #include "qdmr/core/version.hpp"
 #include "write/srgb_encode.hpp"
@@ -57,8 +58,9 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
-  // PNG, JPEG, OpenEXR, PGM and TIFF (of the layouts OpenImageIO passes through) textures are read in process
-  // (imageio/native_reader.hpp): planned and rendered without the module. A PFM texture needs it, and says so.
+  // PNG, JPEG, OpenEXR, PGM, PFM and TIFF (of the layouts OpenImageIO passes through) textures are read in process
+  // (imageio/native_reader.hpp): planned and rendered without the module. A TIFF that OpenImageIO converts needs
+  // it, and says so.
   const std::filesystem::path images = source_dir() / "tests/bad_inputs/files/images";
   const auto albedo = [&](const char* file) { return "/materials/bricks/layers/0/albedo=" + (images / file).string(); };
   for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr"}) {
@@ -77,9 +79,14 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   const CommandResult pfm = run(cli(), {"render", plane, "-o", (dir / "pfm.png").string(), "--width", "32",
                                         "--height", "18", "--set",
                                         "/materials/bricks/layers/0/albedo=" + (dir / "t.pfm").string()});
-  EXPECT_EQ(pfm.exit_code, 2) << pfm.output;
-  EXPECT_NE(pfm.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << pfm.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "pfm.png"));
+  EXPECT_EQ(pfm.exit_code, 0) << pfm.output;
+  write_file(dir / "white.tif", min_is_white_tiff());
+  const CommandResult converted = run(cli(), {"render", plane, "-o", (dir / "white.png").string(), "--width", "32",
+                                              "--height", "18", "--set",
+                                              "/materials/bricks/layers/0/albedo=" + (dir / "white.tif").string()});
+  EXPECT_EQ(converted.exit_code, 2) << converted.output;
+  EXPECT_NE(converted.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << converted.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "white.png"));
 }
 
 // The PNG written without the module holds what qdmr means to write: every byte the sRGB code of the linear

@@ -20,6 +20,7 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
+#include "support/converted_tiff.hpp"
 #include "support/test_support.hpp"
 
 
@@ -214,11 +215,11 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
 
 // The image library's own memory (kImageModuleBytes, measured by bench/image_module_memory.sh) is counted when,
 // and only when, building the frame reads an image file through it: an albedo, a height behind from_height normals,
-// a grid's height map or a weight map, each a PFM file (or a TIFF OpenImageIO converts); procedural and constant
-// textures and PNG, JPEG, OpenEXR, PGM and TIFF files (read in process) load no library.
+// a grid's height map or a weight map, each a TIFF that OpenImageIO converts (min is white); procedural and constant
+// textures and PNG, JPEG, OpenEXR, PGM, PFM and other TIFF files (read in process) load no library.
 TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
   TempDir dir;
-  write_file(dir / "t.pfm", "Pf\n4 4\n-1.0\n" + std::string(64, char(0)));
+  write_file(dir / "t.tif", min_is_white_tiff());
   const auto plan_with = [&](const std::string& material, const std::string& mesh) {
     write_file(dir / "scene.json", R"({"output": {"width": 16, "height": 16},
   "camera": {"position": [0, -2, 1.5], "target": [0, 0, 0], "up": [0, 0, 1]},
@@ -235,13 +236,13 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
   EXPECT_EQ(none.total_bytes(), none.framebuffer_bytes + none.texture_bytes + none.mesh_bytes + none.derived_bytes +
                                     none.working_bytes);
   for (const auto& [material, mesh] : std::vector<std::pair<std::string, std::string>>{
-           {R"({"layers": [{"albedo": "t.pfm"}]})", plane},
-           {R"({"layers": [{"albedo": {"constant": 0.5}, "height": "t.pfm", "normal": "from_height"}]})", plane},
+           {R"({"layers": [{"albedo": "t.tif"}]})", plane},
+           {R"({"layers": [{"albedo": {"constant": 0.5}, "height": "t.tif", "normal": "from_height"}]})", plane},
            {R"({"layers": [{"albedo": {"constant": 0.5}}]})",
-            R"({"type": "grid", "size": [2, 2], "resolution": 4, "height": 0.1, "height_map": "t.pfm"})"},
+            R"({"type": "grid", "size": [2, 2], "resolution": 4, "height": 0.1, "height_map": "t.tif"})"},
            {R"({"layers": [{"albedo": {"constant": 0.2}, "height": {"procedural": "cobbles", "size": 16}},
                            {"albedo": {"constant": 0.8}, "height": {"procedural": "bricks", "size": 16}}],
-               "blend": {"weights": {"source": "file", "file": "t.pfm"}}})", plane}}) {
+               "blend": {"weights": {"source": "file", "file": "t.tif"}}})", plane}}) {
     SCOPED_TRACE(material + " on " + mesh);
     const FramePlan plan = plan_with(material, mesh);
     EXPECT_EQ(plan.image_module_bytes, kImageModuleBytes);
@@ -250,11 +251,12 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
     EXPECT_NE(plan.describe().find("image library 48.00 MiB (to read image files)"), std::string::npos)
         << plan.describe();
   }
-  // PNG, JPEG, OpenEXR, PGM and TIFF files are read in process (imageio/native_reader.hpp): no image library to
-  // count.
+  // PNG, JPEG, OpenEXR, PGM, PFM and most TIFF files are read in process (imageio/native_reader.hpp): no image
+  // library to count.
   const std::filesystem::path images = std::filesystem::path(QDMR_SOURCE_DIR) / "tests/bad_inputs/files/images";
   write_file(dir / "grey.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));
-  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr", "grey.pgm"}) {
+  write_file(dir / "grey.pfm", "Pf\n4 4\n-1.0\n" + std::string(64, char(0)));
+  for (const char* file : {"good.png", "noise.jpg", "noise.tif", "noise.exr", "grey.pgm", "grey.pfm"}) {
     if (!std::filesystem::exists(dir / file)) std::filesystem::copy_file(images / file, dir / file);
     const FramePlan plan = plan_with(std::string(R"({"layers": [{"albedo": ")") + file + R"("}]})", plane);
     EXPECT_EQ(plan.image_module_bytes, 0u) << file;

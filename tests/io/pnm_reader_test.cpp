@@ -1,13 +1,16 @@
 // imageio/pnm_reader.cpp: PBM, PGM and PPM files read in process as Netpbm defines them. Where OpenImageIO's
 // reader got them right (maxval 255 and 65535 below its overflow, bitmaps with separated samples), the same size,
 // channels, type and bits as it; where it did not, the values Netpbm means: 16-bit samples above 32768 as stored,
-// any other maxval as k / maxval, a plain bitmap's digits without separators one pixel each.
+// any other maxval as k / maxval, a plain bitmap's digits without separators one pixel each. PFM files as
+// OpenImageIO reads them: rows bottom-up, the scale's sign the byte order, its magnitude a factor.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "imageio/native_reader.hpp"
@@ -49,6 +52,22 @@ std::string pnm_file(int kind, std::uint32_t maxval, std::uint32_t limit) {
   return out;
 }
 
+// A PFM file ("Pf" or "PF") of hashed 32-bit patterns (every kind of float: NaN, infinities, denormals, -0 among
+// them), `scale` written as given, the samples in the byte order its sign says.
+std::string pfm_file(bool rgb, const std::string& scale) {
+  const bool little = scale[0] == '-';
+  std::string out = rgb ? "PF" : "Pf";  // appended piece by piece: GCC 12 warns wrongly on a chain of + here
+  out += "\n# written by pnm_reader_test\n";
+  out += std::to_string(kWidth) + " " + std::to_string(kHeight) + "\n" + scale + "\n";
+  for (int i = 0; i < kWidth * kHeight * (rgb ? 3 : 1); ++i) {
+    std::uint32_t bits = sample_hash(std::uint32_t(i) * 13u + (rgb ? 1u : 0u));
+    if (i % 5 == 0) bits &= 0x807FFFFFu;  // denormals and zeros
+    if (i % 7 == 0) bits |= 0x7F800000u;  // infinities and NaNs
+    for (int b = 0; b < 4; ++b) out += char(bits >> (little ? 8 * b : 24 - 8 * b));
+  }
+  return out;
+}
+
 TEST(PnmReader, FilesOpenImageIOReadsRightReadAsItReadsThem) {
   struct Case {
     const char* name;
@@ -66,6 +85,44 @@ TEST(PnmReader, FilesOpenImageIOReadsRightReadAsItReadsThem) {
     write_file(dir / c.name, pnm_file(c.kind, c.maxval, c.limit));
     EXPECT_TRUE(imageio::read_natively((dir / c.name).string()));
     expect_same_as_oiio(dir / c.name);
+  }
+  // PFM: both byte orders, grey and RGB, scales of 1 (the usual) and others, which multiply every sample.
+  const std::pair<const char*, std::string> pfm_cases[] = {
+      {"grey_little.pfm", pfm_file(false, "-1.0")}, {"grey_big.pfm", pfm_file(false, "1")},
+      {"rgb_little.pfm", pfm_file(true, "-1.000000")}, {"rgb_big.pfm", pfm_file(true, "+1.0")},
+      {"rgb_scaled.pfm", pfm_file(true, "-2.5")}, {"grey_scaled.pfm", pfm_file(false, "0.3e-1")}};
+  for (const auto& [name, bytes] : pfm_cases) {
+    write_file(dir / name, bytes);
+    EXPECT_TRUE(imageio::read_natively((dir / name).string())) << name;
+    expect_same_as_oiio(dir / name);
+  }
+}
+
+// A PFM's first row in the file is the image's last, and its values are the samples times the scale's magnitude.
+TEST(PnmReader, PfmRowsRunBottomUp) {
+  TempDir dir;
+  const auto floats = [](std::initializer_list<float> values, bool little) {
+    std::string out;
+    for (const float v : values) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &v, 4);
+      for (int b = 0; b < 4; ++b) out += char(bits >> (little ? 8 * b : 24 - 8 * b));
+    }
+    return out;
+  };
+  write_file(dir / "two_rows.pfm", "Pf\n2 2\n-1.0\n" + floats({1.0f, 2.0f, 3.0f, 4.0f}, true));
+  write_file(dir / "big_scaled.pfm", "Pf 2 2 4 " + floats({1.0f, 2.0f, 3.0f, 0.1f}, false));
+  const std::pair<const char*, std::vector<float>> cases[] = {{"two_rows.pfm", {3.0f, 4.0f, 1.0f, 2.0f}},
+                                                              {"big_scaled.pfm", {12.0f, 4.0f * 0.1f, 4.0f, 8.0f}}};
+  for (const auto& [name, expected] : cases) {
+    Decoded d;
+    std::string error;
+    ASSERT_TRUE(read_natively(dir / name, d, error)) << name << ": " << error;
+    ASSERT_EQ(d.type, PixelType::Float);
+    ASSERT_EQ(d.bytes.size(), 16u);
+    std::vector<float> got(4);
+    std::memcpy(got.data(), d.bytes.data(), 16);
+    EXPECT_EQ(got, expected) << name;
   }
 }
 
@@ -117,6 +174,11 @@ TEST(PnmReader, MalformedPixelDataFails) {
       {"short.pgm", "P2\n2 2\n255\n1 2 3\n"},
       {"short_binary.ppm", std::string("P6\n2 1\n255\n") + "\x01\x02\x03"},
       {"short_bitmap.pbm", "P4\n9 2\n\xFF\x80"},
+      {"short.pfm", "Pf\n2 1\n-1.0\n" + std::string(7, '\0')},
+      {"zero_scale.pfm", "Pf\n1 1\n0.0\n" + std::string(4, '\0')},
+      {"word_scale.pfm", "PF\n1 1\nbig\n" + std::string(12, '\0')},
+      {"huge_scale.pfm", "Pf\n1 1\n-1e99\n" + std::string(4, '\0')},
+      {"no_scale.pfm", "Pf\n1 1"},
   };
   for (const auto& [name, bytes] : cases) {
     SCOPED_TRACE(name);

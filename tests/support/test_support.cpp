@@ -1,4 +1,5 @@
 #include "support/test_support.hpp"
+#include "support/converted_tiff.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -159,6 +160,28 @@ std::string read_file(const std::filesystem::path& file) {
 void write_file(const std::filesystem::path& file, const std::string& text) {
   std::ofstream out(file, std::ios::binary);
   out << text;
+}
+
+std::string min_is_white_tiff() {
+  std::string out("II*\0\x08\0\0\0", 8);  // little-endian; the first directory at byte 8
+  const auto add = [&](std::uint32_t value, int bytes) {
+    for (int b = 0; b < bytes; ++b) out += char(value >> (8 * b));
+  };
+  constexpr std::uint32_t kEntries = 8, kPixels = 8 + 2 + 12 * kEntries + 4;
+  add(kEntries, 2);
+  const std::uint32_t entries[kEntries][3] = {  // tag, type (3 short, 4 long), value
+      {256, 3, 4}, {257, 3, 4}, {258, 3, 8}, {259, 3, 1},  // 4x4, 8 bits, no compression
+      {262, 3, 0},                                          // PhotometricInterpretation: min is white
+      {273, 4, kPixels}, {278, 3, 4}, {279, 4, 16}};        // one strip of 16 bytes
+  for (const auto& [tag, type, value] : entries) {
+    add(tag, 2);
+    add(type, 2);
+    add(1, 4);
+    add(value, 4);
+  }
+  add(0, 4);  // no next directory
+  for (int i = 0; i < 16; ++i) add(std::uint32_t(16 * i), 1);
+  return out;
 }
 
 }  // namespace qdmr::test
