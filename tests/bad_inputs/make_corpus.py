@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Writes tests/bad_inputs/files/ and tests/bad_inputs/cases.json: the malformed inputs checked by
 tests/cli/bad_inputs_corpus_test.cpp. Re-run after editing (needs oiiotool for the few valid images the bad
-ones are cut from); the output is deterministic except the EXR and TIFF files (their headers carry the date written). Special files (FIFOs, sockets, devices, a directory) are not
+ones are cut from); the output is deterministic except the files oiiotool made and those cut from them: they carry
+its command line, with the absolute path of files/ (so they differ when run in another checkout), and the EXR and
+TIFF ones the date written. Special files (FIFOs, sockets, devices, a directory) are not
 stored: the test makes them at run time under special/ in its copy of files/ (see the test).
 
 Placeholders in args and messages: {in} is the test's copy of files/, {out} its empty output folder."""
@@ -79,10 +81,33 @@ def png_chunk(kind, data):
 def png_header_only(w, h, color=2, depth=8):
     return b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, color, 0, 0, 0))
 
-def exr_window(data, xmin, ymin, xmax, ymax):
-    key = b"dataWindow\0box2i\0" + struct.pack("<i", 16)
+def exr_size_at(data, name, kind):
+    """Where the declared size of the attribute name (of type kind) is in an EXR header, and that size."""
+    key = name + b"\0" + kind + b"\0"
     at = data.index(key) + len(key)
-    return data[:at] + struct.pack("<iiii", xmin, ymin, xmax, ymax) + data[at + 16:]
+    return at, struct.unpack_from("<i", data, at)[0]
+
+def exr_window(data, xmin, ymin, xmax, ymax):
+    at, size = exr_size_at(data, b"dataWindow", b"box2i")
+    assert size == 16
+    return data[:at + 4] + struct.pack("<iiii", xmin, ymin, xmax, ymax) + data[at + 20:]
+
+def exr_sized(data, name, kind, size, padding=b""):
+    """The attribute name declaring size bytes instead of its own, padding appended to its value."""
+    at, old = exr_size_at(data, name, kind)
+    return data[:at] + struct.pack("<i", size) + data[at + 4:at + 4 + old] + padding + data[at + 4 + old:]
+
+def jpeg_size(data, w, h):
+    """The JPEG with its frame header (SOF0) declaring w x h pixels."""
+    at = data.index(b"\xff\xc0") + 5
+    return data[:at] + struct.pack(">HH", h, w) + data[at + 4:]
+
+def tiff_gray(w, h, pixels):
+    """A little-endian 8-bit grey TIFF of one uncompressed strip declaring w x h pixels, holding pixels."""
+    tags = [(256, 4, w), (257, 4, h), (258, 3, 8), (259, 3, 1), (262, 3, 1), (273, 4, 10 + 12 * 9 + 4),
+            (277, 3, 1), (278, 4, h), (279, 4, w * h)]
+    return (b"II*\0" + struct.pack("<IH", 8, len(tags)) + b"".join(struct.pack("<HHII", t, k, 1, v) for t, k, v in tags)
+            + struct.pack("<I", 0) + pixels)
 
 def jpeg_segment(marker, payload):
     return bytes([0xFF, marker]) + struct.pack(">H", len(payload) + 2) + payload
@@ -147,6 +172,22 @@ images = [
     ("pbm_truncated.pbm", b"P4\n64 64\n" + bytes(10), "truncated"),
     ("pgm_huge.pgm", b"P5\n100000 100000\n255\n" + bytes(16), "outside 1..16384"),
     ("pgm_garbage_header.pgm", b"P5\nfoo bar\n255\n", "cannot read"),
+    # Small files declaring large images (fuzz_image's slow units: seconds and gigabytes before the decoder gave
+    # up); qdmr refuses them without committing the image's memory. A plain PNM needs a byte per value at least.
+    ("tiff_declares_16384x16384.tif", tiff_gray(16384, 16384, bytes(64)), "cannot read"),
+    ("png_declares_16384x10240.png", png_header_only(16384, 10240, color=0) + png_chunk(b"IDAT", zlib.compress(bytes(100)))
+     + png_chunk(b"IEND", b""), "cannot read"),
+    ("jpeg_declares_16384x10240.jpg", jpeg_size(jpg, 16384, 10240), "cannot read"),
+    ("exr_declares_16384x10240.exr", exr_window(exr, 0, 0, 16383, 10239), "cannot read"),
+    ("pgm_ascii_declares_16384x10240.pgm", b"P2\n16384 10240\n255\n0 0 0 0\n", "truncated: the header promises 167772160 values"),
+    ("pbm_ascii_declares_16384x16384.pbm", b"P1\n16384 16384\n0101\n", "truncated: the header promises 268435456 values"),
+    ("ppm_ascii_one_value_short.ppm", b"P3\n2 2\n255\n" + b"0 " * 11, "cannot read"),
+    # OpenEXR 3.1 reads a known attribute type by its type, not its declared size, and the next attribute from
+    # where that value ended; qdmr's header walk requires the declared size. The R, G, B channel list is 55 bytes.
+    ("exr_channel_list_longer_than_declared.exr", exr_sized(exr, b"channels", b"chlist", 54),
+     "attribute 'channels' holds a channel list of 55 bytes, it claims 54"),
+    ("exr_box_larger_than_its_type.exr", exr_sized(exr, b"dataWindow", b"box2i", 18, bytes(2)),
+     "attribute 'dataWindow' of type box2i claims 18 bytes, the type has 16"),
     ("pfm_zero_scale.pfm", b"Pf\n4 4\n0\n" + bytes(64), "its scale '0' is not a finite nonzero number"),
     ("pfm_scale_overflows.pfm", b"Pf\n4 4\n-1e99\n" + bytes(64), "its scale '-1e99' is not a finite nonzero number"),
     ("pfm_no_scale.pfm", b"PF\n4 4\n", "PFM header is malformed (no scale)"),
