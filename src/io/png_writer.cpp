@@ -3,7 +3,9 @@
 #include <isa-l/igzip_lib.h>
 #include <libdeflate.h>
 #include <png.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
@@ -28,41 +30,19 @@ void on_warning(png_structp, png_const_charp) {}
 
 using Bytes = std::vector<unsigned char, DefaultInitAllocator<unsigned char>>;
 
-// `in` as one zlib stream from ISA-L's igzip at its level 1, in one call; empty if it did not fit `out`'s bound
-// (then the caller takes libdeflate).
-Bytes igzip_zlib(const Bytes& in) {
-  // igzip's level 1 wants a work buffer of this size (its "large" default: the best ratio of the level), zeroed
-  // (about 300 KB): what it holds must not depend on what the allocator gave back, or the bytes written might.
-  std::vector<unsigned char> work(ISAL_DEF_LVL1_DEFAULT);
-  // Room for stored blocks (5 bytes per 64 KiB) on incompressible rows, the zlib header and trailer, and slack.
-  Bytes out(in.size() + in.size() / 64 + 1024);
-  isal_zstream stream;
-  isal_deflate_stateless_init(&stream);
-  stream.level = 1;
-  stream.level_buf = work.data();
-  stream.level_buf_size = std::uint32_t(work.size());
-  stream.gzip_flag = IGZIP_ZLIB;
-  stream.end_of_stream = 1;
-  stream.flush = NO_FLUSH;
-  stream.next_in = const_cast<unsigned char*>(in.data());
-  stream.avail_in = std::uint32_t(in.size());
-  stream.next_out = out.data();
-  stream.avail_out = std::uint32_t(out.size());
-  if (isal_deflate_stateless(&stream) != COMP_OK) return {};
-  out.resize(stream.total_out);
-  return out;
+// Bands of rows, each filtered and compressed on its own (in parallel) and joined into one zlib stream: at least
+// 256 KiB of filtered rows each, so a band costs far more than its task and its lost history (a 32 KiB window at
+// its start) costs a few bytes. The split depends on the row size only, so the bytes written do not depend on the
+// thread count.
+std::size_t rows_per_band(std::size_t row_bytes) {
+  return std::max<std::size_t>(1, (std::size_t(1) << 18) / (row_bytes + 1));
 }
 
-// The IDAT payload: every row with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
-// less zeros), as one zlib stream: from igzip at kPngFastLevel, else from libdeflate at `level`. Up is the fastest
-// filter to apply; on the canonical 1080p render it gives 1.67 MB with libdeflate's level 1, where libpng's
-// per-row choice among all five with zlib level 3 gave 1.71 MB (docs/performance.md). Empty on failure. Its
-// buffers are not zeroed first (every byte is written) and take huge pages where they are large
-// (DefaultInitAllocator): fresh pages cost a fault each otherwise.
-Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows, int level) {
-  Bytes filtered((row_bytes + 1) * rows);
-  for (std::size_t y = 0; y < rows; ++y) {
-    unsigned char* out = filtered.data() + y * (row_bytes + 1);
+// Rows [first, end) of `data` with PNG's "Up" filter (byte 2, then each byte less the one above it; the first row
+// of the image less zeros) into `out`, row `first` at its start.
+void filter_up(const unsigned char* data, std::size_t row_bytes, std::size_t first, std::size_t end,
+               unsigned char* out) {
+  for (std::size_t y = first; y < end; ++y, out += row_bytes + 1) {
     const unsigned char* row = data + y * row_bytes;
     out[0] = 2;
     if (y == 0) {
@@ -72,12 +52,70 @@ Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::siz
     const unsigned char* above = row - row_bytes;
     for (std::size_t i = 0; i < row_bytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - above[i]);
   }
-  // igzip takes 32-bit sizes: from 2 GiB of rows on (the output's bound must fit too), and should its bound not
-  // fit, libdeflate.
-  if (level == kPngFastLevel && filtered.size() < (std::size_t(1) << 31)) {
-    Bytes fast = igzip_zlib(filtered);
-    if (!fast.empty()) return fast;
+}
+
+// `in` as raw deflate blocks from ISA-L's igzip at its level 1, in one call: the final blocks of the stream when
+// `last`, else ending in a full flush (byte-aligned, nothing referring back before it), so that the next band's
+// blocks follow it. Empty if they did not fit `out`'s bound.
+Bytes igzip_band(const unsigned char* in, std::size_t size, bool last) {
+  // igzip's level 1 wants a work buffer of this size (its "large" default: the best ratio of the level), zeroed
+  // (about 300 KB): what it holds must not depend on what the allocator gave back, or the bytes written might.
+  std::vector<unsigned char> work(ISAL_DEF_LVL1_DEFAULT);
+  // Room for stored blocks (5 bytes per 64 KiB) on incompressible rows, the flush, and slack.
+  Bytes out(size + size / 64 + 1024);
+  isal_zstream stream;
+  isal_deflate_stateless_init(&stream);
+  stream.level = 1;
+  stream.level_buf = work.data();
+  stream.level_buf_size = std::uint32_t(work.size());
+  stream.gzip_flag = IGZIP_DEFLATE;
+  stream.end_of_stream = last ? 1 : 0;
+  stream.flush = last ? NO_FLUSH : FULL_FLUSH;
+  stream.next_in = const_cast<unsigned char*>(in);
+  stream.avail_in = std::uint32_t(size);
+  stream.next_out = out.data();
+  stream.avail_out = std::uint32_t(out.size());
+  if (isal_deflate_stateless(&stream) != COMP_OK) return {};
+  out.resize(stream.total_out);
+  return out;
+}
+
+// The IDAT payload: every row with the Up filter, as one zlib stream: from igzip at kPngFastLevel, in bands
+// (rows_per_band), else from libdeflate at `level`. Up is the fastest filter to apply; on the canonical 1080p
+// render it gives 1.67 MB with libdeflate's level 1, where libpng's per-row choice among all five with zlib level 3
+// gave 1.71 MB (docs/performance.md). Empty on failure. Its buffers are not zeroed first (every byte is written)
+// and take huge pages where they are large (DefaultInitAllocator): fresh pages cost a fault each otherwise.
+Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows, int level) {
+  const std::size_t filtered_row = row_bytes + 1;
+  Bytes filtered(filtered_row * rows);
+  // igzip takes 32-bit sizes: a band's bound must fit (else libdeflate).
+  const std::size_t band_rows = rows_per_band(row_bytes);
+  if (level == kPngFastLevel && band_rows * filtered_row < (std::size_t(1) << 31)) {
+    const std::size_t bands = (rows + band_rows - 1) / band_rows;
+    std::vector<Bytes> compressed(bands);
+    tbb::parallel_for(std::size_t(0), bands, [&](std::size_t b) {
+      const std::size_t first = b * band_rows, end = std::min(rows, first + band_rows);
+      unsigned char* in = filtered.data() + first * filtered_row;
+      filter_up(data, row_bytes, first, end, in);
+      compressed[b] = igzip_band(in, (end - first) * filtered_row, b + 1 == bands);
+    });
+    std::size_t size = 2 + 4;
+    for (const Bytes& band : compressed) {
+      if (band.empty()) return {};
+      size += band.size();
+    }
+    // zlib's header (deflate, 32 KiB window, "fastest"; 0x7801 is a multiple of 31), the bands, the Adler-32 of
+    // all the filtered rows, most significant byte first.
+    Bytes out;
+    out.reserve(size);
+    out.push_back(0x78);
+    out.push_back(0x01);
+    for (const Bytes& band : compressed) out.insert(out.end(), band.begin(), band.end());
+    const std::uint32_t adler = isal_adler32(1, filtered.data(), filtered.size());
+    for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<unsigned char>(adler >> shift));
+    return out;
   }
+  filter_up(data, row_bytes, 0, rows, filtered.data());
   const std::unique_ptr<libdeflate_compressor, decltype(&libdeflate_free_compressor)> compressor(
       libdeflate_alloc_compressor(level), libdeflate_free_compressor);
   if (!compressor) return {};
