@@ -234,11 +234,14 @@ TEST(ExrReader, RefusedAndDamagedFilesFailInBothReaders) {
   EXPECT_NE(error.find("subsampled OpenEXR channels are not supported (channel 'C' has sampling 2,2)"),
             std::string::npos)
       << error;
-  // Deep data is not an image of one value per channel and pixel: refused, not flattened.
+  // Deep data is not an image of one value per channel and pixel: refused, not flattened, as OpenImageIO's
+  // read_image refuses it too (the backend read it that way before).
   write_deep_exr(dir / "deep.exr");
   error.clear();
   EXPECT_FALSE(read_natively(dir / "deep.exr", native, error));
   EXPECT_NE(error.find("deep"), std::string::npos) << error;
+  Decoded oiio;
+  EXPECT_FALSE(read_with_oiio(dir / "deep.exr", oiio));
 }
 
 }  // namespace

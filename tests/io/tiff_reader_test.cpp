@@ -36,15 +36,16 @@ struct TiffLayout {
   bool big_endian = false;
   std::uint16_t extra = EXTRASAMPLE_UNASSALPHA;  // what the channels after the colour ones are
   const char* software = nullptr;
+  bool bigtiff = false;  // the 64-bit offsets of BigTIFF (libtiff's "8" mode)
+  int images = 1;        // directories: the first is the image read, the others differ from it
 };
 
 std::size_t sample_bytes(std::uint16_t bits) { return bits <= 8 ? 1 : bits / 8; }
 
-// Samples from a hash: every value of the sample type occurs, floats of any bits (NaNs, infinities, denormals)
-// included. Written in host order, libtiff swapping them for a big-endian file.
-void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
-  TIFF* tiff = TIFFOpen(file.string().c_str(), layout.big_endian ? "wb" : "wl");
-  ASSERT_NE(tiff, nullptr) << layout.name;
+// Image `image` of the file: samples from a hash (of the image too): every value of the sample type occurs, floats
+// of any bits (NaNs, infinities, denormals) included. Written in host order, libtiff swapping them for a big-endian
+// file. False if libtiff failed to write a row or tile.
+bool write_tiff_image(TIFF* tiff, const TiffLayout& layout, int image) {
   TIFFSetField(tiff, TIFFTAG_IMAGEWIDTH, kWidth);
   TIFFSetField(tiff, TIFFTAG_IMAGELENGTH, kHeight);
   TIFFSetField(tiff, TIFFTAG_SAMPLESPERPIXEL, layout.channels);
@@ -83,7 +84,8 @@ void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
   const std::size_t bytes = sample_bytes(layout.bits);
   // The sample at (x, y) of `plane` (or of channel c of an interleaved pixel), its bytes in host order.
   const auto sample = [&](std::uint32_t x, std::uint32_t y, std::size_t c, unsigned char* out) {
-    const std::uint32_t h = sample_hash((y * kWidth + x) * 8 + std::uint32_t(c) + 977u * layout.bits);
+    const std::uint32_t h =
+        sample_hash((y * kWidth + x) * 8 + std::uint32_t(c) + 977u * layout.bits + 7919u * std::uint32_t(image));
     if (layout.bits < 8) {
       const std::size_t bit = (x * per_pixel + (layout.separate ? 0 : c)) * layout.bits;
       out[bit / 8 - (x * per_pixel * layout.bits) / 8] |=
@@ -120,6 +122,18 @@ void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
         written = written && TIFFWriteScanline(tiff, row.data(), y, plane) >= 0;
       }
   }
+  return written;
+}
+
+void write_tiff_file(const fs::path& file, const TiffLayout& layout) {
+  const std::string mode = std::string("w") + (layout.big_endian ? "b" : "l") + (layout.bigtiff ? "8" : "");
+  TIFF* tiff = TIFFOpen(file.string().c_str(), mode.c_str());
+  ASSERT_NE(tiff, nullptr) << layout.name;
+  bool written = true;
+  for (int image = 0; image < layout.images; ++image) {
+    written = write_tiff_image(tiff, layout, image) && written;
+    if (image + 1 < layout.images) written = TIFFWriteDirectory(tiff) == 1 && written;
+  }
   TIFFClose(tiff);
   EXPECT_TRUE(written) << layout.name;
 }
@@ -151,6 +165,13 @@ const TiffLayout kClaimed[] = {
      PREDICTOR_FLOATINGPOINT, true, 0},
     {"five_channels16", 5, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_HORIZONTAL, false, 9,
      false, EXTRASAMPLE_UNSPECIFIED},
+    {"rgb8_bigtiff", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_ADOBE_DEFLATE, PREDICTOR_NONE, false, 5,
+     false, EXTRASAMPLE_UNASSALPHA, nullptr, true},
+    {"grey16_bigtiff_tiled_be", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE,
+     false, 0, true, EXTRASAMPLE_UNASSALPHA, nullptr, true},
+    // Two images: both readers read the first (OpenImageIO's subimage 0).
+    {"rgb8_two_images", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_NONE, false, 4, false,
+     EXTRASAMPLE_UNASSALPHA, nullptr, false, 2},
 };
 
 TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
@@ -160,6 +181,13 @@ TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
     SCOPED_TRACE(layout.name);
     const fs::path file = dir / (std::string(layout.name) + ".tif");
     write_tiff_file(file, layout);
+    // The file is what the layout says: BigTIFF's version 43 in its header, every image a directory of its own.
+    const std::string head = read_file(file).substr(0, 4);
+    EXPECT_EQ(head[layout.big_endian ? 3 : 2], layout.bigtiff ? 43 : 42);
+    TIFF* tiff = TIFFOpen(file.string().c_str(), "r");
+    ASSERT_NE(tiff, nullptr);
+    EXPECT_EQ(TIFFNumberOfDirectories(tiff), layout.images);
+    TIFFClose(tiff);
     EXPECT_TRUE(imageio::read_natively(file.string()));
     expect_same_as_oiio(file);
     ++compared;
