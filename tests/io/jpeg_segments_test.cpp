@@ -86,6 +86,27 @@ TEST(JpegSegments, MetadataSegmentsAreDroppedAndThePixelsStayTheSame) {
   EXPECT_EQ(a.texels, b.texels);
 }
 
+// A photo's Exif orientation (here 6: "rotate 90 degrees clockwise to display") is not applied: the texels are
+// the stored ones, as OpenImageIO's read_image gives them (it reports the tag, and leaves the pixels as stored)
+// and as GPU texture loaders take them.
+TEST(JpegSegments, ExifOrientationIsNotApplied) {
+  TempDir dir;
+  const Bytes plain = gradient_jpeg(dir / "plain.jpg");
+  // Exif: a big-endian TIFF header, IFD0 with one entry, Orientation (0x0112), SHORT, 1 value: 6.
+  const Bytes exif = Bytes("Exif\0\0MM\0*\0\0\0\x08", 14) + Bytes("\0\x01", 2) +
+                     Bytes("\x01\x12\0\x03\0\0\0\x01\0\x06\0\0", 12) + Bytes(4, '\0');
+  write_bytes(dir / "rotated.jpg", plain.substr(0, 2) + segment(0xE1, exif) + plain.substr(2));
+  auto in = OIIO::ImageInput::open((dir / "rotated.jpg").string());
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().get_int_attribute("Orientation"), 6);  // the file does carry the tag
+  EXPECT_EQ(in->spec().width, 24);
+  const Image a = read_image(dir / "plain.jpg", "test");
+  const Image b = read_image(dir / "rotated.jpg", "test");
+  EXPECT_EQ(b.width, 24);
+  EXPECT_EQ(b.height, 16);
+  EXPECT_EQ(a.texels, b.texels);
+}
+
 TEST(JpegSegments, DamagedSegmentsBeforeTheFirstScanAreRefusedWithWhatIsWrong) {
   TempDir dir;
   const Bytes plain = gradient_jpeg(dir / "plain.jpg");

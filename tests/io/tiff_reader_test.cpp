@@ -38,6 +38,7 @@ struct TiffLayout {
   const char* software = nullptr;
   bool bigtiff = false;  // the 64-bit offsets of BigTIFF (libtiff's "8" mode)
   int images = 1;        // directories: the first is the image read, the others differ from it
+  std::uint16_t orientation = 0;  // a TIFF Orientation tag (0: none); neither reader applies it
 };
 
 std::size_t sample_bytes(std::uint16_t bits) { return bits <= 8 ? 1 : bits / 8; }
@@ -56,6 +57,7 @@ bool write_tiff_image(TIFF* tiff, const TiffLayout& layout, int image) {
   TIFFSetField(tiff, TIFFTAG_COMPRESSION, layout.compression);
   if (layout.predictor != PREDICTOR_NONE) TIFFSetField(tiff, TIFFTAG_PREDICTOR, layout.predictor);
   if (layout.software) TIFFSetField(tiff, TIFFTAG_SOFTWARE, layout.software);
+  if (layout.orientation != 0) TIFFSetField(tiff, TIFFTAG_ORIENTATION, layout.orientation);
   const std::uint16_t colour = layout.photometric == PHOTOMETRIC_RGB || layout.photometric == PHOTOMETRIC_YCBCR ? 3
                                : layout.photometric == PHOTOMETRIC_SEPARATED                                   ? 4
                                                                                                                : 1;
@@ -172,6 +174,9 @@ const TiffLayout kClaimed[] = {
     // Two images: both readers read the first (OpenImageIO's subimage 0).
     {"rgb8_two_images", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_NONE, false, 4, false,
      EXTRASAMPLE_UNASSALPHA, nullptr, false, 2},
+    // "Rotate 90 degrees clockwise to display": both readers give the samples as stored.
+    {"grey8_orientation6", 1, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false,
+     3, false, EXTRASAMPLE_UNASSALPHA, nullptr, false, 1, ORIENTATION_RIGHTTOP},
 };
 
 TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
@@ -190,6 +195,12 @@ TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
     TIFFClose(tiff);
     EXPECT_TRUE(imageio::read_natively(file.string()));
     expect_same_as_oiio(file);
+    if (layout.orientation != 0) {  // the file carries the tag, and OpenImageIO reports it without applying it
+      auto in = OIIO::ImageInput::open(file.string());
+      ASSERT_TRUE(in);
+      EXPECT_EQ(in->spec().get_int_attribute("Orientation"), int(layout.orientation));
+      EXPECT_EQ(in->spec().width, int(kWidth));
+    }
     ++compared;
   }
   EXPECT_EQ(compared, int(std::size(kClaimed)));
