@@ -146,12 +146,12 @@ Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& de
 
 std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {
   const AoMapSize size = map_size(field, desc);
-  Fnv1a f;
+  ContentHash f;
   f.value(kAoFormatVersion);
   f.value(std::int32_t(field.width));
   f.value(std::int32_t(field.height));
   f.value(std::int32_t(field.address));
-  for (double h : field.h) f.value(h);
+  f.bytes(field.h.data(), field.h.size() * sizeof(double));
   f.value(depth_scale);
   f.value(std::int32_t(ao::direction_count(desc)));
   f.value(desc.radius);
@@ -160,7 +160,7 @@ std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoD
   f.value(desc.jitter ? desc.seed : 0u);
   f.value(std::int32_t(size.width));
   f.value(std::int32_t(size.height));
-  return f.hash;
+  return f.digest();
 }
 
 Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,

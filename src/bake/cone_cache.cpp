@@ -29,14 +29,14 @@ std::filesystem::path default_cache_dir() {
 }
 
 std::uint64_t cone_map_key(const HeightField& field, ConeKind kind) {
-  Fnv1a f;
+  ContentHash f;
   f.value(kConeFormatVersion);
   f.value(std::int32_t(field.width));
   f.value(std::int32_t(field.height));
   f.value(std::int32_t(field.address));
   f.value(std::int32_t(kind));
-  for (double h : field.h) f.value(h);
-  return f.hash;
+  f.bytes(field.h.data(), field.h.size() * sizeof(double));
+  return f.digest();
 }
 
 ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std::filesystem::path& cache_dir) {

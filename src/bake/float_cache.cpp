@@ -18,14 +18,14 @@ struct Header {
   std::uint32_t tag;
   std::int32_t width, height;
   std::uint64_t key;
-  std::uint64_t payload_hash;  // FNV-1a of the values' bytes
+  std::uint64_t payload_hash;  // XXH3-64 of the values' bytes
 };
 static_assert(sizeof(Header) == 40);
 
 std::uint64_t payload_hash(std::span<const float> values) {
-  Fnv1a f;
-  f.bytes(values.data(), values.size() * sizeof(float));
-  return f.hash;
+  ContentHash h;
+  h.bytes(values.data(), values.size() * sizeof(float));
+  return h.digest();
 }
 
 }  // namespace

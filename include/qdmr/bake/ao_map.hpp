@@ -37,7 +37,7 @@ AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc);
 // taps, the max pyramid of the heights above level 0 (fp64). For memory plans; nothing is baked.
 std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc);
 
-// 64-bit FNV-1a of the format version, W, H, address mode, heights (as doubles), depth scale, direction count
+// XXH3-64 of the format version, W, H, address mode, heights (as doubles), depth scale, direction count
 // (clamped to 4..16), radius, coarse, jitter, the seed (when jittered) and the map's size. Not strength or mode.
 std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc);
 

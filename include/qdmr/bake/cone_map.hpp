@@ -77,7 +77,7 @@ ConeMap bake_cone_map_brute_force(const HeightField& field, ConeKind kind);
 // The cache folder: $QDMR_CACHE_DIR, else $XDG_CACHE_HOME/qdmr, else $HOME/.cache/qdmr (else a relative .qdmr-cache).
 std::filesystem::path default_cache_dir();
 
-// 64-bit FNV-1a of a format version, W, H, the address mode, the kind and the heights (as doubles).
+// XXH3-64 of a format version, W, H, the address mode, the kind and the heights (as doubles).
 std::uint64_t cone_map_key(const HeightField& field, ConeKind kind);
 
 // Returns the cached map of (field, kind) from cache_dir, or bakes it and stores it there (temporary file and
