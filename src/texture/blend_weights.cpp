@@ -184,26 +184,32 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   for (int y = 0; y < w.height; ++y)
     for (int x = 0; x < w.width; ++x)
       for (int c = 0; c < 4; ++c) w.at(x, y, c) = weights.texel(0, x, y, c);
-  const auto wrap_index = [](int i, int n) { return ((i % n) + n) % n; };
+  // Weight-texture indices: floor(x) of a coordinate in [-0.5, n - 0.5) lies in [-1, n - 1], and its successor in
+  // [0, n]: one step wraps them (no integer division per texel: those were most of this loop's time).
+  const auto wrap_index = [](int i, int n) { return i < 0 ? i + n : i >= n ? i - n : i; };
 
   HeightField field;
   field.width = lw * scale;
   field.height = lh * scale;
   field.h.resize(std::size_t(field.width) * std::size_t(field.height));
   tbb::parallel_for(0, field.height, [&](int y) {
-    for (int x = 0; x < field.width; ++x) {
-      // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
-      // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic).
-      const double wx = (x + 0.5) / field.width * w.width - 0.5, wy = (y + 0.5) / field.height * w.height - 0.5;
-      const int x0 = int(std::floor(wx)), y0 = int(std::floor(wy));
-      const double fx = wx - x0, fy = wy - y0;
+    // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
+    // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic).
+    const double wy = (y + 0.5) / field.height * w.height - 0.5;
+    const int y0 = int(std::floor(wy));
+    const double fy = wy - y0;
+    const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);
+    const std::size_t layer_row = std::size_t(y % lh) * std::size_t(lw);
+    for (int x = 0, lx = 0; x < field.width; ++x, lx = lx + 1 == lw ? 0 : lx + 1) {  // lx: x % lw
+      const double wx = (x + 0.5) / field.width * w.width - 0.5;
+      const int x0 = int(std::floor(wx));
+      const double fx = wx - x0;
       const int xa = wrap_index(x0, w.width), xb = wrap_index(x0 + 1, w.width);
-      const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);
       double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
       for (int i = 0; i < layers; ++i) {
         const double wi = (double(w.at(xa, ya, i)) * (1 - fx) + double(w.at(xb, ya, i)) * fx) * (1 - fy) +
                           (double(w.at(xa, yb, i)) * (1 - fx) + double(w.at(xb, yb, i)) * fx) * fy;
-        const double hi = h[(std::size_t(i) * lh + std::size_t(y % lh)) * lw + std::size_t(x % lw)];
+        const double hi = h[std::size_t(i) * lh * lw + layer_row + std::size_t(lx)];
         top = std::max(top, wi * hi);
         sum_wh += wi * hi;
         sum_w += wi;
