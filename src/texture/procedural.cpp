@@ -224,32 +224,75 @@ struct Noise {
 
   static double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
 
-  double gradient(std::int64_t i, std::int64_t j, std::uint32_t s, double dx, double dy) const {
+  // Gradient k (of 8 directions) dotted with the offset (dx, dy) from its lattice point.
+  static double gradient(std::uint32_t k, double dx, double dy) {
     constexpr double r = 0.7071067811865476;
     static constexpr double gx[8] = {1, -1, 0, 0, r, -r, r, -r};
     static constexpr double gy[8] = {0, 0, 1, -1, r, r, -r, -r};
-    const std::uint32_t k = hash_mixed(std::uint32_t(i), std::uint32_t(j), s) >> 29;
     return gx[k] * dx + gy[k] * dy;
   }
 
-  Texel operator()(double u, double v) const {
-    double sum = 0.0;
-    for (std::size_t o = 0; o < frequency.size(); ++o) {
-      const std::int64_t f = frequency[o];
-      const std::uint32_t s = mixed_seed[o];
-      const double x = u * double(f), y = v * double(f);
-      const double fx = std::floor(x), fy = std::floor(y);
-      // u, v in (0, 1): lattice indices in [0, f), only the next one wraps.
-      const std::int64_t i = std::int64_t(fx), j = std::int64_t(fy), i1 = i + 1 == f ? 0 : i + 1, j1 = j + 1 == f ? 0 : j + 1;
-      const double tx = x - fx, ty = y - fy;
-      const double n00 = gradient(i, j, s, tx, ty), n10 = gradient(i1, j, s, tx - 1, ty);
-      const double n01 = gradient(i, j1, s, tx, ty - 1), n11 = gradient(i1, j1, s, tx - 1, ty - 1);
-      const double wx = fade(tx), wy = fade(ty);
-      const double a = n00 + (n10 - n00) * wx, b = n01 + (n11 - n01) * wx;
-      sum += amplitude[o] * (a + (b - a) * wy);
+  // What the texels of one lattice cell share, per octave: the four corners' gradients (k = hash >> 29), and per
+  // lattice row the inner halves of the corners' hashes, mix(j + seed). fill() evaluates a row's texels in order,
+  // so a Cursor hashes once per cell and octave instead of four times per texel; the operations on each texel
+  // are the per-texel formula's, in its order, so the bits are the same.
+  class Cursor {
+  public:
+    explicit Cursor(const Noise& noise) : n_(&noise), cells_(noise.frequency.size()) {}
+
+    Texel operator()(double u, double v) {
+      double sum = 0.0;
+      for (std::size_t o = 0; o < n_->frequency.size(); ++o) {
+        const std::int64_t f = n_->frequency[o];
+        Cell& c = cells_[o];
+        if (!c.valid || c.v != v) {  // a new row: what depends on v alone
+          const double y = v * double(f), fy = std::floor(y);
+          c.v = v, c.row_j = std::int64_t(fy), c.ty = y - fy, c.wy = fade(c.ty);
+        }
+        const double x = u * double(f);
+        const double fx = std::floor(x);
+        // u, v in (0, 1): lattice indices in [0, f), only the next one wraps.
+        const std::int64_t i = std::int64_t(fx), j = c.row_j;
+        if (!c.valid || c.i != i || c.j != j) c.enter(i, j, f, n_->mixed_seed[o]);
+        const double tx = x - fx, ty = c.ty;
+        const double n00 = gradient(c.k[0], tx, ty), n10 = gradient(c.k[1], tx - 1, ty);
+        const double n01 = gradient(c.k[2], tx, ty - 1), n11 = gradient(c.k[3], tx - 1, ty - 1);
+        const double wx = fade(tx), wy = c.wy;
+        const double a = n00 + (n10 - n00) * wx, b = n01 + (n11 - n01) * wx;
+        sum += n_->amplitude[o] * (a + (b - a) * wy);
+      }
+      return {sum};
     }
-    return {sum};
-  }
+
+  private:
+    struct Cell {
+      bool valid = false;  // i, j, row and k hold a cell (v, row_j, ty and wy a row as soon as one is seen)
+      double v = 0.0, ty = 0.0, wy = 0.0;  // the row's v, its fraction in the cell and fade(ty)
+      std::int64_t row_j = 0;
+      std::int64_t i = 0, j = -1;
+      std::uint32_t row[2] = {0, 0};  // mix(j + seed), mix(j1 + seed)
+      std::uint32_t k[4] = {0, 0, 0, 0};  // corners (i, j), (i1, j), (i, j1), (i1, j1)
+
+      // hash_mixed(x, y, seed) is mix(x + mix(y + seed)): its inner half depends on the row alone.
+      void enter(std::int64_t ci, std::int64_t cj, std::int64_t f, std::uint32_t seed) {
+        const std::int64_t i1 = ci + 1 == f ? 0 : ci + 1, j1 = cj + 1 == f ? 0 : cj + 1;
+        if (!valid || cj != j) {
+          row[0] = mix(std::uint32_t(cj) + seed);
+          row[1] = mix(std::uint32_t(j1) + seed);
+        }
+        valid = true, i = ci, j = cj;
+        k[0] = mix(std::uint32_t(ci) + row[0]) >> 29;
+        k[1] = mix(std::uint32_t(i1) + row[0]) >> 29;
+        k[2] = mix(std::uint32_t(ci) + row[1]) >> 29;
+        k[3] = mix(std::uint32_t(i1) + row[1]) >> 29;
+      }
+    };
+
+    const Noise* n_;
+    std::vector<Cell> cells_;
+  };
+
+  Cursor cursor() const { return Cursor(*this); }
 };
 
 // The top (h = 1), so a flat pattern adds no depth.
