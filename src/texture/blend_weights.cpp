@@ -192,19 +192,27 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   field.width = lw * scale;
   field.height = lh * scale;
   field.h.resize(std::size_t(field.width) * std::size_t(field.height));
+  // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
+  // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic). What
+  // depends on x alone is the same in every row: computed once per column.
+  struct Column {
+    int xa, xb, lx;  // weight texels left and right, the layers' texel (x mod lw)
+    double fx;
+  };
+  std::vector<Column> columns(std::size_t(field.width));
+  for (int x = 0; x < field.width; ++x) {
+    const double wx = (x + 0.5) / field.width * w.width - 0.5;
+    const int x0 = int(std::floor(wx));
+    columns[std::size_t(x)] = {wrap_index(x0, w.width), wrap_index(x0 + 1, w.width), x % lw, wx - x0};
+  }
   tbb::parallel_for(0, field.height, [&](int y) {
-    // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
-    // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic).
     const double wy = (y + 0.5) / field.height * w.height - 0.5;
     const int y0 = int(std::floor(wy));
     const double fy = wy - y0;
     const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);
     const std::size_t layer_row = std::size_t(y % lh) * std::size_t(lw);
-    for (int x = 0, lx = 0; x < field.width; ++x, lx = lx + 1 == lw ? 0 : lx + 1) {  // lx: x % lw
-      const double wx = (x + 0.5) / field.width * w.width - 0.5;
-      const int x0 = int(std::floor(wx));
-      const double fx = wx - x0;
-      const int xa = wrap_index(x0, w.width), xb = wrap_index(x0 + 1, w.width);
+    for (int x = 0; x < field.width; ++x) {
+      const auto [xa, xb, lx, fx] = columns[std::size_t(x)];
       double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
       for (int i = 0; i < layers; ++i) {
         const double wi = (double(w.at(xa, ya, i)) * (1 - fx) + double(w.at(xb, ya, i)) * fx) * (1 - fy) +
