@@ -85,7 +85,7 @@ double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double dept
                 const ao::Taps& taps, int i, int j, double u, double v) {
   const int n = ao::direction_count(desc);
   const int rotation = desc.jitter ? ao::rotation(std::uint32_t(i), std::uint32_t(j), desc.seed) : 0;
-  const double s = surface_depth(field, depth_scale, u, v, ReferenceSurface::Bilinear);
+  const double s = bilinear_surface_depth(field, depth_scale, u, v);
   double visible = 0.0;
   for (int d = 0; d < n; ++d) {
     const int index = ao::direction_index(n, d, rotation);
@@ -100,7 +100,7 @@ double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double dept
         const auto y = address(std::int64_t(std::floor(tv * field.height)), field.height, field.address);
         depth = depth_scale * (1.0 - pyramid->cell_max(std::min(tap.level, pyramid->top()), x, y));
       } else {
-        depth = surface_depth(field, depth_scale, tu, tv, ReferenceSurface::Bilinear);
+        depth = bilinear_surface_depth(field, depth_scale, tu, tv);
       }
       slope = std::max(slope, (s - depth) / double(tap.distance));
     }

@@ -4,31 +4,6 @@
 #include <cmath>
 
 namespace qdmr {
-namespace {
-
-std::int64_t texel_index(std::int64_t i, std::int64_t n, AddressMode mode) {
-  switch (mode) {
-    case AddressMode::Wrap: {
-      if (i >= 0 && i < n) return i;
-      const std::int64_t m = i % n;
-      return m < 0 ? m + n : m;
-    }
-    case AddressMode::Clamp: return std::clamp<std::int64_t>(i, 0, n - 1);
-    case AddressMode::Mirror: {
-      if (i >= 0 && i < n) return i;
-      std::int64_t m = i % (2 * n);
-      if (m < 0) m += 2 * n;
-      return m < n ? m : 2 * n - 1 - m;
-    }
-  }
-  return 0;
-}
-
-}  // namespace
-
-double HeightField::at(std::int64_t i, std::int64_t j) const {
-  return h[std::size_t(texel_index(j, height, address) * width + texel_index(i, width, address))];
-}
 
 double surface_depth(const HeightField& field, double depth_scale, double u, double v, ReferenceSurface surface) {
   if (surface == ReferenceSurface::Box) {
@@ -42,13 +17,7 @@ double surface_depth(const HeightField& field, double depth_scale, double u, dou
     if (x == fx && y == fy) top = std::max(top, field.at(i - 1, j - 1));
     return depth_scale * (1.0 - top);
   }
-  const double x = u * field.width - 0.5, y = v * field.height - 0.5;
-  const double fi = std::floor(x), fj = std::floor(y);
-  const double fx = x - fi, fy = y - fj;
-  const auto i = std::int64_t(fi), j = std::int64_t(fj);
-  const double h00 = field.at(i, j), h10 = field.at(i + 1, j), h01 = field.at(i, j + 1), h11 = field.at(i + 1, j + 1);
-  const double h = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
-  return depth_scale * (1.0 - h);
+  return bilinear_surface_depth(field, depth_scale, u, v);
 }
 
 Image bilinear_upper_bound(const HeightField& field) {

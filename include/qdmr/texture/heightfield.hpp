@@ -3,6 +3,8 @@
 // u, v in texture repeats; depth measured down from the polygon (depth 0) to depth_scale; a texel of height
 // h in [0,1] lies at depth depth_scale * (1 - h). Level-0 texel (i, j) covers [i/W, (i+1)/W) x [j/H, (j+1)/H)
 // and its centre is ((i + 0.5)/W, (j + 0.5)/H).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -20,8 +22,28 @@ struct HeightField {
   AddressMode address = AddressMode::Wrap;  // wrap repeats the map; clamp extends the edge texels; mirror reflects
 
   // Texel (i, j) with the address mode applied: wrap i mod W; clamp to [0, W); mirror with period 2W
-  // (i = -1 reads texel 0, i = W reads texel W - 1). Any int64 index is valid.
-  double at(std::int64_t i, std::int64_t j) const;
+  // (i = -1 reads texel 0, i = W reads texel W - 1). Any int64 index is valid. Inline: the bakes and the exact
+  // reference read millions of texels.
+  double at(std::int64_t i, std::int64_t j) const {
+    return h[std::size_t(texel_index(j, height, address) * width + texel_index(i, width, address))];
+  }
+
+  static std::int64_t texel_index(std::int64_t i, std::int64_t n, AddressMode mode) {
+    if (i >= 0 && i < n) return i;  // every mode: inside
+    switch (mode) {
+      case AddressMode::Wrap: {
+        const std::int64_t m = i % n;
+        return m < 0 ? m + n : m;
+      }
+      case AddressMode::Clamp: return std::clamp<std::int64_t>(i, 0, n - 1);
+      case AddressMode::Mirror: {
+        std::int64_t m = i % (2 * n);
+        if (m < 0) m += 2 * n;
+        return m < n ? m : 2 * n - 1 - m;
+      }
+    }
+    return 0;
+  }
 };
 
 // A ray in UV/depth space: p(t) = origin + t * direction, t >= 0. Rays of interest enter at depth 0 and go
@@ -41,6 +63,17 @@ enum class ReferenceSurface {
 //   the highest (least deep) of the texels touching it counts; the exact reference uses the same rule.
 // - Bilinear: the bilinear interpolation of the four texel centres around (u, v).
 double surface_depth(const HeightField& field, double depth_scale, double u, double v, ReferenceSurface surface);
+
+// surface_depth(field, depth_scale, u, v, ReferenceSurface::Bilinear), inline for the bakes' inner loops.
+inline double bilinear_surface_depth(const HeightField& field, double depth_scale, double u, double v) {
+  const double x = u * field.width - 0.5, y = v * field.height - 0.5;
+  const double fi = std::floor(x), fj = std::floor(y);
+  const double fx = x - fi, fy = y - fj;
+  const auto i = std::int64_t(fi), j = std::int64_t(fj);
+  const double h00 = field.at(i, j), h10 = field.at(i + 1, j), h01 = field.at(i, j + 1), h11 = field.at(i + 1, j + 1);
+  const double h = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
+  return depth_scale * (1.0 - h);
+}
 
 // Per level-0 texel, the maximum of its 3x3 neighbourhood (address mode applied), as a 1-channel float image:
 // the bilinear surface over a texel's square interpolates only those texels, so a max-quadtree built from this
