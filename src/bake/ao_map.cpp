@@ -26,19 +26,6 @@ constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
 
 AoMapSize map_size(const HeightField& field, const AoDesc& desc) { return ao_map_size(field.width, field.height, desc); }
 
-// Level-0 texel index of i under the address mode (the rule of HeightField::at).
-std::int64_t address(std::int64_t i, std::int64_t n, AddressMode mode) {
-  switch (mode) {
-    case AddressMode::Wrap: return ((i % n) + n) % n;
-    case AddressMode::Clamp: return std::clamp<std::int64_t>(i, 0, n - 1);
-    case AddressMode::Mirror: {
-      const std::int64_t m = ((i % (2 * n)) + 2 * n) % (2 * n);
-      return m < n ? m : 2 * n - 1 - m;
-    }
-  }
-  return 0;
-}
-
 // The max pyramid of the heights, shaped like the max-quadtree: level k+1 has max(1, floor(n/2)) cells per axis,
 // the last one also covering the leftover row/column, so texel x of level 0 lies in cell min(x >> k, n_k - 1).
 // Level 0 is the field's own heights (not copied).
@@ -96,8 +83,11 @@ double texel_ao(const HeightField& field, const MaxPyramid* pyramid, double dept
       const double tu = u + dx * double(tap.distance), tv = v + dy * double(tap.distance);
       double depth;
       if (desc.coarse) {
-        const auto x = address(std::int64_t(std::floor(tu * field.width)), field.width, field.address);
-        const auto y = address(std::int64_t(std::floor(tv * field.height)), field.height, field.address);
+        // Level-0 texel of the tap under the address mode (HeightField::at's rule; no division inside the map).
+        const auto x = HeightField::texel_index(std::int64_t(std::floor(tu * field.width)), field.width,
+                                                field.address);
+        const auto y = HeightField::texel_index(std::int64_t(std::floor(tv * field.height)), field.height,
+                                                field.address);
         depth = depth_scale * (1.0 - pyramid->cell_max(std::min(tap.level, pyramid->top()), x, y));
       } else {
         depth = bilinear_surface_depth(field, depth_scale, tu, tv);
