@@ -28,6 +28,7 @@ struct HeightField {
     return h[std::size_t(texel_index(j, height, address) * width + texel_index(i, width, address))];
   }
 
+  // Index i of a row or column of n texels under the address mode, in [0, n): at's rule, for the bakes too.
   static std::int64_t texel_index(std::int64_t i, std::int64_t n, AddressMode mode) {
     if (i >= 0 && i < n) return i;  // every mode: inside
     switch (mode) {
