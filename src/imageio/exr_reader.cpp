@@ -121,12 +121,7 @@ public:
     }
   }
 
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
-    if (read_) {
-      error = "the OpenEXR file was read already";
-      return false;
-    }
-    read_ = true;
+  bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
     if (type != PixelType::Float) {
       error = "an OpenEXR file is read as floats only";
       return false;
@@ -181,7 +176,6 @@ private:
   std::vector<Channel> channels_;  // in OpenImageIO's order
   int x_ = 0, y_ = 0;              // the data window's corner
   std::int64_t width_ = 0, height_ = 0;
-  bool read_ = false;
 };
 
 }  // namespace

@@ -116,12 +116,7 @@ public:
     return true;
   }
 
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
-    if (read_) {
-      error = "the JPEG was read already";
-      return false;
-    }
-    read_ = true;
+  bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
     const std::size_t row_values = std::size_t(cinfo_.output_width) * std::size_t(cmyk_ ? 3 : cinfo_.num_components);
     const bool direct = type == PixelType::UInt8;
     std::vector<unsigned char> decoded(direct ? 0 : row_values * cinfo_.output_height);
@@ -176,7 +171,6 @@ private:
   std::string error_, warning_;
   bool created_ = false;
   bool cmyk_ = false;
-  bool read_ = false;
 };
 
 }  // namespace

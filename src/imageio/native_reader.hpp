@@ -27,8 +27,19 @@ public:
   virtual ~NativeReader() = default;
   // As Backend::read. `type` other than the file's own converts k to k / (2^bits - 1), correctly rounded; a file
   // of float samples (a TIFF's, an OpenEXR file, a PFM file, a PNM file of a maxval other than 255 and 65535) is
-  // read as floats only.
-  virtual bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) = 0;
+  // read as floats only. A file is read once: a second call fails.
+  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) {
+    if (read_) {
+      error = "the image file was read already";
+      return false;
+    }
+    read_ = true;
+    return read_pixels(type, first_row, row_stride, error);
+  }
+
+private:
+  virtual bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) = 0;
+  bool read_ = false;
 };
 
 // For a file that starts with PNG's, JPEG's, OpenEXR's or PBM/PGM/PPM/PFM's signature, or a TIFF that libtiff opens

@@ -78,12 +78,7 @@ public:
     return true;
   }
 
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
-    if (read_) {
-      error = "the PNG was read already";
-      return false;
-    }
-    read_ = true;
+  bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
     const std::size_t row_bytes = png_get_rowbytes(png_, info_);
     const bool direct = type == stored_type();
     std::vector<unsigned char> decoded(direct ? 0 : row_bytes * height_);
@@ -132,7 +127,6 @@ private:
   png_uint_32 width_ = 0, height_ = 0;
   int bit_depth_ = 0, channels_ = 0;
   bool interlaced_ = false;
-  bool read_ = false;
 };
 
 }  // namespace

@@ -83,12 +83,7 @@ public:
     return true;
   }
 
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
-    if (read_) {
-      error = "the PNM file was read already";
-      return false;
-    }
-    read_ = true;
+  bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
     if (type != stored_ && stored_ == PixelType::Float) {
       error = floats_ ? "a PFM file is read as floats only"
                       : "a PNM file of maxval " + std::to_string(maxval_) + " is read as floats only";
@@ -252,7 +247,6 @@ private:
   std::uint64_t width_ = 0, height_ = 0;
   std::uint32_t maxval_ = 1, channels_ = 1;
   PixelType stored_ = PixelType::UInt8;
-  bool read_ = false;
 };
 
 }  // namespace

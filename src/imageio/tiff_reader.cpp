@@ -48,12 +48,7 @@ public:
     return true;
   }
 
-  bool read(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
-    if (read_) {
-      error = "the TIFF was read already";
-      return false;
-    }
-    read_ = true;
+  bool read_pixels(PixelType type, void* first_row, std::ptrdiff_t row_stride, std::string& error) override {
     if (type != stored_ && stored_ == PixelType::Float) {
       error = "a TIFF of float samples is read as floats only";
       return false;
@@ -187,7 +182,7 @@ private:
   std::uint32_t width_ = 0, height_ = 0, tile_width_ = 0, tile_height_ = 0;
   std::uint16_t channels_ = 0;
   PixelType stored_ = PixelType::UInt8;
-  bool separate_ = false, tiled_ = false, read_ = false;
+  bool separate_ = false, tiled_ = false;
   // The read in progress.
   PixelType type_ = PixelType::UInt8;
   char* first_row_ = nullptr;
