@@ -32,10 +32,12 @@ QDMR_SAMPLER_INLINE Float reduce(const Float& u, AddressMode mode) {
   return xsimd::min(xsimd::max(u, Float(-1.0f)), Float(2.0f));  // further out clamps to the same texels
 }
 
-// Texel index i (within a period or two of the reduced coordinate) to a texel of [0, n).
-QDMR_SAMPLER_INLINE Int address(Int i, const Int& n, AddressMode mode) {
+// Texel index i (within a period or two of the reduced coordinate) to a texel of [0, n). `n_power_of_two`: wrap
+// by masking, which gives the same texel for every i in [-n, 2n) (the reduced coordinates give [-1, n]).
+QDMR_SAMPLER_INLINE Int address(Int i, const Int& n, AddressMode mode, bool n_power_of_two) {
   switch (mode) {
     case AddressMode::Wrap:
+      if (n_power_of_two) return i & (n - Int(1));
       i = xsimd::select(i < Int(0), i + n, i);
       return xsimd::select(i >= n, i - n, i);
     case AddressMode::Mirror: {
@@ -226,10 +228,10 @@ QDMR_SAMPLER_INLINE BilinearTaps bilinear_taps(const TextureView& view, const Sa
   BilinearTaps t;
   split(u, w, pow2, 0.5f, k.fraction_bits, k.exact_texel, x0, t.wx);
   split(v, h, pow2, 0.5f, k.fraction_bits, k.exact_texel, y0, t.wy);
-  t.xa = address(x0, info.width, k.address);
-  t.xb = address(x0 + Int(1), info.width, k.address);
-  t.ya = address(y0, info.height, k.address);
-  t.yb = address(y0 + Int(1), info.height, k.address);
+  t.xa = address(x0, info.width, k.address, pow2);
+  t.xb = address(x0 + Int(1), info.width, k.address, pow2);
+  t.ya = address(y0, info.height, k.address, pow2);
+  t.yb = address(y0 + Int(1), info.height, k.address, pow2);
   t.adjacent = xsimd::all(t.xb == t.xa + Int(1));
   return t;
 }
@@ -241,8 +243,8 @@ QDMR_SAMPLER_INLINE void point_texel(const TextureView& view, const SamplerKey& 
   Float unused;
   split(u, xsimd::to_float(info.width), pow2, 0.0f, k.fraction_bits, k.exact_texel, x, unused);
   split(v, xsimd::to_float(info.height), pow2, 0.0f, k.fraction_bits, k.exact_texel, y, unused);
-  x = address(x, info.width, k.address);
-  y = address(y, info.height, k.address);
+  x = address(x, info.width, k.address, pow2);
+  y = address(y, info.height, k.address, pow2);
 }
 
 // The taps' texels one by one (any lane at an edge).
@@ -318,7 +320,9 @@ QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const Sampl
   const Int x = xsimd::to_int(xsimd::floor(u * w - Float(0.5f)));
   const Int y = xsimd::to_int(xsimd::floor(v * h + xsimd::select(dv > Float(0.0f), Float(0.5f), Float(-0.5f))));
   alignas(64) std::int32_t o[kLanes];
-  (info.offset + (address(y, info.height, ka.address) * info.width + address(x, info.width, ka.address)) * Int(4))
+  const bool pow2 = va.power_of_two();
+  (info.offset + (address(y, info.height, ka.address, pow2) * info.width + address(x, info.width, ka.address, pow2)) *
+                     Int(4))
       .store_aligned(o);
   const Texture &a = va.texture(), &b = vb.texture();
   const bool a_decoded = ka.srgb && !a.linear.empty();
