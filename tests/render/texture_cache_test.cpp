@@ -95,7 +95,9 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
 // when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
-// a 4-layer blend; plane normal mapping (paired, no trace).
+// a 4-layer blend with per-pixel weights (not paired), on its combined quadtree and on the product of the layers'
+// and weights' trees; surface_blend_4layers under QDM, its 4 layers blended by vertex weights (not paired); plane
+// normal mapping (paired, no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
     const char* scene;
@@ -105,11 +107,14 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
                         {"objects_displaced",
                          {{"/materials/floor/technique/name", "\"csm\""}, {"/materials/stone_box/technique/name", "\"rcsm\""}}},
                         {"terrain", {}},
+                        {"terrain", {{"/materials/ground/blend/quadtree", "\"product\""}}},
+                        {"surface_blend_4layers", {{"/materials/blend/technique/name", "\"qdm\""}}},
                         {"plane", {}}};
   for (const Case& c : cases) {
     const char* name = c.scene;
     for (Isa isa : usable_isas()) {
-      SCOPED_TRACE(std::string(name) + (c.overrides.empty() ? "" : " with cones") + ", " + std::string(isa_name(isa)));
+      SCOPED_TRACE(std::string(name) + (c.overrides.empty() ? "" : " with " + c.overrides[0].pointer) + ", " +
+                   std::string(isa_name(isa)));
       const SceneDesc off = small_scene(name, c.overrides);
       auto cache_overrides = c.overrides;
       cache_overrides.push_back({"/texture_cache/layout", "\"morton\""});
