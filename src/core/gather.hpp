@@ -130,61 +130,63 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
   load_bytes8_at(base, o, path, first, second);
 }
 
-// Two texels of 4 floats at base + o[lane] (unaligned), o: the lanes' float indices in memory: floats 0-3 into
-// first[0..3], floats 4-7 into second[0..3], one vector per float. AVX2 and AVX-512 transpose them from 128-bit
-// loads (4x4 per 128-bit segment).
-[[gnu::always_inline]] inline void load_f32x4_pair_at(const float* base, const std::int32_t* o, FetchPath path,
-                                                      Float* first, Float* second) {
+// Floats at..at+3 of each lane's texel of 4 floats at base + o[lane] (unaligned), o: the lanes' float indices in
+// memory, into out[0..3], one vector per float. AVX2 and AVX-512 transpose them from 128-bit loads (4x4 per 128-bit
+// segment); the 4-lane builds transpose four 128-bit loads (a lane-by-lane loop through memory costs a
+// store-forwarding stall per vector).
+[[gnu::always_inline]] inline void load_f32x4_at(const float* base, const std::int32_t* o, int at, FetchPath path,
+                                                 Float* out) {
 #if defined(__AVX512F__)
   if (path == FetchPath::Gather) {
-    avx512_transpose(base, o, 0, first);
-    avx512_transpose(base, o, 4, second);
+    avx512_transpose(base, o, at, out);
     return;
   }
 #elif defined(__AVX2__)
   if (path == FetchPath::Gather) {
-    const auto transpose = [&](int at, Float* out) {
-      const auto row = [&](int lane) {  // lane's texel in the low half, lane + 4's in the high half
-        return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + o[lane] + at)),
-                                    _mm_loadu_ps(base + o[lane + 4] + at), 1);
-      };
-      const __m256 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
-      const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-      const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-      out[0] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
-      out[1] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
-      out[2] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
-      out[3] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+    const auto row = [&](int lane) {  // lane's texel in the low half, lane + 4's in the high half
+      return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(base + o[lane] + at)),
+                                  _mm_loadu_ps(base + o[lane + 4] + at), 1);
     };
-    transpose(0, first);
-    transpose(4, second);
+    const __m256 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+    const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+    const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+    out[0] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+    out[1] = Float(_mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+    out[2] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+    out[3] = Float(_mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
     return;
   }
 #elif defined(__SSE2__) && !defined(__AVX__)
-  // The 4-lane builds: each texel is a 4x4 transpose of four 128-bit loads (a lane-by-lane loop through memory
-  // costs a store-forwarding stall per vector).
   static_assert(kLanes == 4);
   (void)path;
-  for (int at : {0, 4}) {
-    const auto row = [&](int lane) { return _mm_loadu_ps(base + o[lane] + at); };
-    __m128 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    Float* out = at == 0 ? first : second;
-    out[0] = Float(r0);
-    out[1] = Float(r1);
-    out[2] = Float(r2);
-    out[3] = Float(r3);
-  }
+  const auto row = [&](int lane) { return _mm_loadu_ps(base + o[lane] + at); };
+  __m128 r0 = row(0), r1 = row(1), r2 = row(2), r3 = row(3);
+  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+  out[0] = Float(r0);
+  out[1] = Float(r1);
+  out[2] = Float(r2);
+  out[3] = Float(r3);
   return;
 #endif
   (void)path;
-  alignas(64) float value[8][kLanes];
+  alignas(64) float value[4][kLanes];
   for (int lane = 0; lane < kLanes; ++lane)
-    for (int i = 0; i < 8; ++i) value[i][lane] = base[o[lane] + i];
-  for (int i = 0; i < 4; ++i) {
-    first[i] = Float::load_aligned(value[i]);
-    second[i] = Float::load_aligned(value[4 + i]);
-  }
+    for (int i = 0; i < 4; ++i) value[i][lane] = base[o[lane] + at + i];
+  for (int i = 0; i < 4; ++i) out[i] = Float::load_aligned(value[i]);
+}
+
+// Two texels of 4 floats at base + o[lane]: floats 0-3 into first[0..3], floats 4-7 into second[0..3].
+[[gnu::always_inline]] inline void load_f32x4_pair_at(const float* base, const std::int32_t* o, FetchPath path,
+                                                      Float* first, Float* second) {
+  load_f32x4_at(base, o, 0, path, first);
+  load_f32x4_at(base, o, 4, path, second);
+}
+
+// load_f32x4_at() of one texel (at 0) with the indices in a vector.
+[[gnu::always_inline]] inline void load_f32x4(const float* base, const Int& index, FetchPath path, Float* out) {
+  alignas(64) std::int32_t o[kLanes];
+  index.store_aligned(o);
+  load_f32x4_at(base, o, 0, path, out);
 }
 
 // load_f32x4_pair_at() with the indices in a vector.

@@ -148,6 +148,7 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
     if (const DerivedAsset* w = derived(m.weights); w && m.weight_mode == WeightMode::Pixel) inputs.weights = w->texture.get();
     if (const DerivedAsset* c = derived(m.combined_quadtree)) {
       inputs.combined = c->texture.get();
+      inputs.layer_heights = c->layer_heights.get();
       inputs.combined_period = assets.derived[std::size_t(m.combined_surface)].field->width;
     }
     if (const DerivedAsset* a = derived(m.blend_ao)) {

@@ -18,6 +18,7 @@
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/image.hpp"
+#include "qdmr/texture/layer_heights.hpp"
 
 namespace qdmr {
 namespace {
@@ -493,7 +494,11 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
                           : "'combined' needs blend/weights/scale to be a whole number of repeats (use 'product')");
       if (fits) {
         choices.combined_quadtree = true;
-        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16);
+        // The tree, and the layers' level-0 heights side by side (LayerHeights) for the walk's level-0 cells.
+        std::vector<TexelFormat> formats;
+        for (const LayerPlan& l : plan.layers) formats.push_back(textures[std::size_t(l.height_max)].format);
+        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16) +
+                                 layer_heights_bytes(h.width, h.height, formats);
       }
     }
   }

@@ -215,9 +215,14 @@ private:
             combined_surface(heights, *input(0).texture, m.weights_scale, desc.blend.op));
         break;
       }
-      case DerivedKind::CombinedQuadtree:
+      case DerivedKind::CombinedQuadtree: {
         out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field));
+        std::vector<const Texture*> chains;
+        for (const LayerPlan& l : m.layers) chains.push_back(assets_.textures[std::size_t(l.height_max)].get());
+        if (LayerHeights heights = interleave_layer_heights(chains); heights.width > 0)
+          out.layer_heights = std::make_shared<const LayerHeights>(std::move(heights));
         break;
+      }
       case DerivedKind::BlendAoMap: {
         AoDesc ao = desc.ao;
         ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats

@@ -12,14 +12,17 @@
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/core/stats.hpp"
 #include "qdmr/texture/heightfield.hpp"
+#include "qdmr/texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
 
 // One derived item: the member its kind makes (weight textures, quadtrees, AO maps and bilinear bounds are
-// textures; combined surfaces and height fields are fields; cone maps are cones).
+// textures; combined surfaces and height fields are fields; cone maps are cones; a combined quadtree also has
+// its layers' heights side by side).
 struct DerivedAsset {
   std::shared_ptr<const Texture> texture;
+  std::shared_ptr<const LayerHeights> layer_heights;  // a combined quadtree's: its walk's level-0 cells, when made
   std::shared_ptr<const HeightField> field;
   std::shared_ptr<const ConeMap> cones;
 };

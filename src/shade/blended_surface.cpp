@@ -143,8 +143,17 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
     lanes.narrow(~simd::float_mask(coarse));
     // Level 0: the exact box value, as the combined tree was built from.
     Float h[kMaxLayers], w[kMaxLayers];
-    for (int i = 0; i < count_; ++i)
-      h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);
+    if (texture_.layer_heights != nullptr && !fetch_recorder_listens()) {
+      // The same decoded heights as each layer's chain holds at level 0 (wrap: power-of-two sizes).
+      const LayerHeights& lh = *texture_.layer_heights;
+      const Int texel = (cy & Int(lh.height - 1)) * Int(lh.width) + (cx & Int(lh.width - 1));
+      Float all[kMaxLayers];
+      simd::load_f32x4(lh.texels.data(), texel * Int(4), sampler().fetch, all);
+      for (int i = 0; i < count_; ++i) h[i] = present(i) ? all[i] : Float(0.0f);
+    } else {
+      for (int i = 0; i < count_; ++i)
+        h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);
+    }
     weights_at((xsimd::to_float(cx) + Float(0.5f)) / Float(float(width())),
                (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height())), w);
     result = xsimd::select(simd::float_mask(coarse), result, combine(h, w));

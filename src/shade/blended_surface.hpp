@@ -8,6 +8,7 @@
 // cell_max is conservative: the level-0 box value is exact (weights at the texel centre), coarser cells use
 // max(hmax_i * wmax_i) — "QDM1 * QDM2 = conservative QDM" — with wmax_i the largest weight over the UV box the
 // queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
+#include "qdmr/texture/layer_heights.hpp"
 #include "shade/height_surface.hpp"
 #include "texture/fetch_trace.hpp"
 
@@ -22,6 +23,9 @@ struct WeightTexture {
   // of repeats the weights span); values rounded up, so it stays conservative.
   const TextureSampler* combined = nullptr;
   int period = 0;
+  // With it, optional: the layers' level-0 heights side by side, read at the walk's level-0 cells (one load per
+  // lane for every layer) while no texture-cache recorder listens (it sees each layer's chain read).
+  const LayerHeights* layer_heights = nullptr;
 };
 
 // The state weight textures are sampled with, from the material's.

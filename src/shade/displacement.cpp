@@ -71,6 +71,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   if (inputs.combined) {
     combined_.emplace(*inputs.combined, sampler_);
     combined_period_ = inputs.combined_period;
+    layer_heights_ = inputs.layer_heights;
   }
   if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
     throw Error("displacement program", "per-pixel blending needs a weight texture");
@@ -528,7 +529,8 @@ void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) c
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
-  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_};
+  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_,
+                              combined_ ? layer_heights_ : nullptr};
   const BlendedSurface surface(surfaces, count, blend_.op, weights,
                                xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
                                xsimd::max(ray.v0, v1));

@@ -44,6 +44,12 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
     for (std::size_t i = 0; i < plan.derived.size(); ++i) {
       const DerivedAsset& d = assets.derived[i];
       EXPECT_TRUE(d.texture || d.field || d.cones) << plan.derived[i].key << " was not built";
+      if (plan.derived[i].kind == DerivedKind::CombinedQuadtree) {
+        // What the plan counts for it: the tree, and the layers' level-0 heights side by side (every shipped
+        // blend's layers keep decoded copies, so it has them).
+        ASSERT_TRUE(d.layer_heights) << plan.derived[i].key;
+        EXPECT_EQ(plan.derived[i].bytes, d.texture->bytes() + d.layer_heights->texels.size() * sizeof(float));
+      }
     }
     // Prepared again with the first assets as the previous ones: nothing is built, everything shared.
     const Assets again = prepare(plan, &assets, &plan);
