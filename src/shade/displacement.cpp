@@ -530,7 +530,7 @@ void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) c
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
   const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_,
-                              combined_ ? layer_heights_ : nullptr};
+                              layer_heights_};
   const BlendedSurface surface(surfaces, count, blend_.op, weights,
                                xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
                                xsimd::max(ray.v0, v1));

@@ -125,7 +125,7 @@ private:
   std::optional<TextureSampler> weights_;
   std::optional<TextureSampler> combined_;
   int combined_period_ = 0;
-  const LayerHeights* layer_heights_ = nullptr;
+  const LayerHeights* layer_heights_ = nullptr;  // with combined_ only
   std::optional<TextureSampler> blend_ao_;
   int blend_ao_scale_ = 1;
   const ConeMap* cones_;

@@ -17,8 +17,8 @@ LayerHeights interleave_layer_heights(const std::vector<const Texture*>& max_cha
   LayerHeights out{w, h, std::vector<float>(std::size_t(w) * std::size_t(h) * 4, 0.0f)};
   const std::size_t texels = std::size_t(w) * std::size_t(h);
   for (std::size_t i = 0; i < max_chains.size(); ++i) {
-    const Texture& t = *max_chains[i];
-    const float* level0 = t.linear.data() + t.levels[0].offset / std::size_t(bytes_per_texel(t.format));
+    const Texture& chain = *max_chains[i];
+    const float* level0 = chain.linear.data() + chain.levels[0].offset / std::size_t(bytes_per_texel(chain.format));
     for (std::size_t t = 0; t < texels; ++t) out.texels[t * 4 + i] = level0[t];
   }
   return out;
