@@ -54,13 +54,57 @@ namespace qdmr::QDMR_ISA_NAMESPACE::simd {
 #endif
 }
 
+#if defined(__AVX512F__)
+namespace quad_rows_detail {
+
+// The permutations that interleave a 16-lane batch's three channels into its two rows of RGB floats. The rows'
+// 48 floats, row 0's 24 then row 1's, are three vectors; float k of vector j is channel c of pixel p of row r
+// (16 j + k = 24 r + 3 p + c), which is lane 4 (p / 2) + 2 r + p % 2. First, r and g into place (index 16 + lane
+// picks g); then b into the floats of channel 2 (index 16 + lane picks b, index k keeps the first result's).
+struct RgbPermutes {
+  alignas(64) int red_green[3][16];
+  alignas(64) int add_blue[3][16];
+};
+
+constexpr RgbPermutes make_rgb_permutes() {
+  RgbPermutes t{};
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 16; ++k) {
+      const int s = 16 * j + k, r = s / 24, p = (s % 24) / 3, c = s % 3;
+      const int lane = 4 * (p / 2) + 2 * r + p % 2;
+      t.red_green[j][k] = c == 1 ? 16 + lane : lane;
+      t.add_blue[j][k] = c == 2 ? 16 + lane : k;
+    }
+  return t;
+}
+
+inline constexpr RgbPermutes kRgbPermutes = make_rgb_permutes();
+
+}  // namespace quad_rows_detail
+#endif
+
 // Writes the lanes of three channels to their pixels of two rows of interleaved RGB floats (pixel x of a row at
-// row[3x .. 3x + 2]; unaligned). AVX2: each row's 4 pixels are 12 consecutive floats, written as three 128-bit
-// stores per row after an in-register 4 x 3 transpose (both rows at once, one per 128-bit half) instead of 24
-// scalar stores. The other kernels store per lane.
+// row[3x .. 3x + 2]; unaligned), by in-register shuffles instead of a scalar store per channel and lane:
+// AVX-512: each row's 8 pixels are 24 consecutive floats, the two rows three vectors of two permutations each,
+// written as 512- and 256-bit stores; AVX2: each row's 4 pixels are 12 consecutive floats, written as three 128-bit
+// stores per row after an in-register 4 x 3 transpose (both rows at once, one per 128-bit half). SSE4.2 stores
+// per lane.
 [[gnu::always_inline]] inline void store_quad_rows_rgb(const Float& r, const Float& g, const Float& b, float* row0,
                                                        float* row1) {
-#if defined(__AVX2__) && !defined(__AVX512F__)
+#if defined(__AVX512F__)
+  using quad_rows_detail::kRgbPermutes;
+  __m512 out[3];
+  for (int j = 0; j < 3; ++j) {
+    const __m512i red_green = _mm512_load_si512(kRgbPermutes.red_green[j]);
+    const __m512i add_blue = _mm512_load_si512(kRgbPermutes.add_blue[j]);
+    out[j] = _mm512_permutex2var_ps(_mm512_permutex2var_ps(r, red_green, g), add_blue, b);
+  }
+  // Row 0: floats 0-15 and 16-23; row 1: floats 24-31 and 32-47.
+  _mm512_storeu_ps(row0, out[0]);
+  _mm256_storeu_ps(row0 + 16, _mm512_castps512_ps256(out[1]));
+  _mm256_storeu_ps(row1, _mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(out[1]), 1)));
+  _mm512_storeu_ps(row1 + 8, out[2]);
+#elif defined(__AVX2__)
   // Row 0's pixels (lanes 0, 1, 4, 5) in the low half, row 1's (lanes 2, 3, 6, 7) in the high half.
   const auto rows = [](const Float& v) { return _mm256_permute4x64_pd(_mm256_castps_pd(v), 0xd8); };
   const __m256 rr = _mm256_castpd_ps(rows(r)), gg = _mm256_castpd_ps(rows(g)), bb = _mm256_castpd_ps(rows(b));

@@ -1,5 +1,6 @@
 // core/gather.hpp's per-lane loads of texels of 4 floats, on both fetch paths of the build these tests are compiled
-// for (the AVX2 kernel: its transposes, and the portable lane-by-lane loop).
+// for (the AVX2 kernel, and the AVX-512 one in qdmr_avx512_tests: their transposes, and the portable lane-by-lane
+// loop).
 #include <gtest/gtest.h>
 
 #include <vector>
