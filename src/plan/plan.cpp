@@ -131,6 +131,11 @@ int mip_levels(int w, int h) {
   return levels;
 }
 
+// Whether the texture keeps Texture::wrap_footprints: asked for, and within wrap_footprint_bytes' bound.
+bool keeps_wrap_footprints(const TextureRequest& t) {
+  return t.wrap_footprints && wrap_footprint_bytes(t.width, t.height, t.format, t.srgb) > 0;
+}
+
 const char* reduce_name(MipReduce r) {
   switch (r) {
     case MipReduce::Box: return "box";
@@ -142,8 +147,11 @@ const char* reduce_name(MipReduce r) {
 }
 
 int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, TexturePurpose purpose,
-                MipReduce reduce, const LayerDesc& layer, const std::string& where, const std::string& user) {
-  const std::string key = request_key(desc, purpose, layer) + "|mip" + std::to_string(int(reduce));
+                MipReduce reduce, const LayerDesc& layer, const std::string& where, const std::string& user,
+                bool wrap_footprints = false) {
+  // The footprints are in the key: a texture built without them is not reused where they are wanted.
+  const std::string key =
+      request_key(desc, purpose, layer) + "|mip" + std::to_string(int(reduce)) + (wrap_footprints ? "|wrap2x2" : "");
   for (std::size_t i = 0; i < textures.size(); ++i) {
     if (textures[i].key != key) continue;
     if (std::find(textures[i].users.begin(), textures[i].users.end(), user) == textures[i].users.end())
@@ -163,7 +171,9 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.srgb = purpose == TexturePurpose::Albedo;
   r.format = purpose == TexturePurpose::Height ? height_format(desc, source.bits) : TexelFormat::RGBA8;
   r.levels = mip_levels(r.width, r.height);
-  r.bytes = mip_chain_bytes(r.width, r.height, r.format) + linear_copy_bytes(r.width, r.height, r.format, r.srgb);
+  r.wrap_footprints = wrap_footprints;
+  r.bytes = mip_chain_bytes(r.width, r.height, r.format) + linear_copy_bytes(r.width, r.height, r.format, r.srgb) +
+            (wrap_footprints ? wrap_footprint_bytes(r.width, r.height, r.format, r.srgb) : 0);
   r.working_bytes = texture_working_bytes(r, source);
   r.users.push_back(user);
   textures.push_back(std::move(r));
@@ -448,8 +458,11 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
       if (layer.height.source == TextureSource::None)
         throw Error(layer_where + "/height", displaced ? std::string("technique '") + technique_name(kind) + "' needs a height map"
                                                        : std::string("height blending needs a height map in every layer"));
+      // Heights fetched bilinearly with wrap addressing read level 0's footprints whole (Texture::wrap_footprints).
+      const bool wrap_footprints = material.technique.height_fetch == HeightFetch::Bilinear &&
+                                   material.sampling.address == AddressMode::Wrap;
       lp.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
-                              layer_where + "/height", material.name);
+                              layer_where + "/height", material.name, wrap_footprints);
       const TextureRequest& h = textures[std::size_t(lp.height)];
       if (plan.blend && displaced) {
         // Blended layers are marched as one surface on one texel grid.
@@ -636,7 +649,8 @@ std::string FramePlan::describe() const {
     const TextureRequest& t = textures[i];
     s << "  [" << i << "] " << purpose_name(t.purpose) << " " << t.width << "x" << t.height << " "
       << format_name(t.format) << (t.srgb ? " sRGB" : "") << ", " << reduce_name(t.reduce) << " mip chain of "
-      << t.levels << " levels, " << mib(t.bytes);
+      << t.levels << " levels" << (keeps_wrap_footprints(t) ? " and level 0's wrap footprints" : "") << ", "
+      << mib(t.bytes);
     if (t.working_bytes >= (1 << 20) / 100) s << " (" << mib(t.working_bytes) << " more while it is built)";
     s << "  <- " << t.where;
     if (t.desc.source == TextureSource::File) s << " (" << t.desc.file.filename().string() << ")";
@@ -707,8 +721,8 @@ nlohmann::json FramePlan::to_json() const {
   for (const TextureRequest& t : textures) {
     nlohmann::json entry = {{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                             {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
-                            {"levels", t.levels}, {"bytes", t.bytes}, {"working_bytes", t.working_bytes},
-                            {"where", t.where}, {"users", t.users}};
+                            {"levels", t.levels}, {"wrap_footprints", keeps_wrap_footprints(t)}, {"bytes", t.bytes},
+                            {"working_bytes", t.working_bytes}, {"where", t.where}, {"users", t.users}};
     if (t.desc.source == TextureSource::File) entry["file"] = t.desc.file.string();
     j["textures"].push_back(entry);
   }

@@ -34,6 +34,7 @@ Texture build_texture(const TextureRequest& request, TextureStat& stat) {
   if (request.purpose == TexturePurpose::Height) {
     texture = stored_height(request, request.reduce, stat).texture;
     add_linear_copy(texture);
+    if (request.wrap_footprints) add_wrap_footprints(texture);
   } else {
     Image level0;
     if (request.desc.source == TextureSource::FromHeight) {

@@ -228,6 +228,35 @@ void add_linear_copy(Texture& texture) {
   });
 }
 
+std::uint64_t wrap_footprint_bytes(int width, int height, TexelFormat format, bool srgb) {
+  if (channel_count(format) != 1 || linear_copy_bytes(width, height, format, srgb) == 0) return 0;
+  const std::uint64_t bytes = std::uint64_t(width) * std::uint64_t(height) * 4 * sizeof(float);
+  return bytes <= kWrapFootprintsMaxBytes ? bytes : 0;
+}
+
+void add_wrap_footprints(Texture& texture) {
+  const int w = texture.width(), h = texture.height();
+  if (texture.levels.empty() || texture.linear.empty() ||
+      wrap_footprint_bytes(w, h, texture.format, texture.srgb) == 0)
+    return;
+  texture.wrap_footprints.assign(std::size_t(w) * std::size_t(h) * 4, 0.0f);
+  const float* level0 = texture.linear.data() + texture.levels[0].offset / std::size_t(bytes_per_texel(texture.format));
+  for_rows(h, std::size_t(w) * 16, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const float* row = level0 + std::size_t(y) * std::size_t(w);
+      const float* below = level0 + std::size_t(y + 1 == h ? 0 : y + 1) * std::size_t(w);
+      float* out = texture.wrap_footprints.data() + std::size_t(y) * std::size_t(w) * 4;
+      for (int x = 0; x < w; ++x, out += 4) {
+        const int right = x + 1 == w ? 0 : x + 1;
+        out[0] = row[x];
+        out[1] = row[right];
+        out[2] = below[x];
+        out[3] = below[right];
+      }
+    }
+  });
+}
+
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
   if (width < 1 || height < 1 || width > limits::kMaxTextureSide || height > limits::kMaxTextureSide)
     throw Error("texture", "size " + std::to_string(width) + "x" + std::to_string(height) + " is outside 1.." +

@@ -266,6 +266,26 @@ QDMR_SAMPLER_INLINE void filter_taps(const SamplerKey& k, const BilinearTaps& t,
   }
 }
 
+// The taps of a bilinear sample of level 0 with wrap addressing from the texture's wrap footprints (Texture::
+// wrap_footprints): one 16-byte load per lane, neighbours already wrapped, so no lane at the edge needs its own.
+QDMR_SAMPLER_INLINE void fetch_wrap_footprints(const TextureView& view, const SamplerKey& k, const LevelInfo& level0,
+                                               const BilinearTaps& t, Float* t00, Float* t10, Float* t01, Float* t11,
+                                               bool record) {
+  const Texture& texture = view.texture();
+  if (record) {  // the texels a GPU reads, in fetch_taps' order
+    trace_fetch(texture, level0.offset, t.xa, t.ya);
+    trace_fetch(texture, level0.offset, t.xb, t.ya);
+    trace_fetch(texture, level0.offset, t.xa, t.yb);
+    trace_fetch(texture, level0.offset, t.xb, t.yb);
+  }
+  Float footprint[4];
+  simd::load_f32x4(texture.wrap_footprints.data(), (t.ya * level0.width + t.xa) * Int(4), k.fetch, footprint);
+  t00[0] = footprint[0];
+  t10[0] = footprint[1];
+  t01[0] = footprint[2];
+  t11[0] = footprint[3];
+}
+
 QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,
                               const LevelInfo& info, bool linear, Float* out, bool record = true) {
   if (!linear) {
@@ -276,7 +296,10 @@ QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey&
   }
   const BilinearTaps t = bilinear_taps(view, k, u, v, info);
   Float t00[4], t10[4], t01[4], t11[4];
-  if (t.adjacent) {
+  // Bilinear filtering samples level 0 only (sample_levels), the level the footprints are of.
+  if (k.filter == Filter::Bilinear && k.address == AddressMode::Wrap && !view.texture().wrap_footprints.empty()) {
+    fetch_wrap_footprints(view, k, info, t, t00, t10, t01, t11, record);
+  } else if (t.adjacent) {
     if (k.format == TexelFormat::RGBA8 && k.srgb && !view.texture().linear.empty()) {
       fetch_linear_pair(view, k, info, t.xa, t.xb, t.ya, t00, t10, record);
       fetch_linear_pair(view, k, info, t.xa, t.xb, t.yb, t01, t11, record);

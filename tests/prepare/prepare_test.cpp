@@ -41,6 +41,9 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
     ASSERT_EQ(assets.meshes.size(), plan.meshes.size());
     ASSERT_EQ(assets.textures.size(), plan.textures.size());
     ASSERT_EQ(assets.derived.size(), plan.derived.size());
+    // Each texture holds what the plan counts for it: chain, decoded copy, wrap footprints.
+    for (std::size_t i = 0; i < plan.textures.size(); ++i)
+      EXPECT_EQ(plan.textures[i].bytes, assets.textures[i]->bytes()) << shipped.name << " " << plan.textures[i].where;
     for (std::size_t i = 0; i < plan.derived.size(); ++i) {
       const DerivedAsset& d = assets.derived[i];
       EXPECT_TRUE(d.texture || d.field || d.cones) << plan.derived[i].key << " was not built";

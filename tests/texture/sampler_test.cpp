@@ -451,6 +451,59 @@ TEST(TextureSampler, TheDecodedCopyGivesThePerFetchDecodesBits) {
   }
 }
 
+// Level 0's wrap footprints (Texture::wrap_footprints) of R16 and R8 heights hold each texel's bilinear footprint
+// with wrapped neighbours, and sampling with them gives the bits of sampling without them (texel pairs per row,
+// single taps at the edge), through every sampler, the specialised and the generic one, on power-of-two and other
+// sizes, with non-finite and far-off coordinates.
+TEST(TextureSampler, WrapFootprintsGiveTheBitsOfTheTexelPairs) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-3.0f, 4.0f), lod(-1.0f, 9.0f);
+  EXPECT_EQ(wrap_footprint_bytes(64, 32, TexelFormat::R16, false), 64u * 32u * 16u);
+  EXPECT_EQ(wrap_footprint_bytes(64, 32, TexelFormat::R8, false), 64u * 32u * 16u);
+  EXPECT_EQ(wrap_footprint_bytes(64, 32, TexelFormat::RGBA8, true), 0u) << "colour: four channels";
+  EXPECT_EQ(wrap_footprint_bytes(64, 32, TexelFormat::R32F, false), 0u) << "no decoded copy";
+  EXPECT_EQ(wrap_footprint_bytes(2048, 2048, TexelFormat::R16, false), kWrapFootprintsMaxBytes);
+  EXPECT_EQ(wrap_footprint_bytes(4096, 2048, TexelFormat::R16, false), 0u) << "above kWrapFootprintsMaxBytes";
+  for (const TexelFormat format : {TexelFormat::R16, TexelFormat::R8})
+    for (const auto& [w, h] : {std::pair{64, 32}, std::pair{37, 19}}) {
+      const std::string name = format_name(format) + " " + std::to_string(w) + "x" + std::to_string(h);
+      Image img(w, h, 1);
+      for (float& t : img.texels) t = unit(rng);
+      Texture pairs = make_mip_texture(img, format, false, MipReduce::Box);
+      add_linear_copy(pairs);
+      Texture footprints = pairs;
+      add_wrap_footprints(footprints);
+      ASSERT_EQ(footprints.wrap_footprints.size(), std::size_t(w) * std::size_t(h) * 4) << name;
+      EXPECT_EQ(footprints.bytes(), pairs.bytes() + wrap_footprint_bytes(w, h, format, false)) << name;
+      // The last texel's footprint wraps in both axes: (w-1, h-1), (0, h-1), (w-1, 0), (0, 0).
+      const float* corner = footprints.wrap_footprints.data() + (std::size_t(h) * std::size_t(w) - 1) * 4;
+      EXPECT_EQ(corner[0], pairs.texel(0, w - 1, h - 1, 0)) << name;
+      EXPECT_EQ(corner[1], pairs.texel(0, 0, h - 1, 0)) << name;
+      EXPECT_EQ(corner[2], pairs.texel(0, w - 1, 0, 0)) << name;
+      EXPECT_EQ(corner[3], pairs.texel(0, 0, 0, 0)) << name;
+      for (const SamplerState& state : every_sampler_state()) {
+        const TextureSampler without(pairs, state), with(footprints, state);
+        for (int round = 0; round < 16; ++round) {
+          Lanes u, v, l;
+          for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+          if (round == 0) u[1] = kNaN, v[2] = -kInf, l[3] = kNaN, u[4] = 3e7f, v[5] = -1e30f;
+          if (round % 2 == 1)  // every lane inside one row pair: without footprints, the paired loads run
+            for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
+          if (round == 2)  // every lane on the last column and row: the footprints' wrapped neighbours
+            for (int i = 0; i < kLanes; ++i) u[i] = 1.0f - 0.1f / float(w), v[i] = float(i % 3) - 0.2f / float(h);
+          Float a[4], b[4], c[4];
+          without.sample(load(u), load(v), load(l), a);
+          with.sample(load(u), load(v), load(l), b);
+          sample(with.view(), state, load(u), load(v), load(l), c);
+          for (int i = 0; i < kLanes; ++i) {
+            ASSERT_EQ(bits(lanes(a[0])[i]), bits(lanes(b[0])[i])) << name << " " << filter_name(state.filter) << " lane " << i;
+            ASSERT_EQ(bits(lanes(a[0])[i]), bits(lanes(c[0])[i])) << name << " " << filter_name(state.filter) << " generic";
+          }
+        }
+      }
+    }
+}
+
 TEST(TextureSampler, DecodesEveryFormatLikeTheScalarTexelAccessor) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);

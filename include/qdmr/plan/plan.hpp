@@ -32,7 +32,10 @@ struct TextureRequest {
   bool srgb = false;
   MipReduce reduce = MipReduce::Box;
   int width = 0, height = 0, levels = 0;
-  std::uint64_t bytes = 0;   // level 0 and its mip chain
+  std::uint64_t bytes = 0;   // level 0 and its mip chain, with the decoded copy and wrap footprints it keeps
+  // Heights some material fetches bilinearly with wrap addressing: the texture keeps level 0's wrap footprints
+  // (Texture::wrap_footprints, where wrap_footprint_bytes allows).
+  bool wrap_footprints = false;
   // What its build allocates on top of `bytes` and frees again, at the most: the decoded file, level 0 in floats,
   // the heights behind from_height normals.
   std::uint64_t working_bytes = 0;

@@ -38,12 +38,18 @@ public:
   // one-channel height formats R16 and R8 (code / 65535 or / 255: a height fetch, on the critical path of every
   // tracing step, skips the division). The same bits, fewer instructions per fetch.
   std::vector<float> linear;
+  // Level 0's bilinear footprints under wrap addressing, where add_wrap_footprints kept them: for texel (x, y) the
+  // decoded texels (x, y), (x + 1, y), (x, y + 1) and (x + 1, y + 1), the neighbours' indices wrapped, as floats
+  // 4 (y * width + x) to 4 (y * width + x) + 3. A bilinear height fetch with wrap addressing loads a lane's
+  // whole footprint with one 16-byte load, where two texel pairs (one per row) cost twice the loads and address
+  // extractions. The same floats as `linear`, so the same bits.
+  std::vector<float> wrap_footprints;
 
   int width() const { return levels.empty() ? 0 : levels[0].width; }
   int height() const { return levels.empty() ? 0 : levels[0].height; }
   int level_count() const { return int(levels.size()); }
   int channels() const { return channel_count(format); }
-  std::size_t bytes() const { return storage.size() + linear.size() * sizeof(float); }
+  std::size_t bytes() const { return storage.size() + (linear.size() + wrap_footprints.size()) * sizeof(float); }
 
   const std::uint8_t* texel_address(int level, int x, int y) const {
     const TextureLevel& l = levels[std::size_t(level)];
@@ -67,6 +73,16 @@ std::uint64_t linear_copy_bytes(int width, int height, TexelFormat format, bool 
 // Fills Texture::linear from the finished chain when linear_copy_bytes says so; call it after the last change to
 // the storage.
 void add_linear_copy(Texture& texture);
+
+// The bytes of Texture::wrap_footprints that add_wrap_footprints keeps for such a chain: 16 per level-0 texel of a
+// one-channel chain with a decoded copy (the heights: R16, R8), for footprints of up to kWrapFootprintsMaxBytes
+// (a 2048² map), else 0 (larger maps are fetched a texel pair per row).
+inline constexpr std::uint64_t kWrapFootprintsMaxBytes = std::uint64_t(64) << 20;
+std::uint64_t wrap_footprint_bytes(int width, int height, TexelFormat format, bool srgb);
+
+// Fills Texture::wrap_footprints from the decoded copy when wrap_footprint_bytes says so; call it after
+// add_linear_copy.
+void add_wrap_footprints(Texture& texture);
 
 // Allocates the chain for a w x h level 0 (all levels, zeroed, with the tail padding).
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb);
