@@ -91,13 +91,14 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
   const UvDerivatives da = derivatives(a), db = derivatives(b);
   Float lod_a, lod_b;
   albedo_lods(da, db, lod_a, lod_b);
+  // Each frame is a chain of three normalisations (a square root, then a division, each), and the shading normal
+  // one more: a's and b's side by side, so one chain's arithmetic fills the other's waits. The frames and view
+  // vectors need no sample: made while the LOD's chain (a logarithm after a division) is under way.
+  const TangentFrame frame_a = TangentFrame::from(a), frame_b = TangentFrame::from(b);
+  const Vec3 view_a = view_vector(a, lights_), view_b = view_vector(b, lights_);
   sample(a, da, lod_a, sa);
   sample(b, db, lod_b, sb);
-  // Each frame is a chain of three normalisations (a square root, then a division, each), and the shading normal
-  // one more: a's and b's side by side, so one chain's arithmetic fills the other's waits.
-  const TangentFrame frame_a = TangentFrame::from(a), frame_b = TangentFrame::from(b);
   const Vec3 normal_a = shading_normal_of(frame_a, sa.tangent_normal), normal_b = shading_normal_of(frame_b, sb.tangent_normal);
-  const Vec3 view_a = view_vector(a, lights_), view_b = view_vector(b, lights_);
   light(a, sa, frame_a, normal_a, view_a, out_a);
   light(b, sb, frame_b, normal_b, view_b, out_b);
 }
