@@ -238,10 +238,14 @@ DisplacementProgram::QdmBudget DisplacementProgram::qdm_budget(const Setup& setu
 namespace {
 
 // Albedo and tangent-space normal (unnormalised) of one layer at the hit; textures: albedo first, normal second.
-void layer_colour(const TwinSampler& textures, const UvDerivatives& d, const Float& u, const Float& v, Float* albedo,
-                  Float* normal) {
+// like, like_lod: a texture whose LOD from d is known (the height map's, from the setup), or null. An albedo map
+// alike (same_lod_as) has that LOD: the hit's sample does not wait on a second evaluation of the same chain.
+void layer_colour(const TwinSampler& textures, const UvDerivatives& d, const TextureSampler* like, const Float& like_lod,
+                  const Float& u, const Float& v, Float* albedo, Float* normal) {
   const TextureSampler &albedo_texture = textures.first(), &normal_texture = textures.second();
-  const Float albedo_lod = albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+  const Float albedo_lod = like != nullptr && albedo_texture.same_lod_as(*like)
+                               ? like_lod
+                               : albedo_texture.lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
   Float n[4];
   const UvAhead ahead = d.quad_below();
   textures.sample(u, v, albedo_lod,
@@ -321,9 +325,10 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
   Float& specular = at.specular;
   Float& ao = at.ao;
   FetchLanes surface_lanes(FetchPhase::Surface);
+  const TextureSampler* const height_map = layers_[0].height ? &layers_[0].height->height : nullptr;
   if constexpr (std::is_same_v<Surface, SingleLayerSurface>) {
     const Layer& l = layers_[0];
-    layer_colour(l.textures, d, hu, hv, albedo, tangent_normal);
+    layer_colour(l.textures, d, height_map, setup.height_lod, hu, hv, albedo, tangent_normal);
     specular = specular_from_albedo(albedo, l.specular, lighting_.specular);
     if (l.ao) ao = baked_ao(l);
   } else {
@@ -350,7 +355,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
       layer_lanes.narrow(f[i] > Float(0.0f));
       const Layer& l = layers_[std::size_t(i)];
       Float a[4], n[3];
-      layer_colour(l.textures, d, hu, hv, a, n);
+      layer_colour(l.textures, d, height_map, setup.height_lod, hu, hv, a, n);
       for (int c = 0; c < 4; ++c) albedo[c] += f[i] * a[c];
       for (int c = 0; c < 3; ++c) tangent_normal[c] += f[i] * n[c];
       specular += f[i] * specular_from_albedo(a, l.specular, lighting_.specular);
