@@ -459,7 +459,9 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
         throw Error(layer_where + "/height", displaced ? std::string("technique '") + technique_name(kind) + "' needs a height map"
                                                        : std::string("height blending needs a height map in every layer"));
       // Heights fetched bilinearly with wrap addressing read level 0's footprints whole (Texture::wrap_footprints).
-      const bool wrap_footprints = material.technique.height_fetch == HeightFetch::Bilinear &&
+      // Not for blended layers: their fetches read every layer at one point, and four footprint arrays (16 bytes
+      // per texel each) missed the cache more than they saved (the terrain's frame 2 % slower, docs/performance.md).
+      const bool wrap_footprints = !plan.blend && material.technique.height_fetch == HeightFetch::Bilinear &&
                                    material.sampling.address == AddressMode::Wrap;
       lp.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
                               layer_where + "/height", material.name, wrap_footprints);
