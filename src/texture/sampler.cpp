@@ -20,7 +20,6 @@ using simd::kLanes;
 using simd::Mask;
 using namespace sampling_code;
 
-constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
 
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
@@ -177,19 +176,6 @@ TextureView::TextureView(const Texture& texture) : texture_(&texture), levels_(t
   for (int c = 0; c < texture.channels(); ++c) first_texel_[std::size_t(c)] = texture.texel(0, 0, 0, c);
   const auto pow2 = [](int n) { return n > 0 && (n & (n - 1)) == 0; };
   power_of_two_ = pow2(texture.width()) && pow2(texture.height());
-}
-
-Float lod_from_derivatives(const TextureView& view, const Float& dudx, const Float& dvdx, const Float& dudy,
-                           const Float& dvdy) {
-  const Float w(float(view.texture().width())), h(float(view.texture().height()));
-  const Float ax = dudx * w, ay = dvdx * h, bx = dudy * w, by = dvdy * h;
-  const Float px = ax * ax + ay * ay, py = bx * bx + by * by;
-  const Float rho2 = xsimd::select(px > py, px, py);
-  const Mask tiny = rho2 < Float(1.17549435e-38f);  // zero or denormal
-  // 0.5 * log2(rho^2) = log2(rho): exact integers for power-of-two footprints.
-  const Float lod = Float(0.5f) * detmath::log2(xsimd::select(tiny, Float(1.0f), rho2));
-  const Float last(float(view.levels() - 1));
-  return xsimd::select(is_finite(px) & is_finite(py), xsimd::select(tiny, Float(kMinLod), lod), last);
 }
 
 SamplerKey sampler_key(const TextureView& view, const SamplerState& s) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 
+#include "core/det_math.hpp"
 #include "core/gather.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
@@ -75,9 +76,23 @@ struct SamplerKey {
 SamplerKey sampler_key(const TextureView& texture, const SamplerState& state);
 
 // LOD in level-0 texels from UV derivatives, GL formula: log2(max(|d(uv*size)/dx|, |d(uv*size)/dy|)).
-// A zero footprint gives -64; non-finite derivatives give the last level.
-simd::Float lod_from_derivatives(const TextureView& texture, const simd::Float& dudx, const simd::Float& dvdx,
-                                 const simd::Float& dudy, const simd::Float& dvdy);
+// A zero footprint gives -64; non-finite derivatives give the last level. Inline: every shading program's
+// sample waits on it, and a call would also make the caller store its live vector registers around it.
+inline simd::Float lod_from_derivatives(const TextureView& view, const simd::Float& dudx, const simd::Float& dvdx,
+                                        const simd::Float& dudy, const simd::Float& dvdy) {
+  using simd::Float;
+  constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
+  const Float w(float(view.texture().width())), h(float(view.texture().height()));
+  const Float ax = dudx * w, ay = dvdx * h, bx = dudy * w, by = dvdy * h;
+  const Float px = ax * ax + ay * ay, py = bx * bx + by * by;
+  const Float rho2 = xsimd::select(px > py, px, py);
+  const simd::Mask tiny = rho2 < Float(1.17549435e-38f);  // zero or denormal
+  // 0.5 * log2(rho^2) = log2(rho): exact integers for power-of-two footprints.
+  const Float lod = Float(0.5f) * detmath::log2(xsimd::select(tiny, Float(1.0f), rho2));
+  const Float last(float(view.levels() - 1));
+  const simd::Mask finite = ((px - px) == Float(0.0f)) & ((py - py) == Float(0.0f));
+  return xsimd::select(finite, xsimd::select(tiny, Float(kMinLod), lod), last);
+}
 
 // Samples every channel (1..4) at (u, v) with one LOD per lane (bias and clamps applied here; ignored by the
 // level-0 filters point and bilinear); out[c] receives channel c. Lanes with non-finite u or v return
