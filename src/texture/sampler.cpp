@@ -20,7 +20,6 @@ using simd::kLanes;
 using simd::Mask;
 using namespace sampling_code;
 
-
 int fraction_bits(SamplePrecision p) { return p == SamplePrecision::Hw8 ? 8 : p == SamplePrecision::Hw6 ? 6 : 0; }
 
 // For when no texture-cache recorder listens (without its tests, the compiler need not keep the fetches' vector

@@ -90,7 +90,7 @@ inline simd::Float lod_from_derivatives(const TextureView& view, const simd::Flo
   // 0.5 * log2(rho^2) = log2(rho): exact integers for power-of-two footprints.
   const Float lod = Float(0.5f) * detmath::log2(xsimd::select(tiny, Float(1.0f), rho2));
   const Float last(float(view.levels() - 1));
-  const simd::Mask finite = ((px - px) == Float(0.0f)) & ((py - py) == Float(0.0f));
+  const simd::Mask finite = ((px - px) == Float(0.0f)) & ((py - py) == Float(0.0f));  // x - x is 0 unless inf or NaN
   return xsimd::select(finite, xsimd::select(tiny, Float(kMinLod), lod), last);
 }
 
