@@ -177,8 +177,10 @@ public:
   const TextureSampler& first() const { return first_; }
   const TextureSampler& second() const { return second_; }
   bool shares_addresses() const { return twin_ != nullptr; }
-  // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as);
-  // ahead, if given, where the quad below will sample (a prefetch hint where the two share addresses).
+  // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as):
+  // the first's four channels, the second's rgb; its alpha is 1, not sampled (the second is a normal map, whose
+  // alpha nothing reads: the shared path skips its division and filter). ahead, if given, where the quad below
+  // will sample (a prefetch hint where the two share addresses).
   void sample(const simd::Float& u, const simd::Float& v, const simd::Float& first_lod, const simd::Float& second_lod,
               simd::Float* first_out, simd::Float* second_out, const UvAhead* ahead = nullptr) const {
     if (twin_ != nullptr && !fetch_recorder_listens()) {
@@ -187,6 +189,7 @@ public:
     }
     first_.sample(u, v, first_lod, first_out);
     second_.sample(u, v, second_lod, second_out);
+    second_out[3] = simd::Float(1.0f);
   }
 
 private:

@@ -4,6 +4,8 @@
 // where it is not (the generic sampler) they run per call. Coordinates are first reduced exactly to one period
 // of the address mode, so texel indices stay small for any finite u; then texel indices and weights come either
 // from exact float arithmetic or from fixed point with 8 or 6 fractional bits, as texture units do.
+#include <algorithm>
+
 #include "core/gather.hpp"
 #include "core/simd.hpp"
 #include "texture/fetch_trace.hpp"
@@ -73,7 +75,8 @@ QDMR_SAMPLER_INLINE Float decode_unorm8(const SamplerKey& k, const Int& byte, bo
               : xsimd::to_float(byte) / Float(255.0f);
 }
 
-QDMR_SAMPLER_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out) {
+// channels: how many of the texel's channels to decode (the others are left as they are).
+QDMR_SAMPLER_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out, int channels = 4) {
   switch (k.format) {
     case TexelFormat::R8: out[0] = decode_unorm8(k, raw & Int(0xFF), k.srgb); return;
     case TexelFormat::RG8:
@@ -84,7 +87,8 @@ QDMR_SAMPLER_INLINE void decode(const SamplerKey& k, const Int& raw, Float* out)
       out[0] = decode_unorm8(k, raw & Int(0xFF), k.srgb);
       out[1] = decode_unorm8(k, (raw >> 8) & Int(0xFF), k.srgb);
       out[2] = decode_unorm8(k, (raw >> 16) & Int(0xFF), k.srgb);
-      out[3] = decode_unorm8(k, xsimd::bitwise_cast<Int>(xsimd::bitwise_cast<simd::UInt>(raw) >> 24), false);
+      if (channels > 3)
+        out[3] = decode_unorm8(k, xsimd::bitwise_cast<Int>(xsimd::bitwise_cast<simd::UInt>(raw) >> 24), false);
       return;
     case TexelFormat::R16: out[0] = xsimd::to_float(raw & Int(0xFFFF)) / Float(65535.0f); return;
     case TexelFormat::R32F: out[0] = xsimd::bitwise_cast<Float>(raw); return;
@@ -118,11 +122,11 @@ QDMR_SAMPLER_INLINE void fetch(const TextureView& view, const SamplerKey& k, con
 // Texels (x, y) and (x + 1, y) of every lane of a texture with 4-byte texels, from one 8-byte load per lane, o: the
 // lanes' byte offsets of texel (x, y).
 QDMR_SAMPLER_INLINE void fetch_texel_pair_at(const Texture& t, const SamplerKey& k, const std::int32_t* o, Float* a,
-                                             Float* b) {
+                                             Float* b, int channels = 4) {
   Int first, second;
   simd::load_bytes8_at(t.storage.data(), o, k.fetch, first, second);
-  decode(k, first, a);
-  decode(k, second, b);
+  decode(k, first, a, channels);
+  decode(k, second, b, channels);
 }
 
 // fetch() of texels (xa, y) and (xb, y) = (xa + 1, y), adjacent in memory, from one load per lane: 4 bytes for
@@ -257,9 +261,10 @@ QDMR_SAMPLER_INLINE void fetch_taps(const TextureView& view, const SamplerKey& k
   fetch(view, k, info, t.xb, t.yb, t11, record);
 }
 
+// channels: how many of the format's channels to filter (all by default).
 QDMR_SAMPLER_INLINE void filter_taps(const SamplerKey& k, const BilinearTaps& t, const Float* t00, const Float* t10,
-                                     const Float* t01, const Float* t11, Float* out) {
-  for (int c = 0; c < channel_count(k.format); ++c) {
+                                     const Float* t01, const Float* t11, Float* out, int channels = 4) {
+  for (int c = 0; c < std::min(channel_count(k.format), channels); ++c) {
     const Float top = t00[c] + (t10[c] - t00[c]) * t.wx;
     const Float bottom = t01[c] + (t11[c] - t01[c]) * t.wx;
     out[c] = top + (bottom - top) * t.wy;
@@ -324,12 +329,12 @@ QDMR_SAMPLER_INLINE bool twin_keys(const SamplerKey& a, const SamplerKey& b) {
 
 // Texels (x, y) and (x + 1, y) of every lane of an RGBA8 texture, o: the lanes' byte offsets of texel (x, y).
 QDMR_SAMPLER_INLINE void fetch_rgba8_pair_at(const TextureView& view, const SamplerKey& k, const std::int32_t* o,
-                                             Float* first, Float* second) {
+                                             Float* first, Float* second, int channels = 4) {
   const Texture& t = view.texture();
   if (k.srgb && !t.linear.empty())
     simd::load_f32x4_pair_at(t.linear.data(), o, k.fetch, first, second);
   else
-    fetch_texel_pair_at(t, k, o, first, second);
+    fetch_texel_pair_at(t, k, o, first, second, channels);
 }
 
 // Prefetches, in each lane, the bilinear footprint's row that a sample at (u, v) on `info`'s level reads and a
@@ -358,8 +363,9 @@ QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const Sampl
   }
 }
 
-// sample_level() of two textures (twin_keys) at once: out[0..3] texture a's channels, out[4..7] texture b's. Never
-// recorded: the caller knows no texture-cache recorder listens.
+// sample_level() of two textures (twin_keys) at once: out[0..3] texture a's channels, out[4..6] texture b's rgb
+// (b's alpha is not filtered: no division for it). Never recorded: the caller knows no texture-cache recorder
+// listens.
 QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
                                            const SamplerKey& kb, const Float& u, const Float& v, const LevelInfo& info,
                                            bool linear, Float* out) {
@@ -377,15 +383,15 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
     (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
     (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
     fetch_rgba8_pair_at(va, ka, top, a00, a10);
-    fetch_rgba8_pair_at(vb, kb, top, b00, b10);
+    fetch_rgba8_pair_at(vb, kb, top, b00, b10, 3);
     fetch_rgba8_pair_at(va, ka, bottom, a01, a11);
-    fetch_rgba8_pair_at(vb, kb, bottom, b01, b11);
+    fetch_rgba8_pair_at(vb, kb, bottom, b01, b11, 3);
   } else {
     fetch_taps(va, ka, info, t, a00, a10, a01, a11, false);
     fetch_taps(vb, kb, info, t, b00, b10, b01, b11, false);
   }
   filter_taps(ka, t, a00, a10, a01, a11, out);
-  filter_taps(kb, t, b00, b10, b01, b11, out + 4);
+  filter_taps(kb, t, b00, b10, b01, b11, out + 4, 3);
 }
 
 // Whether a mip-linear sample may skip its coarse level: no lane weighs it (f, the LOD's fraction, is 0 in every
@@ -448,7 +454,8 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
 }
 
 // sample_with() of two textures alike (twin_keys, one chain layout) at the same coordinates and LOD: out_a and
-// out_b get what sample_with() gives each, from one address computation. Never recorded. ahead (optional): where
+// out_b's rgb get what sample_with() gives each, from one address computation; out_b's alpha is 1 (the second
+// texture is a normal map, whose alpha nothing reads). Never recorded. ahead (optional): where
 // the quad below samples, prefetched on the finest level this sample reads.
 QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey& kb, const TextureView& va,
                                           const TextureView& vb, const SamplerState& s, const Float& u,
@@ -461,7 +468,7 @@ QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey
   }
   Float out[8];
   bool finest = true;  // sample_levels() reads the finer level first
-  sample_levels(ka, va, s, u, v, lod, 8, first_texel, false,
+  sample_levels(ka, va, s, u, v, lod, 7, first_texel, false,
                 [&](const Float& ru, const Float& rv, const LevelInfo& info, bool linear,
                     Float* level_out) __attribute__((always_inline)) {
                   if (finest && ahead != nullptr) {
@@ -475,10 +482,9 @@ QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey
                   sample_level_twin(va, ka, vb, kb, ru, rv, info, linear, level_out);
                 },
                 out);
-  for (int c = 0; c < 4; ++c) {
-    out_a[c] = out[c];
-    out_b[c] = out[4 + c];
-  }
+  for (int c = 0; c < 4; ++c) out_a[c] = out[c];
+  for (int c = 0; c < 3; ++c) out_b[c] = out[4 + c];
+  out_b[3] = Float(1.0f);
 }
 
 // wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.
