@@ -16,7 +16,22 @@ UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
   return UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
 }
 
+// Whether the albedo map is magnified in every lane of the batch and no bias can lift it: each lane's footprint
+// is at most one texel (rho² ≤ 1, where lod_from_derivatives gives at most 0) and the material's LOD bias is at
+// most 0. The sampler then reads level 0 of both maps whatever the exact LOD (sample_levels clamps any LOD plus
+// bias of at most 0 to level 0, and the LOD is read by nothing else here), so 0 serves, without the logarithm's
+// chain of dependent operations.
+bool NormalMappingProgram::magnified(const UvDerivatives& d) const {
+  const TextureSampler& albedo = textures_.first();
+  if (albedo.state().lod_bias > 0.0f) return false;
+  const Float w(float(albedo.texture().width())), h(float(albedo.texture().height()));
+  const Float ax = d.dudx * w, ay = d.dvdx * h, bx = d.dudy * w, by = d.dvdy * h;
+  // NaN or infinite footprints fail the test (and go to lod_from_derivatives).
+  return xsimd::all(((ax * ax + ay * ay) <= Float(1.0f)) & ((bx * bx + by * by) <= Float(1.0f)));
+}
+
 Float NormalMappingProgram::albedo_lod(const UvDerivatives& d) const {
+  if (magnified(d)) return Float(0.0f);
   return textures_.first().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
@@ -25,6 +40,10 @@ Float NormalMappingProgram::albedo_lod(const UvDerivatives& d) const {
 // back from its own lanes (the computation is lane by lane: the bits are those of two evaluations).
 void NormalMappingProgram::albedo_lods(const UvDerivatives& da, const UvDerivatives& db, Float& lod_a,
                                        Float& lod_b) const {
+  if (magnified(da) && magnified(db)) {
+    lod_a = lod_b = Float(0.0f);
+    return;
+  }
   if (lod_mode_ != LodMode::PerQuad) {
     lod_a = albedo_lod(da);
     lod_b = albedo_lod(db);

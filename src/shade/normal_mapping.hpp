@@ -22,6 +22,7 @@ public:
 private:
   struct Samples;
   shading::UvDerivatives derivatives(const Fragments& in) const;
+  bool magnified(const shading::UvDerivatives& d) const;
   simd::Float albedo_lod(const shading::UvDerivatives& d) const;
   void albedo_lods(const shading::UvDerivatives& a, const shading::UvDerivatives& b, simd::Float& lod_a,
                    simd::Float& lod_b) const;

@@ -504,6 +504,41 @@ TEST(TextureSampler, WrapFootprintsGiveTheBitsOfTheTexelPairs) {
     }
 }
 
+// The sampler reads level 0 for any LOD plus bias of at most 0, whatever its exact value (sample_levels clamps it
+// there): normal mapping relies on it and passes 0 for batches whose footprints are at most one texel (LOD at most
+// 0 in every lane) when the bias is at most 0. Every sampler state, biases 0 to -3, LOD clamps below and above 0.
+TEST(TextureSampler, EveryLodOfAtMostZeroReadsWhatLodZeroReads) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), coord(-3.0f, 4.0f), magnified(-64.0f, 0.0f);
+  Image img(32, 16, 4);
+  for (float& t : img.texels) t = unit(rng);
+  Texture albedo = make_mip_texture(img, TexelFormat::RGBA8, true, MipReduce::Box);
+  add_linear_copy(albedo);
+  const Texture normal = make_mip_texture(img, TexelFormat::RGBA8, false, MipReduce::Box);
+  for (SamplerState state : every_sampler_state())
+    for (const float bias : {0.0f, -0.5f, -3.0f})
+      for (const auto& [min_lod, max_lod] : {std::pair{0.0f, 16.0f}, std::pair{-2.0f, 16.0f}, std::pair{1.5f, 3.0f},
+                                             std::pair{-4.0f, -1.0f}}) {
+        state.lod_bias = bias;
+        state.min_lod = min_lod;
+        state.max_lod = max_lod;
+        for (const Texture* t : {static_cast<const Texture*>(&albedo), &normal}) {
+          const TextureSampler sampler(*t, state);
+          Lanes u, v, l;
+          for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = magnified(rng);
+          l[0] = 0.0f, l[1 % kLanes] = -64.0f, l[2 % kLanes] = -0.0f;
+          Float exact[4], zero[4];
+          sampler.sample(load(u), load(v), load(l), exact);
+          sampler.sample(load(u), load(v), Float(0.0f), zero);
+          for (int ch = 0; ch < 4; ++ch)
+            for (int i = 0; i < kLanes; ++i)
+              ASSERT_EQ(bits(lanes(exact[ch])[i]), bits(lanes(zero[ch])[i]))
+                  << filter_name(state.filter) << " bias " << bias << " clamp " << min_lod << ".." << max_lod
+                  << " LOD " << l[i] << " channel " << ch;
+        }
+      }
+}
+
 TEST(TextureSampler, DecodesEveryFormatLikeTheScalarTexelAccessor) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
