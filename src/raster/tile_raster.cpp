@@ -437,12 +437,11 @@ private:
   void count(std::uint32_t pass, const ShadeOutput& out) {
     alignas(64) float iterations[kLanes];
     out.iterations.store_aligned(iterations);
-    float longest = iterations[0], shortest = iterations[0];
-    for (int l = 1; l < kLanes; ++l) {
-      longest = std::max(longest, iterations[l]);
-      shortest = std::min(shortest, iterations[l]);
-    }
-    if (longest == shortest) {  // every lane alike (always, for a program without a trace): one bin
+    // Every lane alike (always, for a program without a trace): one compare instead of a scan.
+    const bool alike = xsimd::all(out.iterations == Float(iterations[0]));
+    float longest = iterations[0];
+    for (int l = 1; l < kLanes && !alike; ++l) longest = std::max(longest, iterations[l]);
+    if (alike) {  // one bin
       const auto n = std::uint64_t(longest);
       const auto lanes = std::uint64_t(std::popcount(pass));
       counters_.iterations_useful += n * lanes;
