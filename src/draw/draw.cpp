@@ -179,7 +179,7 @@ std::uint64_t DrawScratch::bytes() const {
   const ItemVertices& item = geometry_scratch.item;
   std::uint64_t total = capacity(item.clip) + capacity(item.frustum_code) + capacity(item.band_code) +
                         capacity(item.projected) + capacity(geometry.vertices) + capacity(geometry.triangles) +
-                        capacity(setups);
+                        capacity(setups) + capacity(tile_counters);
   for (const GeometryChunk& chunk : geometry_scratch.chunks)
     total += capacity(chunk.triangles) + capacity(chunk.clipped_vertices);
   for (const auto& chunk : bins.bins)
@@ -239,13 +239,16 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
     context.cache = &scene.texture_cache;
     context.cache_addresses = &*cache_addresses;
   }
-  std::vector<TileCounters> tile_counters(std::size_t(grid.count()));
+  std::vector<TileCounters>& tile_counters = scratch.tile_counters;  // kept: 8 KiB each, zeroed by their tiles
+  tile_counters.resize(std::size_t(grid.count()));
   std::atomic<int> tiles_done{0};
   std::mutex progress_mutex;
   const int report_every = std::max(1, grid.count() / 100);
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
     for (int tile = range.begin(); tile != range.end(); ++tile) {
-      kernel.raster_tile(context, tile, grid.rect(tile), bins, tile_counters[std::size_t(tile)]);
+      TileCounters& counters = tile_counters[std::size_t(tile)];
+      counters.reset();
+      kernel.raster_tile(context, tile, grid.rect(tile), bins, counters);
       const int done = ++tiles_done;
       if (options.progress && done % report_every == 0) {
         std::lock_guard lock(progress_mutex);

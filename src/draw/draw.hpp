@@ -33,6 +33,7 @@ struct DrawScratch {
   GeometryResult geometry;
   TriangleSetups setups;
   TileBins bins;
+  std::vector<TileCounters> tile_counters;  // one per tile, zeroed by its tile at the start of each draw
 
   std::uint64_t bytes() const;  // the arrays' capacity
 };

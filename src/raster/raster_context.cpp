@@ -1,6 +1,14 @@
 #include "raster/raster_context.hpp"
 
+#include <algorithm>
+
 namespace qdmr {
+
+void TileCounters::reset() {
+  static_cast<TileCounts&>(*this) = TileCounts{};
+  std::fill_n(iteration_histogram.begin(), histogram_bins, std::uint64_t(0));
+  histogram_bins = 0;
+}
 
 TileCounters& TileCounters::operator+=(const TileCounters& o) {
   bin_entries += o.bin_entries;
@@ -11,7 +19,8 @@ TileCounters& TileCounters::operator+=(const TileCounters& o) {
   quads_shaded += o.quads_shaded;
   pixels_shaded += o.pixels_shaded;
   pixels_depth_failed += o.pixels_depth_failed;
-  for (std::size_t i = 0; i < iteration_histogram.size(); ++i) iteration_histogram[i] += o.iteration_histogram[i];
+  for (int i = 0; i < o.histogram_bins; ++i) iteration_histogram[std::size_t(i)] += o.iteration_histogram[std::size_t(i)];
+  histogram_bins = std::max(histogram_bins, o.histogram_bins);
   iterations_useful += o.iterations_useful;
   iterations_executed += o.iterations_executed;
   cache_accesses += o.cache_accesses;

@@ -1,6 +1,7 @@
 #pragma once
 // What a draw kernel's tile rasterizer reads and writes, and the counters it keeps per tile. ISA-independent:
 // the draw stage fills it, any kernel consumes it.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -14,7 +15,8 @@
 
 namespace qdmr {
 
-struct TileCounters {
+// A tile's scalar counters (TileCounters adds its iteration histogram).
+struct TileCounts {
   std::uint64_t bin_entries = 0;       // triangles visited by this tile
   std::uint64_t blocks_rejected = 0;   // 8x8 blocks skipped by the coarse test
   std::uint64_t blocks_full = 0;       // 8x8 blocks entirely inside a triangle (no per-pixel edge test)
@@ -23,14 +25,29 @@ struct TileCounters {
   std::uint64_t quads_shaded = 0;      // 2x2 quads with at least one written pixel
   std::uint64_t pixels_shaded = 0;     // lanes written (covered and passed the depth test)
   std::uint64_t pixels_depth_failed = 0;
-  // Intersection loop iterations of the written pixels: histogram (last bin: that many or more), and lane
-  // use: useful = sum of the lanes' own iterations, executed = the batch's longest lane times the lane count.
-  static constexpr int kIterationBins = 1024;
-  std::array<std::uint64_t, kIterationBins + 1> iteration_histogram{};
+  // Intersection loop iterations' lane use: useful = sum of the lanes' own iterations, executed = the batch's
+  // longest lane times the lane count.
   std::uint64_t iterations_useful = 0, iterations_executed = 0;
   // The emulated texture cache (when on): texel reads replayed through it, and how many hit.
   std::uint64_t cache_accesses = 0, cache_hits = 0;
+};
 
+struct TileCounters : TileCounts {
+  // Intersection loop iterations of the written pixels: histogram (last bin: that many or more). Bins
+  // [0, histogram_bins) hold every count made since the counters were zero, so zeroing and summing touch only
+  // those (a frame's tiles are kept and zeroed in parallel; most programs fill bin 0 alone).
+  static constexpr int kIterationBins = 1024;
+  std::array<std::uint64_t, kIterationBins + 1> iteration_histogram{};
+  int histogram_bins = 0;
+
+  // `lanes` written pixels that ran n iterations each.
+  void count_iterations(std::uint64_t n, std::uint64_t lanes) {
+    const int bin = int(std::min<std::uint64_t>(n, kIterationBins));
+    iteration_histogram[std::size_t(bin)] += lanes;
+    histogram_bins = std::max(histogram_bins, bin + 1);
+  }
+  // Back to all zero.
+  void reset();
   TileCounters& operator+=(const TileCounters& o);
 };
 

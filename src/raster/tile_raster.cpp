@@ -445,13 +445,13 @@ private:
       const auto n = std::uint64_t(longest);
       const auto lanes = std::uint64_t(std::popcount(pass));
       counters_.iterations_useful += n * lanes;
-      counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)] += lanes;
+      counters_.count_iterations(n, lanes);
     } else {
       for (int l = 0; l < kLanes; ++l) {
         if (!((pass >> l) & 1u)) continue;
         const auto n = std::uint64_t(iterations[l]);
         counters_.iterations_useful += n;
-        ++counters_.iteration_histogram[std::min<std::uint64_t>(n, TileCounters::kIterationBins)];
+        counters_.count_iterations(n, 1);
       }
     }
     counters_.iterations_executed += std::uint64_t(longest) * kLanes;
