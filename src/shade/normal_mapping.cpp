@@ -24,10 +24,10 @@ UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
 bool NormalMappingProgram::magnified(const UvDerivatives& d) const {
   const TextureSampler& albedo = textures_.first();
   if (albedo.state().lod_bias > 0.0f) return false;
-  const Float w(float(albedo.texture().width())), h(float(albedo.texture().height()));
-  const Float ax = d.dudx * w, ay = d.dvdx * h, bx = d.dudy * w, by = d.dvdy * h;
+  Float px, py;
+  footprint_lengths2(albedo.view(), d.dudx, d.dvdx, d.dudy, d.dvdy, px, py);
   // NaN or infinite footprints fail the test (and go to lod_from_derivatives).
-  return xsimd::all(((ax * ax + ay * ay) <= Float(1.0f)) & ((bx * bx + by * by) <= Float(1.0f)));
+  return xsimd::all((px <= Float(1.0f)) & (py <= Float(1.0f)));
 }
 
 Float NormalMappingProgram::albedo_lod(const UvDerivatives& d) const {

@@ -75,6 +75,15 @@ struct SamplerKey {
 };
 SamplerKey sampler_key(const TextureView& texture, const SamplerState& state);
 
+// The squared lengths of a pixel's footprint along x and y in level-0 texels: |d(uv*size)/dx|², |d(uv*size)/dy|².
+inline void footprint_lengths2(const TextureView& view, const simd::Float& dudx, const simd::Float& dvdx,
+                               const simd::Float& dudy, const simd::Float& dvdy, simd::Float& px, simd::Float& py) {
+  const simd::Float w(float(view.texture().width())), h(float(view.texture().height()));
+  const simd::Float ax = dudx * w, ay = dvdx * h, bx = dudy * w, by = dvdy * h;
+  px = ax * ax + ay * ay;
+  py = bx * bx + by * by;
+}
+
 // LOD in level-0 texels from UV derivatives, GL formula: log2(max(|d(uv*size)/dx|, |d(uv*size)/dy|)).
 // A zero footprint gives -64; non-finite derivatives give the last level. Inline: every shading program's
 // sample waits on it, and a call would also make the caller store its live vector registers around it.
@@ -82,9 +91,8 @@ inline simd::Float lod_from_derivatives(const TextureView& view, const simd::Flo
                                         const simd::Float& dudy, const simd::Float& dvdy) {
   using simd::Float;
   constexpr float kMinLod = -64.0f;  // LOD of a zero (or denormal) footprint
-  const Float w(float(view.texture().width())), h(float(view.texture().height()));
-  const Float ax = dudx * w, ay = dvdx * h, bx = dudy * w, by = dvdy * h;
-  const Float px = ax * ax + ay * ay, py = bx * bx + by * by;
+  Float px, py;
+  footprint_lengths2(view, dudx, dvdx, dudy, dvdy, px, py);
   const Float rho2 = xsimd::select(px > py, px, py);
   const simd::Mask tiny = rho2 < Float(1.17549435e-38f);  // zero or denormal
   // 0.5 * log2(rho^2) = log2(rho): exact integers for power-of-two footprints.
