@@ -82,8 +82,8 @@ public:
       cx_ = xsimd::select(cross_x, xsimd::to_int(xsimd::floor(px / cell)), cx_);
       cy_ = xsimd::select(cross_y, xsimd::to_int(xsimd::floor(py / cell)), cy_);
     } else {
-      cx_ = xsimd::select(cross_x, xsimd::select(grid_.pos_x, cx_ + Int(1), cx_ - Int(1)), cx_);
-      cy_ = xsimd::select(cross_y, xsimd::select(grid_.pos_y, cy_ + Int(1), cy_ - Int(1)), cy_);
+      cx_ = xsimd::select(cross_x, cx_ + grid_.step_x, cx_);
+      cy_ = xsimd::select(cross_y, cy_ + grid_.step_y, cy_);
     }
     // After a crossing: stay, go up one level (the talk's fix for degeneration into linear search), or go up
     // while the wall just crossed is also a wall of the parent.

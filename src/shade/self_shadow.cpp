@@ -79,7 +79,6 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   const RepeatOrigin origin(p, surface.width(), surface.height());
   const Float dx = p.du * width, dy = p.dv * height;  // texels per unit of depth climbed
   const GridRay ray(x0, y0, dx, dy);
-  const Int step_x = xsimd::select(ray.pos_x, Int(1), Int(-1)), step_y = xsimd::select(ray.pos_y, Int(1), Int(-1));
 
   // Along a wall the ray is never inside a column.
   const Mask along_wall = ((dx == zero) & (x0 == xsimd::floor(x0))) | ((dy == zero) & (y0 == xsimd::floor(y0)));
@@ -87,14 +86,14 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   // crossing is computed from its integer wall, (wall - x0) * inv_dx (crossing()), at every level alike.
   const Int t0x = xsimd::to_int(xsimd::select(dx > zero, xsimd::ceil(x0) - Float(1.0f), xsimd::floor(x0)));
   const Int t0y = xsimd::to_int(xsimd::select(dy > zero, xsimd::ceil(y0) - Float(1.0f), xsimd::floor(y0)));
-  const Float wall_x0 = xsimd::to_float(xsimd::select(ray.pos_x, t0x + Int(1), t0x));
-  const Float wall_y0 = xsimd::to_float(xsimd::select(ray.pos_y, t0y + Int(1), t0y));
+  const Float wall_x0 = xsimd::to_float(t0x + ray.exit_x);
+  const Float wall_y0 = xsimd::to_float(t0y + ray.exit_y);
   const Float tx0 = xsimd::select(dx != zero, crossing<false>(wall_x0, x0, dx, ray.inv_dx), inf);
   const Float ty0 = xsimd::select(dy != zero, crossing<false>(wall_y0, y0, dy, ray.inv_dy), inf);
   Float c = xsimd::min(tx0, ty0);
   const IntMask first_x = int_mask(tx0 <= ty0), first_y = int_mask(ty0 <= tx0);
   Int level(0);
-  Int cx = xsimd::select(first_x, t0x + step_x, t0x), cy = xsimd::select(first_y, t0y + step_y, t0y);
+  Int cx = xsimd::select(first_x, t0x + ray.step_x, t0x), cy = xsimd::select(first_y, t0y + ray.step_y, t0y);
   climb_aligned(level, cx, cy, int_mask(p.active), first_x, first_y, ray.pos_x, ray.pos_y, top);
 
   // Where the ray is above every column: the depth of the highest texel when the top level covers the map
@@ -124,8 +123,8 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
     c = xsimd::select(advance, xsimd::max(xsimd::min(tx, ty), c), c);
     const IntMask moving = int_mask(advance);
     const IntMask cross_x = moving & int_mask(tx <= ty), cross_y = moving & int_mask(ty <= tx);
-    cx = xsimd::select(cross_x, cx + step_x, cx);
-    cy = xsimd::select(cross_y, cy + step_y, cy);
+    cx = xsimd::select(cross_x, cx + ray.step_x, cx);
+    cy = xsimd::select(cross_y, cy + ray.step_y, cy);
     climb_aligned(level, cx, cy, moving, cross_x, cross_y, ray.pos_x, ray.pos_y, top);
     active = active & ~(advance & (p.s - c <= floor_depth));
   }

@@ -70,19 +70,25 @@ inline simd::Float crossing(const simd::Float& wall, const simd::Float& origin, 
 }
 
 // A ray over a texel grid, x(t) = x0 + dx t, y(t) = y0 + dy t (texel units), with what every cell step asks of
-// it computed once: the reciprocals of its direction (crossing) and the sign of each axis, as masks.
+// it computed once: the reciprocals of its direction (crossing) and the sign of each axis, as masks and as the
+// index steps they imply (vectors: a cell step adds them instead of selecting by a mask, which the loops would
+// reload from memory at every step once the constant masks outnumber AVX-512's mask registers).
 struct GridRay {
   GridRay(const simd::Float& x0_in, const simd::Float& y0_in, const simd::Float& dx_in, const simd::Float& dy_in)
       : x0(x0_in), y0(y0_in), dx(dx_in), dy(dy_in), inv_dx(simd::Float(1.0f) / dx), inv_dy(simd::Float(1.0f) / dy),
         pos_x(simd::int_mask(dx > simd::Float(0.0f))), pos_y(simd::int_mask(dy > simd::Float(0.0f))),
         neg_x(dx < simd::Float(0.0f)), neg_y(dy < simd::Float(0.0f)), flat_x(dx == simd::Float(0.0f)),
-        flat_y(dy == simd::Float(0.0f)) {}
+        flat_y(dy == simd::Float(0.0f)), exit_x(xsimd::select(pos_x, simd::Int(1), simd::Int(0))),
+        exit_y(xsimd::select(pos_y, simd::Int(1), simd::Int(0))), step_x(exit_x + exit_x - simd::Int(1)),
+        step_y(exit_y + exit_y - simd::Int(1)) {}
 
   simd::Float x0, y0, dx, dy;
   simd::Float inv_dx, inv_dy;  // fl(1 / dx), fl(1 / dy)
   simd::IntMask pos_x, pos_y;  // dx > 0, dy > 0: the cell index steps up
   simd::Mask neg_x, neg_y;     // dx < 0, dy < 0
   simd::Mask flat_x, flat_y;   // dx == 0, dy == 0: parallel to that axis's walls
+  simd::Int exit_x, exit_y;    // 1 where the index steps up, else 0: the exit wall of cell c is c + exit
+  simd::Int step_x, step_y;    // +1 where the index steps up, else -1: the cell after an exit wall is c + step
 };
 
 // Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray at t: t is compared with
@@ -117,8 +123,8 @@ inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::
   using simd::Int;
   const Float inf(std::numeric_limits<float>::infinity());
   const Float cell = xsimd::to_float(Int(1) << level);
-  const Float wall_x = xsimd::to_float(xsimd::select(ray.pos_x, cx + Int(1), cx)) * cell;
-  const Float wall_y = xsimd::to_float(xsimd::select(ray.pos_y, cy + Int(1), cy)) * cell;
+  const Float wall_x = xsimd::to_float(cx + ray.exit_x) * cell;
+  const Float wall_y = xsimd::to_float(cy + ray.exit_y) * cell;
   tx = xsimd::select(ray.flat_x, inf, crossing<Fp64>(wall_x, ray.x0, ray.dx, ray.inv_dx));
   ty = xsimd::select(ray.flat_y, inf, crossing<Fp64>(wall_y, ray.y0, ray.dy, ray.inv_dy));
 }
