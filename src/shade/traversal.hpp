@@ -80,7 +80,8 @@ struct GridRay {
         neg_x(dx < simd::Float(0.0f)), neg_y(dy < simd::Float(0.0f)), flat_x(dx == simd::Float(0.0f)),
         flat_y(dy == simd::Float(0.0f)), exit_x(xsimd::select(pos_x, simd::Int(1), simd::Int(0))),
         exit_y(xsimd::select(pos_y, simd::Int(1), simd::Int(0))), step_x(exit_x + exit_x - simd::Int(1)),
-        step_y(exit_y + exit_y - simd::Int(1)) {}
+        step_y(exit_y + exit_y - simd::Int(1)),
+        regular(xsimd::all(~(flat_x | flat_y) & finite(inv_dx) & finite(inv_dy) & finite(x0) & finite(y0))) {}
 
   simd::Float x0, y0, dx, dy;
   simd::Float inv_dx, inv_dy;  // fl(1 / dx), fl(1 / dy)
@@ -89,11 +90,17 @@ struct GridRay {
   simd::Mask flat_x, flat_y;   // dx == 0, dy == 0: parallel to that axis's walls
   simd::Int exit_x, exit_y;    // 1 where the index steps up, else 0: the exit wall of cell c is c + exit
   simd::Int step_x, step_y;    // +1 where the index steps up, else -1: the cell after an exit wall is c + step
+  // Every lane has a finite origin and a nonzero direction with finite reciprocals in both axes, so no crossing
+  // is NaN or parallel: the cell stepping can skip the parallel lanes' rules (the same results for such rays).
+  bool regular;
+
+private:
+  static simd::Mask finite(const simd::Float& f) { return xsimd::abs(f) <= simd::Float(3.4028235e38f); }
 };
 
 // Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray at t: t is compared with
 // where the ray crosses the parent's mid lines, computed exactly as wall crossings are, so a ray standing on a wall
-// is never put back into the cell it just left.
+// is never put back into the cell it just left. t is never NaN.
 template <bool Fp64 = false>
 inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const GridRay& ray, simd::Int& level,
                              simd::Int& cx, simd::Int& cy) {
@@ -105,12 +112,21 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
   const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
   const Float tx = crossing<Fp64>(mid_x, ray.x0, ray.dx, ray.inv_dx);
   const Float ty = crossing<Fp64>(mid_y, ray.y0, ray.dy, ray.inv_dy);
-  const simd::Mask high_x =
-      (simd::float_mask(ray.pos_x) & (t >= tx)) | (ray.neg_x & (t < tx)) | (ray.flat_x & (ray.x0 >= mid_x));
-  const simd::Mask high_y =
-      (simd::float_mask(ray.pos_y) & (t >= ty)) | (ray.neg_y & (t < ty)) | (ray.flat_y & (ray.y0 >= mid_y));
-  cx = xsimd::select(descend, cx * Int(2) + xsimd::select(simd::int_mask(high_x), Int(1), Int(0)), cx);
-  cy = xsimd::select(descend, cy * Int(2) + xsimd::select(simd::int_mask(high_y), Int(1), Int(0)), cy);
+  Int high_x, high_y;  // 1 for the child on the high side of the mid line
+  if (ray.regular) {
+    // Neither t (never NaN, the caller's promise) nor a crossing is NaN, so t < tx is exactly !(t >= tx).
+    high_x = xsimd::select(simd::int_mask(t >= tx), ray.exit_x, ray.exit_x ^ Int(1));
+    high_y = xsimd::select(simd::int_mask(t >= ty), ray.exit_y, ray.exit_y ^ Int(1));
+  } else {
+    const simd::Mask hx =
+        (simd::float_mask(ray.pos_x) & (t >= tx)) | (ray.neg_x & (t < tx)) | (ray.flat_x & (ray.x0 >= mid_x));
+    const simd::Mask hy =
+        (simd::float_mask(ray.pos_y) & (t >= ty)) | (ray.neg_y & (t < ty)) | (ray.flat_y & (ray.y0 >= mid_y));
+    high_x = xsimd::select(simd::int_mask(hx), Int(1), Int(0));
+    high_y = xsimd::select(simd::int_mask(hy), Int(1), Int(0));
+  }
+  cx = xsimd::select(descend, cx * Int(2) + high_x, cx);
+  cy = xsimd::select(descend, cy * Int(2) + high_y, cy);
   level = xsimd::select(descend, child_level, level);
 }
 
@@ -125,8 +141,12 @@ inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::
   const Float cell = xsimd::to_float(Int(1) << level);
   const Float wall_x = xsimd::to_float(cx + ray.exit_x) * cell;
   const Float wall_y = xsimd::to_float(cy + ray.exit_y) * cell;
-  tx = xsimd::select(ray.flat_x, inf, crossing<Fp64>(wall_x, ray.x0, ray.dx, ray.inv_dx));
-  ty = xsimd::select(ray.flat_y, inf, crossing<Fp64>(wall_y, ray.y0, ray.dy, ray.inv_dy));
+  tx = crossing<Fp64>(wall_x, ray.x0, ray.dx, ray.inv_dx);
+  ty = crossing<Fp64>(wall_y, ray.y0, ray.dy, ray.inv_dy);
+  if (!ray.regular) {
+    tx = xsimd::select(ray.flat_x, inf, tx);
+    ty = xsimd::select(ray.flat_y, inf, ty);
+  }
 }
 
 // After a wall crossing, the `climbing` lanes go up while the wall just crossed (cross_x / cross_y) is also a
