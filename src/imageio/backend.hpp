@@ -76,4 +76,9 @@ private:
   Reader* reader_ = nullptr;
 };
 
+// The header a ReadFile of `path` would find (true), or false with `error` set where it would not open; no pixel is
+// read, and the image module is loaded only for a file that neither the native readers nor libtiff (a TIFF
+// OpenImageIO converts: read_tiff_header in imageio/tiff_reader.cpp) can answer for.
+bool read_header(const std::string& path, ReadSpec& spec, std::string& error);
+
 }  // namespace qdmr::imageio

@@ -5,7 +5,8 @@
 // files as OpenImageIO read them. They are the formats of textures, and reading them without OpenImageIO spares a
 // job the loading of the image module (~260 shared libraries, 0.3-0.5 s: docs/performance.md). Every other file
 // goes to the backend (imageio/backend.hpp): the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says
-// which), and formats qdmr does not take as textures (refused after the backend names them).
+// which; their header alone is read here: read_header), and formats qdmr does not take as textures (refused after
+// the backend names them).
 //
 // What OpenImageIO 2.4 does and these readers do too: libpng expands palettes, low bit depths and tRNS to 8-bit
 // channels (and alpha), 16-bit samples in host order, an interlaced file read whole, a JPEG's CMYK or YCCK
@@ -75,6 +76,10 @@ std::unique_ptr<NativeReader> opened(Arguments&&... arguments) {
 std::unique_ptr<NativeReader> open_png(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_jpeg(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_tiff(const std::string& path, ReadSpec& spec, bool& claimed);
+// The header (size, channels, sample type; no metadata) that OpenImageIO's open gives a TIFF, read by libtiff as
+// OpenImageIO reads it: for the layouts open_tiff leaves to the backend, which a plan need not load for them. False,
+// `spec` left as it was, for a file libtiff cannot open, one OpenImageIO refuses, or one this cannot be sure of.
+bool read_tiff_header(const std::string& path, ReadSpec& spec);
 std::unique_ptr<NativeReader> open_exr(const std::string& path, ReadSpec& spec, std::string& error);
 std::unique_ptr<NativeReader> open_pnm(const std::string& path, ReadSpec& spec, std::string& error);
 

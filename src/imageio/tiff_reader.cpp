@@ -2,7 +2,8 @@
 // through unchanged: grey (min-is-black) or RGB samples of 8 or 16 bits unsigned or 32-bit floats, in strips or
 // tiles, interleaved or in planes, with any compression libtiff decodes but JPEG (which OpenImageIO may read
 // through libtiff's RGBA interface). OpenImageIO converts the other layouts (palettes, min-is-white, CMYK, 1- to
-// 14-bit samples, signed or half-float samples, YCbCr), and reads the first image only, as here; they stay its.
+// 14-bit samples, signed or half-float samples, YCbCr), and reads the first image only, as here; they stay its to
+// read, but their header, which a plan needs, is read here too, as OpenImageIO's open finds it (read_tiff_header).
 #include <tiffio.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "imageio/native_reader.hpp"
@@ -22,6 +24,22 @@ constexpr int kMaxKeptMessages = 3;  // a damaged strip may be reported once per
 
 std::size_t size_of(PixelType type) { return type == PixelType::UInt8 ? 1 : type == PixelType::UInt16 ? 2 : 4; }
 
+// A libtiff message unprinted (its default handlers write to stderr). OpenImageIO ignores libtiff's warnings
+// (unknown tags, a missing optional field).
+int ignore_message(TIFF*, void*, const char*, const char*, va_list) { return 1; }
+
+// `path` opened by libtiff as OpenImageIO opens it ("m": read, not memory-mapped), its errors to `on_error`; null
+// if libtiff cannot read its first directory.
+TIFF* open_file(const std::string& path, TIFFErrorHandlerExtR on_error, void* user_data) {
+  TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
+  if (!options) return nullptr;
+  TIFFOpenOptionsSetErrorHandlerExtR(options, on_error, user_data);
+  TIFFOpenOptionsSetWarningHandlerExtR(options, ignore_message, nullptr);
+  TIFF* tiff = TIFFOpenExt(path.c_str(), "rm", options);
+  TIFFOpenOptionsFree(options);
+  return tiff;
+}
+
 class TiffReader final : public NativeReader {
 public:
   ~TiffReader() override {
@@ -32,12 +50,7 @@ public:
   // left as it was.
   bool open(const std::string& path, ReadSpec& spec, bool& claimed) {
     claimed = false;
-    TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
-    if (!options) return false;
-    TIFFOpenOptionsSetErrorHandlerExtR(options, on_error, this);
-    TIFFOpenOptionsSetWarningHandlerExtR(options, on_warning, this);
-    tiff_ = TIFFOpenExt(path.c_str(), "rm", options);  // "m": read, not memory-mapped, as OpenImageIO opens it
-    TIFFOpenOptionsFree(options);
+    tiff_ = open_file(path, on_error, this);
     if (!tiff_ || !passes_through()) return false;
     claimed = true;
     // Uniform: libtiff keeps one SampleFormat and one BitsPerSample for every channel.
@@ -77,8 +90,6 @@ private:
     ++self.messages_;
     return 1;  // handled: libtiff's default handler would print to stderr
   }
-  // OpenImageIO ignores libtiff's warnings (unknown tags, a missing optional field).
-  static int on_warning(TIFF*, void*, const char*, const char*, va_list) { return 1; }
 
   // Whether OpenImageIO would pass this layout through as stored; also sets the fields the read uses.
   bool passes_through() {
@@ -191,10 +202,77 @@ private:
   std::size_t converted_size_ = 0;
 };
 
+// The header OpenImageIO 2.4's reader gives the first image of `tiff` (tiffinput.cpp: readspec,
+// readspec_photometric, seek_subimage), from the fields it reads, read as it reads them; false where its open fails
+// (samples it has no type for, a layout libtiff's RGBA interface refuses) or this cannot be sure of what it gives.
+bool oiio_header(TIFF* tiff, ReadSpec& spec) {
+  std::uint32_t width = 0, height = 0, depth = 1;
+  std::uint16_t samples = 1, bits = 8, format = SAMPLEFORMAT_UINT, compression = COMPRESSION_NONE;
+  TIFFGetField(tiff, TIFFTAG_IMAGEWIDTH, &width);
+  TIFFGetField(tiff, TIFFTAG_IMAGELENGTH, &height);
+  TIFFGetFieldDefaulted(tiff, TIFFTAG_IMAGEDEPTH, &depth);
+  TIFFGetFieldDefaulted(tiff, TIFFTAG_SAMPLESPERPIXEL, &samples);
+  TIFFGetField(tiff, TIFFTAG_BITSPERSAMPLE, &bits);  // 8 without the tag, as OpenImageIO has it (libtiff says 1)
+  TIFFGetFieldDefaulted(tiff, TIFFTAG_SAMPLEFORMAT, &format);
+  TIFFGetFieldDefaulted(tiff, TIFFTAG_COMPRESSION, &compression);
+  std::uint16_t photometric = samples == 1 ? PHOTOMETRIC_MINISBLACK : PHOTOMETRIC_RGB;
+  TIFFGetField(tiff, TIFFTAG_PHOTOMETRIC, &photometric);
+  if (depth != 1) return false;  // a volume (ImageDepth): left to OpenImageIO, as by the reader
+  int channels = samples;
+  // The samples' type, fewer bits widened (1 to 6 to 8, 10 to 14 to 16, 24 to 32); OpenImageIO's types but 8- and
+  // 16-bit unsigned (signed, half, 32-bit integer, double) are floats here. None: a type OpenImageIO has none for.
+  std::optional<PixelType> type;
+  const bool to_8 = bits == 1 || bits == 2 || bits == 4 || bits == 6 || bits == 8;
+  const bool to_16 = bits == 10 || bits == 12 || bits == 14 || bits == 16;
+  const bool numbers = format == SAMPLEFORMAT_UINT || format == SAMPLEFORMAT_INT || format == SAMPLEFORMAT_IEEEFP;
+  if (to_8)
+    type = format == SAMPLEFORMAT_INT ? PixelType::Float : PixelType::UInt8;  // any other format read as unsigned
+  else if (to_16 && format == SAMPLEFORMAT_UINT)
+    type = PixelType::UInt16;
+  else if (((to_16 || bits == 24 || bits == 32) && numbers) || (bits == 64 && format == SAMPLEFORMAT_IEEEFP))
+    type = PixelType::Float;
+  if (photometric == PHOTOMETRIC_SEPARATED) {
+    std::uint16_t inks = INKSET_CMYK;
+    TIFFGetFieldDefaulted(tiff, TIFFTAG_INKSET, &inks);
+    if (inks == INKSET_CMYK && channels == 4) channels = 3;  // CMYK to RGB; other inks as stored
+  } else if (photometric == PHOTOMETRIC_PALETTE) {
+    // To 8-bit RGB, through 2^bits colours that OpenImageIO takes for granted: a palette of more than 8 bits, or
+    // with no colour map, is left to it.
+    std::uint16_t *red = nullptr, *green = nullptr, *blue = nullptr;
+    if (bits > 8 || TIFFGetField(tiff, TIFFTAG_COLORMAP, &red, &green, &blue) != 1) return false;
+    channels = 3;
+    type = PixelType::UInt8;
+  }
+  // JPEG-compressed samples other than three, and colour spaces other than RGB (YCbCr, CIE L*a*b*, LogL, LogLuv),
+  // are read through libtiff's RGBA interface: 8-bit samples, as many channels; the open fails where libtiff says
+  // that interface cannot read the file. OpenImageIO asks it after reading the Exif directory and going back to the
+  // image's: a file with one is left to it.
+  const bool jpeg = compression == COMPRESSION_JPEG || compression == COMPRESSION_OJPEG;
+  const bool not_rgb = photometric == PHOTOMETRIC_YCBCR || photometric == PHOTOMETRIC_CIELAB ||
+                       photometric == PHOTOMETRIC_ICCLAB || photometric == PHOTOMETRIC_ITULAB ||
+                       photometric == PHOTOMETRIC_LOGL || photometric == PHOTOMETRIC_LOGLUV;
+  if ((jpeg && channels != 3) || not_rgb) {
+    toff_t exif = 0;
+    char why_not[1024];
+    if (TIFFGetField(tiff, TIFFTAG_EXIFIFD, &exif) == 1 || TIFFRGBAImageOK(tiff, why_not) != 1) return false;
+    type = PixelType::UInt8;
+  }
+  if (!type) return false;
+  // OpenImageIO's limits (1024 channels, 32 GiB of samples) are not checked: a texture's (4 channels, 16384 pixels
+  // a side, read_image_header's checks) are inside them, so a file over them is refused either way.
+  set_image(spec, int(width), int(height), channels, "tiff", *type);
+  return true;
+}
+
 }  // namespace
 
 std::unique_ptr<NativeReader> open_tiff(const std::string& path, ReadSpec& spec, bool& claimed) {
   return opened<TiffReader>(path, spec, claimed);
+}
+
+bool read_tiff_header(const std::string& path, ReadSpec& spec) {
+  const std::unique_ptr<TIFF, void (*)(TIFF*)> tiff(open_file(path, ignore_message, nullptr), TIFFClose);
+  return tiff && oiio_header(tiff.get(), spec);
 }
 
 }  // namespace qdmr::imageio

@@ -267,9 +267,8 @@ Error read_error(const std::string& where, const std::filesystem::path& file, st
   return Error(where, "cannot read '" + shown_path(file) + "': " + message);
 }
 
-// The file checked (kind, size), opened, and its header checked (format, size, channels, PNM fields, a
-// JPEG's end marker): nothing decoded yet.
-std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& file, const std::string& where) {
+// The file checked before it is opened (kind, size, an OpenEXR header, PNG chunks, PNM fields): its size.
+std::uint64_t check_file(const std::filesystem::path& file, const std::string& where) {
   const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const std::uint64_t size = check_input_file(file, where, InputKind::Image);
   // OpenImageIO gives a file to OpenEXR by its magic number whatever its extension.
@@ -281,10 +280,13 @@ std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& fil
   if (const std::string magic = bytes_of(file, 0, 2);
       magic.size() == 2 && magic[0] == 'P' && std::string_view("123456fF").find(magic[1]) != std::string_view::npos)
     if (const std::string problem = check_pnm(file, size); !problem.empty()) throw fail(problem);
-  std::string error;
-  auto in = std::make_unique<imageio::ReadFile>(file.string(), error);
-  if (!*in) throw fail(error);
-  const imageio::ReadSpec& spec = in->spec();
+  return size;
+}
+
+// The header of the file (of `size` bytes) checked: format, size, channels, a JPEG's end marker, a PNG's IEND.
+void check_header(const std::filesystem::path& file, const std::string& where, std::uint64_t size,
+                  const imageio::ReadSpec& spec) {
+  const auto fail = [&](const std::string& message) { return read_error(where, file, message); };
   const std::string& format = spec.format;
   if (std::find(std::begin(kFormats), std::end(kFormats), format) == std::end(kFormats))
     throw fail("unsupported image format '" + format + "' (textures are PNG, JPEG, OpenEXR, TIFF or PGM/PPM)");
@@ -305,6 +307,15 @@ std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& fil
   if (spec.depth > 1) throw fail("volume images are not supported");
   if (spec.channels < 1 || spec.channels > 4)
     throw fail(std::to_string(spec.channels) + " channels (textures take 1 to 4)");
+}
+
+// The file checked, opened, and its header checked: nothing decoded yet.
+std::unique_ptr<imageio::ReadFile> open_checked(const std::filesystem::path& file, const std::string& where) {
+  const std::uint64_t size = check_file(file, where);
+  std::string error;
+  auto in = std::make_unique<imageio::ReadFile>(file.string(), error);
+  if (!*in) throw read_error(where, file, error);
+  check_header(file, where, size, in->spec());
   return in;
 }
 
@@ -315,8 +326,12 @@ int source_bits(const imageio::ReadSpec& spec) {
 }  // namespace
 
 ImageHeader read_image_header(const std::filesystem::path& file, const std::string& where) {
-  const auto in = open_checked(file, where);
-  const imageio::ReadSpec& spec = in->spec();
+  const std::uint64_t size = check_file(file, where);
+  // The header alone, which a TIFF that OpenImageIO converts gives without the image module.
+  imageio::ReadSpec spec;
+  std::string error;
+  if (!imageio::read_header(file.string(), spec, error)) throw read_error(where, file, error);
+  check_header(file, where, size, spec);
   return {spec.width, spec.height, spec.channels, source_bits(spec)};
 }
 

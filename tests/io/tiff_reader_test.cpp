@@ -2,20 +2,25 @@
 // and gives what OpenImageIO's reader gives (with oiio:UnassociatedAlpha, as the backend opens files): the same
 // size, channels, sample type, Software tag and every sample's bits, over strips and tiles, interleaved and planar
 // samples, every compression but JPEG, both byte orders and extra channels. The layouts OpenImageIO converts are
-// left to it, and damaged pixel data fails in both readers.
+// left to it, but their header (read_tiff_header, all a plan reads) is the one OpenImageIO's open gives, damaged
+// directories included, and reading it loads no image module. Damaged pixel data fails in both readers.
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
 #include <tiffio.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "imageio/native_reader.hpp"
 #include "io/read_both_ways.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/texture/image.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -32,7 +37,7 @@ struct TiffLayout {
   std::uint16_t channels, photometric, bits, format;
   std::uint16_t compression = COMPRESSION_NONE, predictor = PREDICTOR_NONE;
   bool separate = false;
-  std::uint32_t rows_per_strip = 1;  // 0: tiled, 16 x 16
+  std::uint32_t rows_per_strip = 1;  // 0: tiled, 16 x 16 (samples of 8 bits or more)
   bool big_endian = false;
   std::uint16_t extra = EXTRASAMPLE_UNASSALPHA;  // what the channels after the colour ones are
   const char* software = nullptr;
@@ -58,12 +63,17 @@ bool write_tiff_image(TIFF* tiff, const TiffLayout& layout, int image) {
   if (layout.predictor != PREDICTOR_NONE) TIFFSetField(tiff, TIFFTAG_PREDICTOR, layout.predictor);
   if (layout.software) TIFFSetField(tiff, TIFFTAG_SOFTWARE, layout.software);
   if (layout.orientation != 0) TIFFSetField(tiff, TIFFTAG_ORIENTATION, layout.orientation);
-  const std::uint16_t colour = layout.photometric == PHOTOMETRIC_RGB || layout.photometric == PHOTOMETRIC_YCBCR ? 3
-                               : layout.photometric == PHOTOMETRIC_SEPARATED                                   ? 4
-                                                                                                               : 1;
+  const bool three = layout.photometric == PHOTOMETRIC_RGB || layout.photometric == PHOTOMETRIC_YCBCR ||
+                     layout.photometric == PHOTOMETRIC_CIELAB;
+  const std::uint16_t colour = three ? 3 : layout.photometric == PHOTOMETRIC_SEPARATED ? 4 : 1;
   if (layout.channels > colour) {
     const std::vector<std::uint16_t> extra(layout.channels - colour, layout.extra);
     TIFFSetField(tiff, TIFFTAG_EXTRASAMPLES, std::uint16_t(extra.size()), extra.data());
+  }
+  if (layout.photometric == PHOTOMETRIC_YCBCR) {
+    // A chroma sample for every pixel, so rows are written as RGB's are; JPEG takes RGB and converts it.
+    TIFFSetField(tiff, TIFFTAG_YCBCRSUBSAMPLING, 1, 1);
+    if (layout.compression == COMPRESSION_JPEG) TIFFSetField(tiff, TIFFTAG_JPEGCOLORMODE, JPEGCOLORMODE_RGB);
   }
   if (layout.photometric == PHOTOMETRIC_PALETTE) {
     std::vector<std::uint16_t> r(256), g(256), b(256);
@@ -93,7 +103,7 @@ bool write_tiff_image(TIFF* tiff, const TiffLayout& layout, int image) {
       out[bit / 8 - (x * per_pixel * layout.bits) / 8] |=
           static_cast<unsigned char>((h & ((1u << layout.bits) - 1)) << (8 - layout.bits - bit % 8));
     } else {
-      std::memcpy(out, &h, bytes);
+      std::memcpy(out, &h, std::min(bytes, sizeof h));  // a double's high half left zero
     }
   };
   const std::uint16_t planes = layout.separate ? layout.channels : 1;
@@ -206,24 +216,50 @@ TEST(TiffReader, LayoutsOpenImageIOPassesThroughReadAsItReadsThem) {
   EXPECT_EQ(compared, int(std::size(kClaimed)));
 }
 
-// What OpenImageIO converts (palette to RGB, min-is-white inverted, 1-bit to 8, CMYK to RGB, JPEG through the RGBA
-// interface) or reads in a type the readers do not have (signed, half float, 32-bit integers) is not claimed:
-// the backend reads it, as before.
+// The layouts OpenImageIO converts that qdmr takes as textures (1 to 4 channels), which the readers leave to it:
+// every kind tiffinput.cpp treats apart (palettes; 1-, 2-, 4-, 10- and 12-bit samples; min-is-white; CMYK and other
+// inks; signed, half, 32-bit integer, 24-bit float and double samples; JPEG with three samples or through libtiff's
+// RGBA interface; YCbCr and CIE L*a*b*).
+const TiffLayout kConverted[] = {
+    {"palette8", 1, PHOTOMETRIC_PALETTE, 8, SAMPLEFORMAT_UINT},
+    {"palette4_lzw", 1, PHOTOMETRIC_PALETTE, 4, SAMPLEFORMAT_UINT, COMPRESSION_LZW, PREDICTOR_NONE, false, 8},
+    {"palette1_be", 1, PHOTOMETRIC_PALETTE, 1, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 1, true},
+    {"min_is_white1", 1, PHOTOMETRIC_MINISWHITE, 1, SAMPLEFORMAT_UINT},
+    {"min_is_white8", 1, PHOTOMETRIC_MINISWHITE, 8, SAMPLEFORMAT_UINT},
+    {"min_is_white16_alpha_deflate", 2, PHOTOMETRIC_MINISWHITE, 16, SAMPLEFORMAT_UINT, COMPRESSION_ADOBE_DEFLATE,
+     PREDICTOR_NONE, false, 4},
+    {"bilevel", 1, PHOTOMETRIC_MINISBLACK, 1, SAMPLEFORMAT_UINT},
+    {"grey2", 1, PHOTOMETRIC_MINISBLACK, 2, SAMPLEFORMAT_UINT},
+    {"grey4", 1, PHOTOMETRIC_MINISBLACK, 4, SAMPLEFORMAT_UINT},
+    {"rgba4", 4, PHOTOMETRIC_RGB, 4, SAMPLEFORMAT_UINT},
+    {"grey12", 1, PHOTOMETRIC_MINISBLACK, 12, SAMPLEFORMAT_UINT},
+    {"rgb10_planar", 3, PHOTOMETRIC_RGB, 10, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, true},
+    {"cmyk8", 4, PHOTOMETRIC_SEPARATED, 8, SAMPLEFORMAT_UINT},
+    {"cmyk16_be", 4, PHOTOMETRIC_SEPARATED, 16, SAMPLEFORMAT_UINT, COMPRESSION_NONE, PREDICTOR_NONE, false, 1, true},
+    {"three_inks8", 3, PHOTOMETRIC_SEPARATED, 8, SAMPLEFORMAT_UINT},
+    {"grey_int8", 1, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_INT},
+    {"grey_int16", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_INT},
+    {"rgb_int16", 3, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_INT},
+    {"grey_half", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_IEEEFP},
+    {"rgba_half_tiled", 4, PHOTOMETRIC_RGB, 16, SAMPLEFORMAT_IEEEFP, COMPRESSION_NONE, PREDICTOR_NONE, false, 0},
+    {"grey_uint32", 1, PHOTOMETRIC_MINISBLACK, 32, SAMPLEFORMAT_UINT},
+    {"grey_int32", 1, PHOTOMETRIC_MINISBLACK, 32, SAMPLEFORMAT_INT},
+    {"grey_float24", 1, PHOTOMETRIC_MINISBLACK, 24, SAMPLEFORMAT_IEEEFP},
+    {"grey_double", 1, PHOTOMETRIC_MINISBLACK, 64, SAMPLEFORMAT_IEEEFP},
+    {"rgb8_jpeg", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_JPEG, PREDICTOR_NONE, false, 16},
+    {"grey8_jpeg", 1, PHOTOMETRIC_MINISBLACK, 8, SAMPLEFORMAT_UINT, COMPRESSION_JPEG, PREDICTOR_NONE, false, 16},
+    {"ycbcr8_jpeg", 3, PHOTOMETRIC_YCBCR, 8, SAMPLEFORMAT_UINT, COMPRESSION_JPEG, PREDICTOR_NONE, false, 16},
+    {"ycbcr8", 3, PHOTOMETRIC_YCBCR, 8, SAMPLEFORMAT_UINT},
+    {"cielab8", 3, PHOTOMETRIC_CIELAB, 8, SAMPLEFORMAT_UINT},
+};
+
+// What OpenImageIO converts (palette to RGB, min-is-white inverted, fewer bits widened, CMYK to RGB, JPEG and YCbCr
+// through the RGBA interface) or reads in a type the readers do not have (signed, half float, 32-bit integers, double)
+// is not claimed: the backend reads it, as before.
 TEST(TiffReader, LayoutsOpenImageIOConvertsAreLeftToIt) {
-  const TiffLayout kLeft[] = {
-      {"palette8", 1, PHOTOMETRIC_PALETTE, 8, SAMPLEFORMAT_UINT},
-      {"min_is_white8", 1, PHOTOMETRIC_MINISWHITE, 8, SAMPLEFORMAT_UINT},
-      {"bilevel", 1, PHOTOMETRIC_MINISBLACK, 1, SAMPLEFORMAT_UINT},
-      {"grey4", 1, PHOTOMETRIC_MINISBLACK, 4, SAMPLEFORMAT_UINT},
-      {"cmyk8", 4, PHOTOMETRIC_SEPARATED, 8, SAMPLEFORMAT_UINT},
-      {"rgb8_jpeg", 3, PHOTOMETRIC_RGB, 8, SAMPLEFORMAT_UINT, COMPRESSION_JPEG, PREDICTOR_NONE, false, 16},
-      {"grey_int16", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_INT},
-      {"grey_half", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_IEEEFP},
-      {"grey_uint32", 1, PHOTOMETRIC_MINISBLACK, 32, SAMPLEFORMAT_UINT},
-  };
   TempDir dir;
   int left = 0;
-  for (const TiffLayout& layout : kLeft) {
+  for (const TiffLayout& layout : kConverted) {
     SCOPED_TRACE(layout.name);
     const fs::path file = dir / (std::string(layout.name) + ".tif");
     write_tiff_file(file, layout);
@@ -239,7 +275,7 @@ TEST(TiffReader, LayoutsOpenImageIOConvertsAreLeftToIt) {
     EXPECT_TRUE(spec.format.empty());
     ++left;
   }
-  EXPECT_EQ(left, int(std::size(kLeft)));
+  EXPECT_EQ(left, int(std::size(kConverted)));
 }
 
 // Asked for another type, the samples are converted as the PNG and JPEG readers convert them (k of b bits as
@@ -311,6 +347,150 @@ TEST(TiffReader, DamagedPixelDataFailsInBothReaders) {
     ++cases;
   }
   EXPECT_EQ(cases, 3);
+}
+
+// The header read_image_header makes of a reader's.
+ImageHeader header_of(const imageio::ReadSpec& spec) {
+  return {spec.width, spec.height, spec.channels,
+          spec.uniform && spec.type == PixelType::UInt8 ? 8 : spec.uniform && spec.type == PixelType::UInt16 ? 16 : 32};
+}
+
+// The header OpenImageIO's open gives (the backend, linked into the tests); none, with `error`, if it fails.
+std::optional<ImageHeader> oiio_header(const fs::path& file, std::string& error) {
+  imageio::ReadSpec spec;
+  imageio::Reader* reader = imageio::oiio_backend().open(file.string(), spec, error);
+  if (!reader) return std::nullopt;
+  imageio::oiio_backend().close(reader);
+  EXPECT_EQ(spec.format, "tiff");
+  EXPECT_EQ(spec.depth, 1);
+  return header_of(spec);
+}
+
+void expect_same(const ImageHeader& header, const ImageHeader& oiio) {
+  EXPECT_EQ(header.width, oiio.width);
+  EXPECT_EQ(header.height, oiio.height);
+  EXPECT_EQ(header.channels, oiio.channels);
+  EXPECT_EQ(header.source_bits, oiio.source_bits);
+}
+
+// Their header, which a plan reads with libtiff (imageio::read_tiff_header), is the one OpenImageIO's open gives.
+TEST(TiffHeader, LayoutsOpenImageIOConvertsHaveTheHeaderItGives) {
+  TempDir dir;
+  int compared = 0;
+  for (const TiffLayout& layout : kConverted) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    std::string error;
+    const std::optional<ImageHeader> oiio = oiio_header(file, error);
+    ASSERT_TRUE(oiio) << error;
+    imageio::ReadSpec spec;
+    ASSERT_TRUE(imageio::read_tiff_header(file.string(), spec));
+    EXPECT_EQ(spec.format, "tiff");
+    expect_same(header_of(spec), *oiio);
+    expect_same(read_image_header(file, "test"), *oiio);
+    ++compared;
+  }
+  EXPECT_EQ(compared, int(std::size(kConverted)));
+}
+
+// `qdmr plan` of a scene with such a texture runs with no image module to load (QDMR_IMAGEIO_MODULE naming no file);
+// rendering it still needs the module, and says so.
+TEST(TiffHeader, PlanReadsThemWithoutTheImageModule) {
+  TempDir dir;
+  const std::string plane = (source_dir() / "scenes" / "plane.json").string();
+  const std::string no_module = "QDMR_IMAGEIO_MODULE=" + (dir / "no-such-module.so").string();
+  const auto albedo = [&](const fs::path& file) { return "/materials/bricks/layers/0/albedo=" + file.string(); };
+  for (const TiffLayout& layout : kConverted) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    const CommandResult plan = run("/usr/bin/env", {no_module, cli().string(), "plan", plane, "--set", albedo(file)});
+    EXPECT_EQ(plan.exit_code, 0) << plan.output;
+  }
+  const CommandResult render = run("/usr/bin/env", {no_module, cli().string(), "render", plane, "-o",
+                                                     (dir / "p.png").string(), "--width", "32", "--height", "18",
+                                                     "--set", albedo(dir / "palette8.tif")});
+  EXPECT_EQ(render.exit_code, 2) << render.output;
+  EXPECT_NE(render.output.find("cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
+}
+
+// A TIFF libtiff opens but OpenImageIO's open refuses (samples it has no type for; a layout libtiff's RGBA interface
+// refuses) is left to it, and refused as before: one error line naming the file.
+TEST(TiffHeader, WhatOpenImageIORefusesIsRefusedAsBefore) {
+  const TiffLayout kRefused[] = {
+      {"grey_void16", 1, PHOTOMETRIC_MINISBLACK, 16, SAMPLEFORMAT_VOID},
+      {"grey_uint64", 1, PHOTOMETRIC_MINISBLACK, 64, SAMPLEFORMAT_UINT},
+      {"cielab_float", 3, PHOTOMETRIC_CIELAB, 32, SAMPLEFORMAT_IEEEFP},
+  };
+  TempDir dir;
+  for (const TiffLayout& layout : kRefused) {
+    SCOPED_TRACE(layout.name);
+    const fs::path file = dir / (std::string(layout.name) + ".tif");
+    write_tiff_file(file, layout);
+    std::string error;
+    EXPECT_FALSE(oiio_header(file, error));
+    EXPECT_FALSE(error.empty());
+    imageio::ReadSpec spec;
+    EXPECT_FALSE(imageio::read_tiff_header(file.string(), spec));
+    EXPECT_TRUE(spec.format.empty());
+    try {
+      read_image_header(file, "test");
+      ADD_FAILURE() << "not refused";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(file.filename().string()), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+}
+
+// Damaged directories: every byte of a converted TIFF's directory (and of the values that follow it) overwritten in
+// turn. Wherever libtiff's header is taken, OpenImageIO opens the file with the same header, or refuses it by its
+// limits (1024 channels, 32 GiB of samples), which qdmr's own checks are inside: they refuse it too, with one error
+// line naming the file. Any other file goes to OpenImageIO as before.
+TEST(TiffHeader, DamagedDirectoriesGiveOpenImageIOsHeader) {
+  TempDir dir;
+  int taken = 0;
+  for (const std::string name : {"palette8", "min_is_white8", "cmyk8", "grey_half", "grey8_jpeg", "ycbcr8_jpeg"}) {
+    SCOPED_TRACE(name);
+    const fs::path file = dir / "good.tif";
+    write_tiff_file(file, *std::find_if(std::begin(kConverted), std::end(kConverted),
+                                        [&](const TiffLayout& layout) { return layout.name == name; }));
+    const std::string bytes = read_file(file);
+    // Little-endian: the directory's offset, its entries' count, then 12 bytes an entry.
+    std::uint32_t directory = 0;
+    std::uint16_t entries = 0;
+    std::memcpy(&directory, bytes.data() + 4, 4);
+    ASSERT_LT(directory + 2, bytes.size());
+    std::memcpy(&entries, bytes.data() + directory, 2);
+    const std::size_t end = std::min<std::size_t>(bytes.size(), directory + 2 + 12 * entries + 4 + 64);
+    for (std::size_t at = directory; at < end; ++at)
+      for (const unsigned char value : {0x00, 0x03, 0xFF}) {
+        if (static_cast<unsigned char>(bytes[at]) == value) continue;
+        SCOPED_TRACE("byte " + std::to_string(at) + " = " + std::to_string(value));
+        std::string damaged = bytes;
+        damaged[at] = char(value);
+        const fs::path bad = dir / "bad.tif";
+        write_file(bad, damaged);
+        imageio::ReadSpec spec;
+        if (!imageio::read_tiff_header(bad.string(), spec)) continue;
+        std::string error;
+        const std::optional<ImageHeader> oiio = oiio_header(bad, error);
+        if (oiio) expect_same(header_of(spec), *oiio);
+        try {
+          const ImageHeader header = read_image_header(bad, "test");
+          ASSERT_TRUE(oiio) << "OpenImageIO refuses what libtiff's header took: " << error;
+          expect_same(header, *oiio);
+        } catch (const Error& e) {
+          const std::string message = e.what();
+          EXPECT_NE(message.find("bad.tif"), std::string::npos) << message;
+          EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+        }
+        ++taken;
+      }
+  }
+  EXPECT_GT(taken, 1000);
 }
 
 }  // namespace
