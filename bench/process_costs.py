@@ -3,7 +3,8 @@
 
   - `qdmr --help` and `qdmr plan` of a procedural scene, of one whose textures are PNG and JPEG files, of one
     with a TIFF, an OpenEXR, a PGM and a PFM texture (all read in process), and of one with a TIFF stored "min is
-    white", a layout OpenImageIO converts (which loads the image module): each at most 50 ms;
+    white", a layout OpenImageIO converts (the plan reads its header with libtiff; a render reads its pixels
+    through the image module): each at most 50 ms;
   - a whole `qdmr render` of the canonical scene (bench/llvmpipe/canonical.json, normal mapping, 1920x1080) to
     PNG: at most 2 x its warm frame + 50 ms, by wall time and by its stats' time_ms.total; its PNG written in at
     most 40 ms (time_ms.write); its frame (time_ms.draw, cold: the process's first) within 1.2 x the warm one;
@@ -65,7 +66,7 @@ def main():
     pfm = os.path.join(tmp, "grey.pfm")  # a 4x4 PFM, read in process
     with open(pfm, "wb") as f:
         f.write(b"Pf\n4 4\n-1.0\n" + bytes(64))
-    converted = os.path.join(tmp, "white.tif")  # a 4x4 min-is-white TIFF, read through the image module
+    converted = os.path.join(tmp, "white.tif")  # a 4x4 min-is-white TIFF: its pixels are read through the image module
     with open(converted, "wb") as f:
         entries = [(256, 3, 4), (257, 3, 4), (258, 3, 8), (259, 3, 1), (262, 3, 0), (273, 4, 8 + 2 + 12 * 8 + 4),
                    (278, 3, 4), (279, 4, 16)]  # 4x4, 8 bits, uncompressed, min is white, one strip
