@@ -63,6 +63,17 @@ Float edges_to_float(const Int64& low, const Int64& high) {
                       xsimd::bitwise_cast<Double>(high + magic_bits) - Double(kMagic));
 }
 
+// Bit j set where lane j of v is negative (its sign bit).
+std::uint32_t negative_lanes(const Int64& v) {
+#if defined(__AVX512F__)
+  return std::uint32_t(_mm512_movepi64_mask(__m512i(v)));
+#elif defined(__AVX__)
+  return std::uint32_t(_mm256_movemask_pd(_mm256_castsi256_pd(__m256i(v))));
+#else
+  return std::uint32_t(_mm_movemask_pd(_mm_castsi128_pd(__m128i(v))));
+#endif
+}
+
 // Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside.
 int classify_block(const TriangleSetup& s, int bx, int by) {
   bool full = true;
@@ -303,15 +314,20 @@ private:
     if (full && whole) {
       inside = kAllLanes;
     } else {
-      alignas(64) std::int64_t lane_w[3][kLanes];
-      for (int i = 0; i < 3; ++i)
-        for (int h = 0; h < 2; ++h) w[i][h].store_aligned(&lane_w[i][h * kHalf]);
-      for (int l = 0; l < kLanes; ++l) {
-        const int px = x + lane_dx(l), py = y + lane_dy(l);
-        if (px > tile_.x1 || py > tile_.y1) continue;
-        const bool in = full || ((lane_w[0][l] + s.bias[0]) | (lane_w[1][l] + s.bias[1]) | (lane_w[2][l] + s.bias[2])) >= 0;
-        inside |= std::uint32_t(in) << l;
+      // A lane is inside where no biased edge value is negative: where their OR has no sign bit.
+      std::uint32_t covered = kAllLanes;
+      if (!full) {
+        covered = 0;
+        for (int h = 0; h < 2; ++h) {
+          const Int64 any = (w[0][h] + Int64(s.bias[0])) | (w[1][h] + Int64(s.bias[1])) | (w[2][h] + Int64(s.bias[2]));
+          covered |= (~negative_lanes(any) & ((1u << kHalf) - 1u)) << (h * kHalf);
+        }
       }
+      std::uint32_t in_tile = kAllLanes;
+      if (!whole)
+        for (int l = 0; l < kLanes; ++l)
+          if (x + lane_dx(l) > tile_.x1 || y + lane_dy(l) > tile_.y1) in_tile &= ~(1u << l);
+      inside = covered & in_tile;
       if (inside == 0) return false;
     }
     // A held-back batch that will write one of these pixels writes it before the early depth test reads it.
