@@ -1,6 +1,7 @@
 #include "raster/tile_raster.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <type_traits>
@@ -40,15 +41,34 @@ constexpr int kHalf = kLanes / 2;
 static_assert(int(Int64::size) == kHalf && int(Double::size) == kHalf);
 
 struct EdgeSteps {
-  alignas(64) std::int64_t lane[3][kLanes];  // edge value offset of each lane from the batch origin
+  Int64 lane[3][2];  // edge value offset of each lane from the batch origin, per half batch
 };
 
+// All-ones in the lanes where bit `bit` of lane_dx (or lane_dy, for bit -1) is set: a lane's offset times an edge
+// step is a sum of the step's shifted copies, selected by these.
+constexpr std::array<std::int64_t, kLanes> lane_bit_mask(int bit) {
+  std::array<std::int64_t, kLanes> m{};
+  for (int l = 0; l < kLanes; ++l) m[std::size_t(l)] = ((bit < 0 ? lane_dy(l) : lane_dx(l) >> bit) & 1) ? -1 : 0;
+  return m;
+}
+alignas(64) constexpr std::array<std::int64_t, kLanes> kLaneDx1 = lane_bit_mask(0), kLaneDx2 = lane_bit_mask(1),
+                                                      kLaneDx4 = lane_bit_mask(2), kLaneDy1 = lane_bit_mask(-1);
+static_assert(2 * simd::kQuadsPerBatch <= 8, "lane_dx fits in three bits");
+
+// -dy * scale * lane_dx + dx * scale * lane_dy for each lane, exactly, in vector operations: scalar stores read back
+// as vectors stalled on store forwarding at every triangle (a frame of small triangles spent a third of its
+// triangle setup there).
 EdgeSteps edge_steps(const TriangleSetup& s) {
   EdgeSteps e;
-  for (int i = 0; i < 3; ++i)
-    for (int l = 0; l < kLanes; ++l)
-      e.lane[i][l] = -std::int64_t(s.dy[i]) * limits::kSubpixelScale * lane_dx(l) +
-                     std::int64_t(s.dx[i]) * limits::kSubpixelScale * lane_dy(l);
+  for (int i = 0; i < 3; ++i) {
+    const std::int64_t a = -std::int64_t(s.dy[i]) * limits::kSubpixelScale;
+    const std::int64_t b = std::int64_t(s.dx[i]) * limits::kSubpixelScale;
+    for (int h = 0; h < 2; ++h) {
+      const auto mask = [&](const auto& m) { return Int64::load_aligned(m.data() + h * kHalf); };
+      e.lane[i][h] = (Int64(a) & mask(kLaneDx1)) + (Int64(a * 2) & mask(kLaneDx2)) + (Int64(a * 4) & mask(kLaneDx4)) +
+                     (Int64(b) & mask(kLaneDy1));
+    }
+  }
   return e;
 }
 
@@ -306,7 +326,7 @@ private:
     Int64 w[3][2];  // each edge's value at every lane, in halves
     for (int i = 0; i < 3; ++i) {
       const Int64 base(s.edge(i, X, Y));
-      for (int h = 0; h < 2; ++h) w[i][h] = base + Int64::load_aligned(&steps_.lane[i][h * kHalf]);
+      for (int h = 0; h < 2; ++h) w[i][h] = base + steps_.lane[i][h];
     }
     // Batches that lie wholly in the tile (all but those on its right or bottom edge) skip the per-lane bounds.
     const bool whole = x + kBatchWidth - 1 <= tile_.x1 && y + 1 <= tile_.y1;
