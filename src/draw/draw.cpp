@@ -177,8 +177,8 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
 std::uint64_t DrawScratch::bytes() const {
   const auto capacity = [](const auto& v) { return std::uint64_t(v.capacity()) * sizeof(v[0]); };
   const ItemVertices& item = geometry_scratch.item;
-  std::uint64_t total = capacity(item.clip) + capacity(item.frustum_code) + capacity(item.band_code) +
-                        capacity(item.projected) + capacity(geometry.vertices) + capacity(geometry.triangles) +
+  std::uint64_t total = capacity(item.frustum_code) + capacity(item.band_code) + capacity(item.screen) +
+                        capacity(geometry.vertices) + capacity(geometry.triangles) +
                         capacity(setups) + capacity(tile_counters);
   for (const GeometryChunk& chunk : geometry_scratch.chunks)
     total += capacity(chunk.triangles) + capacity(chunk.clipped_vertices);

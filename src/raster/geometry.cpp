@@ -105,41 +105,63 @@ private:
   std::array<ClipPlane, 6> planes_;
 };
 
-void transform_vertices(const DrawItem& item, const glm::mat4& view_projection, const Projection& projection,
-                        ItemVertices& out) {
-  const MeshData& mesh = *item.mesh;
-  const glm::mat3 linear(item.model);
-  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
-  const bool mirrored = glm::determinant(linear) < 0.0f;
-  const std::size_t n = mesh.vertex_count();
-  out.clip.resize(n);
+// The vertex stage of one draw item: a mesh vertex in clip space with its varyings.
+class VertexStage {
+public:
+  VertexStage(const DrawItem& item, const glm::mat4& view_projection)
+      : item_(item), view_projection_(view_projection), linear_(item.model),
+        normal_matrix_(glm::transpose(glm::inverse(linear_))), mirrored_(glm::determinant(linear_) < 0.0f) {}
+
+  bool mirrored() const { return mirrored_; }
+
+  ClipVertex clip_vertex(std::size_t i) const {
+    const MeshData& mesh = *item_.mesh;
+    const glm::vec4 world = item_.model * glm::vec4(mesh.positions[i], 1.0f);
+    const glm::vec3 nrm = glm::normalize(normal_matrix_ * mesh.normals[i]);
+    const glm::vec4& t4 = mesh.tangents[i];
+    const glm::vec3 t = glm::normalize(linear_ * glm::vec3(t4));
+    ClipVertex v;
+    v.clip = view_projection_ * world;
+    const glm::vec4 w = mesh.blend_weights.empty() ? glm::vec4(0.0f) : mesh.blend_weights[i];
+    v.varyings = {world.x, world.y, world.z, nrm.x, nrm.y, nrm.z, t.x, t.y, t.z, mirrored_ ? -t4.w : t4.w,
+                  mesh.uvs[i].x, mesh.uvs[i].y, w.x, w.y, w.z, w.w};
+    return v;
+  }
+
+private:
+  const DrawItem& item_;
+  glm::mat4 view_projection_;
+  glm::mat3 linear_, normal_matrix_;
+  bool mirrored_;
+};
+
+// Every vertex of the item through the vertex stage: its outcodes, and where it is inside the guard band its
+// screen vertex (into `screen_vertices`) and position.
+void transform_vertices(const DrawItem& item, const VertexStage& stage, const Projection& projection,
+                        ItemVertices& out, ScreenVertex* screen_vertices) {
+  const std::size_t n = item.mesh->vertex_count();
   out.frustum_code.resize(n);
   out.band_code.resize(n);
-  out.projected.resize(n);
+  out.screen.resize(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const glm::vec4 world = item.model * glm::vec4(mesh.positions[i], 1.0f);
-      const glm::vec3 nrm = glm::normalize(normal_matrix * mesh.normals[i]);
-      const glm::vec4& t4 = mesh.tangents[i];
-      const glm::vec3 t = glm::normalize(linear * glm::vec3(t4));
-      ClipVertex& v = out.clip[i];
-      v.clip = view_projection * world;
-      const glm::vec4 w = mesh.blend_weights.empty() ? glm::vec4(0.0f) : mesh.blend_weights[i];
-      v.varyings = {world.x, world.y, world.z, nrm.x, nrm.y, nrm.z, t.x, t.y, t.z, mirrored ? -t4.w : t4.w,
-                    mesh.uvs[i].x, mesh.uvs[i].y, w.x, w.y, w.z, w.w};
+      const ClipVertex v = stage.clip_vertex(i);
       out.frustum_code[i] = outcode(v.clip, 1.0f, 1.0f);
       out.band_code[i] = outcode(v.clip, projection.gx(), projection.gy());
-      if (out.band_code[i] == 0) out.projected[i] = projection.project(v);
+      if (out.band_code[i] != 0) continue;
+      const ProjectedVertex p = projection.project(v);
+      screen_vertices[i] = p.vertex;
+      out.screen[i] = {p.x, p.y};
     }
   });
 }
 
 class ChunkAssembler {
 public:
-  ChunkAssembler(const DrawItem& item, const ItemVertices& vertices, const Projection& projection,
-                 std::uint32_t vertex_base, GeometryChunk& chunk)
-      : item_(item), vertices_(vertices), projection_(projection), vertex_base_(vertex_base), chunk_(chunk),
-        mirrored_(glm::determinant(glm::mat3(item.model)) < 0.0f) {}
+  ChunkAssembler(const DrawItem& item, const VertexStage& stage, const ItemVertices& vertices,
+                 const Projection& projection, std::uint32_t vertex_base, GeometryChunk& chunk)
+      : item_(item), stage_(stage), vertices_(vertices), projection_(projection), vertex_base_(vertex_base),
+        chunk_(chunk), mirrored_(stage.mirrored()) {}
 
   void triangle(std::size_t t) {
     const MeshData& mesh = *item_.mesh;
@@ -152,14 +174,14 @@ public:
       return;
     }
     if ((vertices_.band_code[idx[0]] | vertices_.band_code[idx[1]] | vertices_.band_code[idx[2]]) == 0) {
-      const ProjectedVertex* p[3] = {&vertices_.projected[idx[0]], &vertices_.projected[idx[1]], &vertices_.projected[idx[2]]};
+      const ScreenPoint* p[3] = {&vertices_.screen[idx[0]], &vertices_.screen[idx[1]], &vertices_.screen[idx[2]]};
       emit({vertex_base_ + idx[0], vertex_base_ + idx[1], vertex_base_ + idx[2]}, {p[0]->x, p[1]->x, p[2]->x},
            {p[0]->y, p[1]->y, p[2]->y}, material);
       return;
     }
     ++chunk_.counters.clipped;
     ClipVertex polygon_a[kMaxPolygon], polygon_b[kMaxPolygon];
-    for (int k = 0; k < 3; ++k) polygon_a[k] = vertices_.clip[idx[k]];
+    for (int k = 0; k < 3; ++k) polygon_a[k] = stage_.clip_vertex(idx[k]);
     int count = 3;
     ClipVertex* in = polygon_a;
     ClipVertex* out = polygon_b;
@@ -206,6 +228,7 @@ private:
   }
 
   const DrawItem& item_;
+  const VertexStage& stage_;
   const ItemVertices& vertices_;
   const Projection& projection_;
   std::uint32_t vertex_base_;
@@ -228,12 +251,10 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
   std::size_t used = 0;
   for (const DrawItem& item : items) {
     ItemVertices& vertices = scratch.item;
-    transform_vertices(item, view_projection, projection, vertices);
+    const VertexStage stage(item, view_projection);
     const std::uint32_t base = std::uint32_t(result.vertices.size());
-    result.vertices.resize(result.vertices.size() + vertices.projected.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.projected.size(), 8192), [&](const auto& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i) result.vertices[base + i] = vertices.projected[i].vertex;
-    });
+    result.vertices.resize(result.vertices.size() + item.mesh->vertex_count());
+    transform_vertices(item, stage, projection, vertices, result.vertices.data() + base);
     const std::size_t triangles = item.mesh->triangle_count();
     const std::size_t first_chunk = used;
     used += (triangles + kTrianglesPerChunk - 1) / kTrianglesPerChunk;
@@ -243,7 +264,7 @@ void run_geometry(const std::vector<DrawItem>& items, const glm::mat4& view, con
       chunk.triangles.clear();
       chunk.clipped_vertices.clear();
       chunk.counters = GeometryCounters{};
-      ChunkAssembler assembler(item, vertices, projection, base, chunk);
+      ChunkAssembler assembler(item, stage, vertices, projection, base, chunk);
       const std::size_t begin = (c - first_chunk) * kTrianglesPerChunk;
       const std::size_t end = std::min(triangles, begin + kTrianglesPerChunk);
       for (std::size_t t = begin; t < end; ++t) assembler.triangle(t);

@@ -65,11 +65,17 @@ struct ProjectedVertex {
   std::int32_t x = 0, y = 0;  // fixed point
 };
 
-// The vertices of one draw item after the vertex stage.
+// A vertex's fixed-point screen position.
+struct ScreenPoint {
+  std::int32_t x = 0, y = 0;
+};
+
+// The vertices of one draw item after the vertex stage; their screen vertices go straight to the result's. Their
+// clip-space vertices are not kept: the few triangles that need clipping make theirs again (the same operations,
+// so the same bits), which spares a frame of small triangles 80 bytes written per vertex.
 struct ItemVertices {
-  UninitVector<ClipVertex> clip;
   UninitVector<unsigned> frustum_code, band_code;
-  UninitVector<ProjectedVertex> projected;  // valid where band_code == 0
+  UninitVector<ScreenPoint> screen;  // valid where band_code == 0
 };
 
 // The triangles of one chunk of an item (assembled in parallel), with the vertices its clipping made.
