@@ -94,8 +94,8 @@ public:
     p.vertex.inv_w = float(inv_w);
     p.vertex.z = float(ndc_z * 0.5 + 0.5);
     p.vertex.varyings = v.varyings;
-    p.x = std::int32_t(std::floor(sx * limits::kSubpixelScale + 0.5));
-    p.y = std::int32_t(std::floor(sy * limits::kSubpixelScale + 0.5));
+    p.position.x = std::int32_t(std::floor(sx * limits::kSubpixelScale + 0.5));
+    p.position.y = std::int32_t(std::floor(sy * limits::kSubpixelScale + 0.5));
     return p;
   }
 
@@ -151,7 +151,7 @@ void transform_vertices(const DrawItem& item, const VertexStage& stage, const Pr
       if (out.band_code[i] != 0) continue;
       const ProjectedVertex p = projection.project(v);
       screen_vertices[i] = p.vertex;
-      out.screen[i] = {p.x, p.y};
+      out.screen[i] = p.position;
     }
   });
 }
@@ -202,8 +202,9 @@ public:
       chunk_.clipped_vertices.push_back(projected[k].vertex);
     }
     for (int k = 2; k < count; ++k)
-      emit({local[0], local[k - 1], local[k]}, {projected[0].x, projected[k - 1].x, projected[k].x},
-           {projected[0].y, projected[k - 1].y, projected[k].y}, material);
+      emit({local[0], local[k - 1], local[k]},
+           {projected[0].position.x, projected[k - 1].position.x, projected[k].position.x},
+           {projected[0].position.y, projected[k - 1].position.y, projected[k].position.y}, material);
   }
 
 private:

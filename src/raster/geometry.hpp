@@ -59,15 +59,15 @@ struct GeometryResult {
   GeometryCounters counters;
 };
 
-// A vertex after the vertex stage: its screen vertex and fixed-point position.
-struct ProjectedVertex {
-  ScreenVertex vertex;
-  std::int32_t x = 0, y = 0;  // fixed point
-};
-
 // A vertex's fixed-point screen position.
 struct ScreenPoint {
   std::int32_t x = 0, y = 0;
+};
+
+// A vertex after the vertex stage: its screen vertex and fixed-point position.
+struct ProjectedVertex {
+  ScreenVertex vertex;
+  ScreenPoint position;
 };
 
 // The vertices of one draw item after the vertex stage; their screen vertices go straight to the result's. Their
