@@ -60,14 +60,6 @@ const Workload& workload(int which) {
   return which == 0 ? grid : plane;
 }
 
-TriangleSetups setup_all(const GeometryResult& geometry, const Viewport& viewport) {
-  TriangleSetups setups(geometry.triangles.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
-  });
-  return setups;
-}
-
 void report(benchmark::State& state, const Workload& w, int threads) {
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(w.draws[0].mesh->triangle_count()));
   state.counters["threads"] = threads;
@@ -97,22 +89,20 @@ void BM_Geometry(benchmark::State& state, int which) {
   state.counters["B/screen_vertex"] = double(sizeof(ScreenVertex));
 }
 
-void BM_SetupBinning(benchmark::State& state, int which) {
+void BM_Binning(benchmark::State& state, int which) {
   const Workload& w = workload(which);
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
   const GeometryResult geometry = geometry_of(w, arena);
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
-  TileBins bins;
+  TileBins bins;  // kept between iterations, as the renderer keeps them between frames
   for (auto _ : state) {
     arena.execute([&] {
-      const TriangleSetups setups = setup_all(geometry, w.viewport);
-      bin_triangles(setups, grid, bins);
+      bin_triangles(geometry, w.viewport, grid, bins);
       benchmark::DoNotOptimize(bins.bins.data());
     });
   }
   report(state, w, threads);
-  state.counters["B/triangle_setup"] = double(sizeof(TriangleSetup));
 }
 
 // As a draw does it: clear the colour and depth targets, then rasterize and shade every tile.
@@ -121,10 +111,9 @@ void BM_RasterShade(benchmark::State& state, int which) {
   const int threads = int(state.range(0));
   tbb::task_arena arena(threads);
   const GeometryResult geometry = geometry_of(w, arena);
-  const TriangleSetups setups = arena.execute([&] { return setup_all(geometry, w.viewport); });
   const TileGrid grid(w.viewport.width, w.viewport.height, 64);
   TileBins bins;
-  bin_triangles(setups, grid, bins);
+  arena.execute([&] { bin_triangles(geometry, w.viewport, grid, bins); });
   const std::size_t pixels = std::size_t(w.viewport.width) * std::size_t(w.viewport.height);
   std::uint64_t shaded = 0;
   for (auto _ : state) {
@@ -135,7 +124,6 @@ void BM_RasterShade(benchmark::State& state, int which) {
     fb.depth.resize(pixels);
     RasterContext context;
     context.geometry = &geometry;
-    context.setups = &setups;
     context.framebuffer = &fb;
     for (const auto& program : w.programs) context.programs.push_back(program.get());
     std::vector<TileCounters> counters(std::size_t(grid.count()));
@@ -155,7 +143,7 @@ void BM_RasterShade(benchmark::State& state, int which) {
 }  // namespace
 
 BENCHMARK_CAPTURE(BM_Geometry, grid1m, 0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_SetupBinning, grid1m, 0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Binning, grid1m, 0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterShade, grid1m, 0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RasterShade, plane, 1)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 

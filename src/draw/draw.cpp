@@ -179,7 +179,7 @@ std::uint64_t DrawScratch::bytes() const {
   const ItemVertices& item = geometry_scratch.item;
   std::uint64_t total = capacity(item.frustum_code) + capacity(item.band_code) + capacity(item.screen) +
                         capacity(geometry.vertices) + capacity(geometry.triangles) +
-                        capacity(setups) + capacity(tile_counters);
+                        capacity(tile_counters);
   for (const GeometryChunk& chunk : geometry_scratch.chunks)
     total += capacity(chunk.triangles) + capacity(chunk.clipped_vertices);
   for (const auto& chunk : bins.bins)
@@ -211,15 +211,9 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   stats.triangles_rasterized = geometry.counters.triangles_out;
 
   start = Clock::now();
-  TriangleSetups& setups = scratch.setups;
-  setups.resize(geometry.triangles.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, setups.size(), 4096), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i)
-      setups[i] = setup_triangle(geometry.triangles[i], geometry, viewport);
-  });
   const TileGrid grid(viewport.width, viewport.height, options.tile_size);
   TileBins& bins = scratch.bins;
-  bin_triangles(setups, grid, bins);
+  bin_triangles(geometry, viewport, grid, bins);
   stats.binning_ms = ms_since(start);
   stats.tiles = std::uint64_t(grid.count());
   stats.tile_size = options.tile_size;
@@ -230,7 +224,6 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   stats.framebuffer_bytes = fb.bytes();
   RasterContext context;
   context.geometry = &geometry;
-  context.setups = &setups;
   context.framebuffer = &fb;
   for (const auto& program : programs) context.programs.push_back(program.get());
   std::optional<TextureAddressMap> cache_addresses;

@@ -25,13 +25,12 @@ struct DrawOptions {
 // One program per plan material, made by `kernel` from the prepared assets.
 std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel);
 
-// The per-triangle arrays of a frame (screen vertices and triangles, setups, tile bins). Kept between draws (of
+// The per-triangle arrays of a frame (screen vertices and triangles, tile bins). Kept between draws (of
 // one scene or the next), their pages are reused: a frame of a million triangles otherwise faults in ~270 MB of
 // fresh pages.
 struct DrawScratch {
   GeometryScratch geometry_scratch;
   GeometryResult geometry;
-  TriangleSetups setups;
   TileBins bins;
   std::vector<TileCounters> tile_counters;  // one per tile, zeroed by its tile at the start of each draw
 

@@ -25,7 +25,7 @@ struct TileGrid {
   }
 };
 
-// Triangle indices (into the setups) per chunk of consecutive triangles and per tile: bins[chunk][tile].
+// Triangle indices (into the geometry's triangles) per chunk of consecutive triangles and per tile: bins[chunk][tile].
 // Chunks are binned in parallel; a tile reads its lists chunk by chunk, which is submission order.
 struct TileBins {
   static constexpr std::size_t kTrianglesPerChunk = 32768;
@@ -38,8 +38,8 @@ struct TileBins {
   }
 };
 
-// Replaces the lists of `bins`; their memory is kept, so a caller that keeps `bins` between frames allocates
-// nothing in a warm frame.
-void bin_triangles(const TriangleSetups& setups, const TileGrid& grid, TileBins& bins);
+// Bins every triangle of `geometry` by its bounds. Replaces the lists of `bins`; their memory is kept, so a caller
+// that keeps `bins` between frames allocates nothing in a warm frame.
+void bin_triangles(const GeometryResult& geometry, const Viewport& viewport, const TileGrid& grid, TileBins& bins);
 
 }  // namespace qdmr

@@ -53,8 +53,7 @@ struct TileCounters : TileCounts {
 
 struct RasterContext {
   const GeometryResult* geometry = nullptr;
-  const TriangleSetups* setups = nullptr;
-  std::vector<const Program*> programs;  // indexed by TriangleSetup::material; made by the kernel that rasterizes
+  std::vector<const Program*> programs;  // indexed by ScreenTriangle::material; made by the kernel that rasterizes
   Framebuffer* framebuffer = nullptr;
   // The emulated texture cache, or null (off): its settings and the address of every texture the programs read.
   const TextureCacheDesc* cache = nullptr;

@@ -536,6 +536,10 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   if (depth_plane.size() < stride * rows) depth_plane.resize(stride * rows);
   std::fill_n(depth_plane.data(), stride * rows, 1.0f);
   const TileDepth depth{depth_plane.data(), tile.x0, tile.y0, stride};
+  const Viewport viewport{fb.width, fb.height};
+  const auto setup = [&](std::uint32_t index) {
+    return setup_triangle(context.geometry->triangles[index], *context.geometry, viewport);
+  };
   // What reads depth after the tile (keeps_depth_plane) reads the frame's plane.
   const auto copy_depth_out = [&] {
     if (fb.depth.empty()) return;
@@ -544,7 +548,7 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   };
   if (context.cache == nullptr) {
     TileRasterizer rasterizer(context, tile, depth, counters, nullptr);
-    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle(setup(index)); });
     rasterizer.flush();
     copy_depth_out();
     return;
@@ -554,7 +558,7 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   {
     const FetchRecorder::Listening listening(recorder);
     TileRasterizer rasterizer(context, tile, depth, counters, &recorder);
-    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle((*context.setups)[index]); });
+    bins.for_each_in_tile(tile_index, [&](std::uint32_t index) { rasterizer.triangle(setup(index)); });
     rasterizer.flush();
   }
   copy_depth_out();

@@ -21,6 +21,17 @@ int last_pixel_at_or_before(std::int64_t v) {
 
 }  // namespace
 
+PixelRect triangle_bounds(const ScreenTriangle& t, const Viewport& viewport) {
+  const int min_x = std::min({t.x[0], t.x[1], t.x[2]}), max_x = std::max({t.x[0], t.x[1], t.x[2]});
+  const int min_y = std::min({t.y[0], t.y[1], t.y[2]}), max_y = std::max({t.y[0], t.y[1], t.y[2]});
+  PixelRect r;
+  r.x0 = std::max(0, first_pixel_at_or_after(min_x));
+  r.y0 = std::max(0, first_pixel_at_or_after(min_y));
+  r.x1 = std::min(viewport.width - 1, last_pixel_at_or_before(max_x));
+  r.y1 = std::min(viewport.height - 1, last_pixel_at_or_before(max_y));
+  return r;
+}
+
 TriangleSetup setup_triangle(const ScreenTriangle& t, const GeometryResult& geometry, const Viewport& viewport) {
   TriangleSetup s;
   std::int64_t area2 = 0;
@@ -37,12 +48,7 @@ TriangleSetup setup_triangle(const ScreenTriangle& t, const GeometryResult& geom
   }
   area2 = s.edge(0, t.x[0], t.y[0]);
   s.area2 = area2;
-  const int min_x = std::min({t.x[0], t.x[1], t.x[2]}), max_x = std::max({t.x[0], t.x[1], t.x[2]});
-  const int min_y = std::min({t.y[0], t.y[1], t.y[2]}), max_y = std::max({t.y[0], t.y[1], t.y[2]});
-  s.bounds.x0 = std::max(0, first_pixel_at_or_after(min_x));
-  s.bounds.y0 = std::max(0, first_pixel_at_or_after(min_y));
-  s.bounds.x1 = std::min(viewport.width - 1, last_pixel_at_or_before(max_x));
-  s.bounds.y1 = std::min(viewport.height - 1, last_pixel_at_or_before(max_y));
+  s.bounds = triangle_bounds(t, viewport);
   const float inv_area2 = 1.0f / float(area2);
   for (int i = 0; i < 3; ++i) {
     const ScreenVertex& v = geometry.vertices[t.vertex[i]];

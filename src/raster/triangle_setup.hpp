@@ -1,6 +1,7 @@
 #pragma once
 // Triangle setup: integer edge functions with the top-left fill rule, and the per-vertex values
-// the rasterizer interpolates. Everything a tile needs to rasterize a triangle, computed once.
+// the rasterizer interpolates. Everything a tile needs to rasterize a triangle, computed by the tile: a frame of
+// small triangles would spend more writing a million setups to memory and reading them back than making them.
 #include <array>
 #include <cstdint>
 
@@ -29,7 +30,8 @@ struct TriangleSetup {
   std::int64_t edge(int i, std::int64_t X, std::int64_t Y) const { return std::int64_t(dx[i]) * Y - std::int64_t(dy[i]) * X + c[i]; }
 };
 
-using TriangleSetups = UninitVector<TriangleSetup>;
+// The pixels whose centres the triangle may cover, clamped to the viewport (empty: none).
+PixelRect triangle_bounds(const ScreenTriangle& t, const Viewport& viewport);
 
 TriangleSetup setup_triangle(const ScreenTriangle& t, const GeometryResult& geometry, const Viewport& viewport);
 

@@ -71,11 +71,9 @@ struct ScreenScene {
   // Rasterizes every triangle with the counting program; returns the per-pixel shade counts.
   std::vector<int> raster_counts(int tile_size = 64) const {
     const Viewport viewport{width, height};
-    TriangleSetups setups;
-    for (const ScreenTriangle& t : geometry.triangles) setups.push_back(setup_triangle(t, geometry, viewport));
     const TileGrid grid(width, height, tile_size);
     TileBins bins;
-    bin_triangles(setups, grid, bins);
+    bin_triangles(geometry, viewport, grid, bins);
     Framebuffer fb;
     fb.width = width;
     fb.height = height;
@@ -83,7 +81,6 @@ struct ScreenScene {
     CountingProgram program(width, height);
     RasterContext context;
     context.geometry = &geometry;
-    context.setups = &setups;
     context.framebuffer = &fb;
     context.programs = {static_cast<const Program*>(&program)};
     for (int tile = 0; tile < grid.count(); ++tile) {
