@@ -94,18 +94,18 @@ std::uint32_t negative_lanes(const Int64& v) {
 #endif
 }
 
-// Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside.
+// Classifies an 8x8 block: 0 = outside, 1 = partially covered, 2 = fully inside. An edge value is affine in the
+// pixel, so its least and greatest over the block's corner pixels are the top-left corner's plus the negative
+// (or positive) parts of its two steps across the block.
 int classify_block(const TriangleSetup& s, int bx, int by) {
+  constexpr std::int64_t kSpan = std::int64_t(kBlock - 1) * limits::kSubpixelScale;
+  const std::int64_t X = pixel_centre_fixed(bx), Y = pixel_centre_fixed(by);
   bool full = true;
   for (int i = 0; i < 3; ++i) {
-    std::int64_t lo = INT64_MAX, hi = INT64_MIN;
-    for (int corner = 0; corner < 4; ++corner) {
-      const std::int64_t X = pixel_centre_fixed(bx + (corner & 1) * (kBlock - 1));
-      const std::int64_t Y = pixel_centre_fixed(by + (corner >> 1) * (kBlock - 1));
-      const std::int64_t w = s.edge(i, X, Y) + s.bias[i];
-      lo = std::min(lo, w);
-      hi = std::max(hi, w);
-    }
+    const std::int64_t w = s.edge(i, X, Y) + s.bias[i];
+    const std::int64_t across_x = -std::int64_t(s.dy[i]) * kSpan, across_y = std::int64_t(s.dx[i]) * kSpan;
+    const std::int64_t lo = w + std::min<std::int64_t>(across_x, 0) + std::min<std::int64_t>(across_y, 0);
+    const std::int64_t hi = w + std::max<std::int64_t>(across_x, 0) + std::max<std::int64_t>(across_y, 0);
     if (hi < 0) return 0;
     if (lo < 0) full = false;
   }
