@@ -156,7 +156,6 @@ public:
           for (int x = x_begin; x <= x_end; x += kBatchWidth) batch(x, y, kind == 2);
       }
     }
-    if (waiting_ >= 0) shade_waiting();  // the triangle's last batch had no partner
   }
 
   // Shades what is still held back: call once after the tile's last triangle.

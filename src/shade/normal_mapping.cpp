@@ -106,10 +106,15 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
 // gives the core independent work to overlap with it.
 void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                       ShadeOutput& out_b) const {
-  Samples sa, sb;
   const UvDerivatives da = derivatives(a), db = derivatives(b);
   Float lod_a, lod_b;
   albedo_lods(da, db, lod_a, lod_b);
+  const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
+  if (simd::LanePacking::fits(covered_a, covered_b)) {
+    shade_packed(a, da, lod_a, out_a, b, db, lod_b, out_b, simd::LanePacking(covered_a, covered_b));
+    return;
+  }
+  Samples sa, sb;
   // Each frame is a chain of three normalisations (a square root, then a division, each), and the shading normal
   // one more: a's and b's side by side, so one chain's arithmetic fills the other's waits. The frames and view
   // vectors need no sample: made while the LOD's chain (a logarithm after a division) is under way.
@@ -120,6 +125,34 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
   const Vec3 normal_a = shading_normal_of(frame_a, sa.tangent_normal), normal_b = shading_normal_of(frame_b, sb.tangent_normal);
   light(a, sa, frame_a, normal_a, view_a, out_a);
   light(b, sb, frame_b, normal_b, view_b, out_b);
+}
+
+// Past the LODs (which read whole quads) everything is lane by lane: the covered lanes of both batches run as one
+// batch, and each batch's outputs are its own lanes back (the others are never written).
+void NormalMappingProgram::shade_packed(const Fragments& a, const UvDerivatives& da, const Float& lod_a,
+                                        ShadeOutput& out_a, const Fragments& b, const UvDerivatives& db,
+                                        const Float& lod_b, ShadeOutput& out_b, const simd::LanePacking& packing) const {
+  Fragments packed;
+  for (int k = 0; k < kBaseVaryingCount; ++k) packed.varyings[k] = packing.pack(a.varyings[k], b.varyings[k]);
+  const UvAhead ahead_a = da.quad_below(), ahead_b = db.quad_below();
+  const UvAhead ahead{packing.pack(ahead_a.du, ahead_b.du), packing.pack(ahead_a.dv, ahead_b.dv)};
+  Samples s;
+  textures_.sample(packed.varyings[kU], packed.varyings[kV], packing.pack(lod_a, lod_b),
+                   packing.pack(normal_lod(da, lod_a), normal_lod(db, lod_b)), s.albedo, s.tangent_normal, &ahead);
+  const TangentFrame frame = TangentFrame::from(packed);
+  ShadeOutput lit;
+  light(packed, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(packed, lights_), lit);
+  const auto unpack = [&](const Fragments& in, ShadeOutput& out, auto lanes) {
+    out = lit;
+    for (int c = 0; c < 3; ++c) {
+      out.color[c] = lanes(lit.color[c]);
+      out.normal[c] = lanes(lit.normal[c]);
+    }
+    out.hit_u = in.varyings[kU];
+    out.hit_v = in.varyings[kV];
+  };
+  unpack(a, out_a, [&](const Float& v) { return packing.first(v); });
+  unpack(b, out_b, [&](const Float& v) { return packing.second(v); });
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,6 +1,7 @@
 #pragma once
 // The first shading program: albedo with tangent-space normal mapping, lit by the material's lighting model
 // (lighting_models.hpp) from directional lights plus ambient.
+#include "core/lane_packing.hpp"
 #include "program/light_rig.hpp"
 #include "program/batch.hpp"
 #include "shade/shading_math.hpp"
@@ -33,6 +34,10 @@ private:
   // side by side).
   void light(const Fragments& in, const Samples& samples, const shading::TangentFrame& frame,
              const shading::Vec3& shading_normal, const shading::Vec3& view, ShadeOutput& out) const;
+  // shade_pair() of two batches whose covered lanes fit in one (small triangles).
+  void shade_packed(const Fragments& a, const shading::UvDerivatives& da, const simd::Float& lod_a, ShadeOutput& out_a,
+                    const Fragments& b, const shading::UvDerivatives& db, const simd::Float& lod_b, ShadeOutput& out_b,
+                    const simd::LanePacking& packing) const;
 
   TwinSampler textures_;  // albedo first, normal map second
   LodMode lod_mode_;

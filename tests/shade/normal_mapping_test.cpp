@@ -1,0 +1,124 @@
+// NormalMappingProgram::shade_pair gives each batch what shade() gives it alone, bit for bit in every covered lane:
+// batches dense enough to run side by side, and sparse ones whose covered lanes run packed in one batch (small
+// triangles).
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstdint>
+#include <random>
+
+#include "core/lane_packing.hpp"
+#include "qdmr/texture/mip_texture.hpp"
+#include "shade/normal_mapping.hpp"
+
+namespace qdmr {
+namespace {
+
+using simd::Float;
+using simd::kLanes;
+
+Image random_image(int size, std::mt19937& rng) {
+  Image img(size, size, 4);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (float& t : img.texels) t = unit(rng);
+  return img;
+}
+
+// Per quad: a random UV with random screen derivatives (footprints from magnified to several texels), so the
+// quad's LOD varies; per lane: a random frame, tangent sign and world point.
+Fragments random_fragments(std::mt19937& rng, std::uint32_t covered) {
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), signed_unit(-1.0f, 1.0f);
+  alignas(64) float var[kVaryingCount][kLanes] = {};
+  for (int q = 0; q < kLanes / 4; ++q) {
+    const float u = 4.0f * unit(rng), v = 4.0f * unit(rng);
+    const float scale = 0.002f * std::pow(40.0f, unit(rng));
+    const float dudx = scale * signed_unit(rng), dvdx = scale * signed_unit(rng);
+    const float dudy = scale * signed_unit(rng), dvdy = scale * signed_unit(rng);
+    for (int c = 0; c < 4; ++c) {
+      const int l = 4 * q + c;
+      const float x = float(c % 2), y = float(c / 2);
+      var[kU][l] = u + x * dudx + y * dudy;
+      var[kV][l] = v + x * dvdx + y * dvdy;
+      for (int k = kWorldX; k <= kTangentZ; ++k) var[k][l] = signed_unit(rng);
+      var[kNormalZ][l] += 2.0f;  // away from a degenerate frame
+      var[kTangentX][l] += 2.0f;
+      var[kTangentW][l] = unit(rng) < 0.5f ? -1.0f : 1.0f;
+    }
+  }
+  Fragments in;
+  for (int k = 0; k < kVaryingCount; ++k) in.varyings[k] = Float::load_aligned(var[k]);
+  in.pixel_x = in.pixel_y = Float(0.0f);
+  in.view_depth = Float(5.0f);
+  in.covered = simd::from_bits(covered);
+  return in;
+}
+
+void expect_same_covered_lanes(const ShadeOutput& alone, const ShadeOutput& paired, std::uint32_t covered,
+                               int trial) {
+  const auto expect = [&](const Float& x, const Float& y, const char* what) {
+    alignas(64) float a[kLanes], b[kLanes];
+    x.store_aligned(a);
+    y.store_aligned(b);
+    for (int l = 0; l < kLanes; ++l) {
+      if (!((covered >> l) & 1u)) continue;
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(a[l]), std::bit_cast<std::uint32_t>(b[l]))
+          << what << " lane " << l << " trial " << trial;
+    }
+  };
+  for (int c = 0; c < 3; ++c) {
+    expect(alone.color[c], paired.color[c], "color");
+    expect(alone.normal[c], paired.normal[c], "normal");
+  }
+  expect(alone.hit_u, paired.hit_u, "hit_u");
+  expect(alone.hit_v, paired.hit_v, "hit_v");
+  expect(alone.iterations, paired.iterations, "iterations");
+  expect(alone.shadow, paired.shadow, "shadow");
+  expect(alone.ao, paired.ao, "ao");
+  EXPECT_EQ(alone.writes_depth, paired.writes_depth);
+}
+
+void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbedo& specular, unsigned seed) {
+  std::mt19937 rng(seed);
+  const Texture albedo = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, true, MipReduce::Box);
+  const Texture normal = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, false, MipReduce::Box);
+  LightRig lights;
+  lights.directional.push_back({glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)), glm::vec3(1.0f, 0.9f, 0.8f)});
+  lights.ambient = glm::vec3(0.1f);
+  lights.camera_position = glm::vec3(0.2f, -0.4f, 3.0f);
+  const NormalMappingProgram program("test", albedo, normal, SamplingDesc{}, lighting, specular, lights);
+  ASSERT_TRUE(program.pairs_batches());
+  const std::uint32_t all = (1u << kLanes) - 1u;
+  int packed = 0, side_by_side = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    // Mostly sparse coverage (a few pixels of small triangles), now and then a full batch.
+    const auto coverage = [&] {
+      const std::uint32_t m = trial % 5 == 0 ? all : (rng() & rng() & all);
+      return m != 0 ? m : 1u << (rng() % kLanes);
+    };
+    const std::uint32_t covered_a = coverage(), covered_b = coverage();
+    const Fragments a = random_fragments(rng, covered_a), b = random_fragments(rng, covered_b);
+    ShadeOutput alone_a, alone_b, paired_a, paired_b;
+    program.shade(a, alone_a);
+    program.shade(b, alone_b);
+    program.shade_pair(a, paired_a, b, paired_b);
+    expect_same_covered_lanes(alone_a, paired_a, covered_a, trial);
+    expect_same_covered_lanes(alone_b, paired_b, covered_b, trial);
+    ++(simd::LanePacking::fits(covered_a, covered_b) ? packed : side_by_side);
+  }
+  EXPECT_GT(packed, 100);  // both ways of pairing were taken
+  EXPECT_GT(side_by_side, 20);
+}
+
+TEST(NormalMappingPair, SameBitsAsEachBatchAloneBlinnPhong) { expect_pairs_as_alone(LightingDesc{}, SpecularFromAlbedo{}, 3); }
+
+TEST(NormalMappingPair, SameBitsAsEachBatchAloneCookTorranceWithSpecularFromAlbedo) {
+  LightingDesc lighting;
+  lighting.model = LightingModel::CookTorrance;
+  SpecularFromAlbedo specular;
+  specular.enabled = true;
+  specular.power = 2.0f;
+  expect_pairs_as_alone(lighting, specular, 4);
+}
+
+}  // namespace
+}  // namespace qdmr
