@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """qdmr vs Mesa llvmpipe on the same work: bench/llvmpipe/canonical.json with normal mapping, POM, relief and
-QDM at depth scales 0.1 and 0.3 (issue #12's table).
+QDM at depth scales 0.1 and 0.3, and the 1 M-triangle grid (issue #12's table).
 
 1. The texel check (small frame, default 480x270): each technique and depth rendered by qdmr (`qdmr render
    --aov hit_uv --aov depth --aov iterations`) and by llvmpipe_bench (`--hit-uv`); for the pixels both cover,
@@ -8,8 +8,11 @@ QDM at depth scales 0.1 and 0.3 (issue #12's table).
    iterations per pixel on each side (mean, and the fraction of pixels with the same count).
 2. The timing (default 1920x1080, 2 threads each): in every round each case runs once in each renderer,
    renderers alternating (the order flips every round); qdmr: `qdmr bench --frames N --warmup K`, its
-   draw_ms median; llvmpipe: `llvmpipe_bench --runs N`, its median after the warm-up frame. The table gives
-   the median over rounds, llvmpipe / qdmr, and the issue's goal (>= 2x normal, POM, relief; >= 4x QDM).
+   draw_ms median; llvmpipe: `llvmpipe_bench --runs N`, its median after the warm-up frame. The grid case
+   (timed only) is scenes/plane.json's normal-mapped plane as a 710x710 grid (1,008,200 triangles) in both:
+   `qdmr bench scenes/plane.json --set /objects/0/mesh=...` and `llvmpipe_bench --mesh grid`. The table gives
+   the median over rounds, llvmpipe / qdmr, and the issue's goal (>= 2x normal, POM, relief and the grid;
+   >= 4x QDM).
 The load average is printed before and after.
 
     bench/llvmpipe_compare.py [-B BUILD_DIR] [--qdmr QDMR] [--rounds 5] [--frames 5] [--warmup 2]
@@ -39,7 +42,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "bench", "llvmpipe", "canonical.json")
 MATERIAL = "/materials/cobbles"
 CASES = [("normal", 0.1)] + [(t, d) for t in ("pom", "relief", "qdm") for d in (0.1, 0.3)]
-GOALS = {"normal": 2.0, "pom": 2.0, "relief": 2.0, "qdm": 4.0}  # llvmpipe / qdmr, issue #12
+TIMED_CASES = CASES + [("grid", None)]
+GOALS = {"normal": 2.0, "pom": 2.0, "relief": 2.0, "qdm": 4.0, "grid": 2.0}  # llvmpipe / qdmr, issue #12
+GRID_SCENE = os.path.join(ROOT, "scenes", "plane.json")
+GRID_MESH = '/objects/0/mesh={"type":"grid","size":[4,4],"resolution":710,"uv_scale":[2,2]}'  # as llvmpipe_bench's
 LLVMPIPE_ENV = {"LIBGL_ALWAYS_SOFTWARE": "1", "GALLIUM_DRIVER": "llvmpipe"}
 
 
@@ -158,25 +164,27 @@ def texel_check(qdmr, llvmpipe, args, tmp):
 
 def time_qdmr(qdmr, technique, depth, args, tmp):
     out = os.path.join(tmp, "qdmr_bench.json")
-    result = run_json([qdmr, "bench", SCENE, "--frames", str(args.frames), "--warmup", str(args.warmup),
-                       "--threads", str(args.threads), "--width", str(args.width), "--height", str(args.height),
-                       "--isa", args.isa, "--json", out] + technique_sets(technique, depth), json_file=out)
+    scene = [GRID_SCENE, "--set", GRID_MESH] if technique == "grid" else [SCENE] + technique_sets(technique, depth)
+    result = run_json([qdmr, "bench"] + scene + ["--frames", str(args.frames), "--warmup", str(args.warmup),
+                      "--threads", str(args.threads), "--width", str(args.width), "--height", str(args.height),
+                      "--isa", args.isa, "--json", out], json_file=out)
     return result["draw_ms"]["median"], result
 
 
 def time_llvmpipe(llvmpipe, technique, depth, args):
-    result = run_json([llvmpipe, "--technique", technique, "--depth", str(depth), "--width", str(args.width),
-                       "--height", str(args.height), "--runs", str(args.frames)], env=llvmpipe_env(args.threads))
+    case = ["--mesh", "grid"] if technique == "grid" else ["--technique", technique, "--depth", str(depth)]
+    result = run_json([llvmpipe] + case + ["--width", str(args.width), "--height", str(args.height),
+                                           "--runs", str(args.frames)], env=llvmpipe_env(args.threads))
     return result["median_ms"], result
 
 
 def measure_rounds(qdmr, llvmpipe, args, tmp):
     """{case: {"qdmr": [ms per round], "llvmpipe": [...]}} and the last JSON of each renderer. Within a round each
     case runs in both renderers back to back; which goes first flips every round."""
-    times = {case: {"qdmr": [], "llvmpipe": []} for case in CASES}
+    times = {case: {"qdmr": [], "llvmpipe": []} for case in TIMED_CASES}
     info = {}
     for r in range(args.rounds):
-        for case in CASES:
+        for case in TIMED_CASES:
             for who in ("llvmpipe", "qdmr") if r % 2 == 0 else ("qdmr", "llvmpipe"):
                 if who == "qdmr":
                     ms, info[who] = time_qdmr(qdmr, *case, args, tmp)
@@ -196,18 +204,18 @@ def timing(qdmr, llvmpipe, args, tmp):
           f"qdmr bench {args.frames} frames after {args.warmup}, llvmpipe {args.frames} after 1\n")
     times, info = measure_rounds(qdmr, llvmpipe, args, tmp)
     with open(os.path.join(tmp, "timing.json"), "w") as f:  # every round's times, kept with --keep
-        json.dump([{"technique": c[0], "depth": c[1], **times[c]} for c in CASES], f, indent=1)
+        json.dump([{"technique": c[0], "depth": c[1], **times[c]} for c in TIMED_CASES], f, indent=1)
     print(f"qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
           f"{info['qdmr']['pixels_shaded']} pixels shaded; llvmpipe: {info['llvmpipe']['renderer']}, "
           f"{info['llvmpipe']['pixels_covered']} pixels covered (last case)\n")
     print("| technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met "
           "| llvmpipe ms per round | qdmr ms per round |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for technique, depth in CASES:
+    for technique, depth in TIMED_CASES:
         t = times[(technique, depth)]
         lp, q = statistics.median(t["llvmpipe"]), statistics.median(t["qdmr"])
         ratio, goal = lp / q, GOALS[technique]
-        depth_text = "-" if technique == "normal" else f"{depth:g}"
+        depth_text = "-" if depth is None or technique == "normal" else f"{depth:g}"
         print(f"| {technique} | {depth_text} | {lp:.1f} | {q:.1f} | **{ratio:.2f}x** | >= {goal:g}x "
               f"| {'yes' if ratio >= goal else 'no'} | {per_round(t['llvmpipe'])} | {per_round(t['qdmr'])} |")
 
