@@ -221,6 +221,20 @@ DisplacementProgram::Hit DisplacementProgram::refine_qdm_hit(const Surface& surf
   return hit;
 }
 
+// refine_qdm_hit() of two paired batches' hits (no recorder listens); the linear refinement of both at once.
+void DisplacementProgram::refine_qdm_hits(const SingleLayerSurface& surface, const Setup& setup_a, Hit& hit_a,
+                                          const Setup& setup_b, Hit& hit_b) const {
+  if (technique_.refinement != QdmRefinement::Linear) {
+    hit_a = refine_qdm_hit(surface, setup_a, hit_a);
+    hit_b = refine_qdm_hit(surface, setup_b, hit_b);
+    return;
+  }
+  hit_a.box_s = hit_a.s;
+  hit_b.box_s = hit_b.s;
+  trace::refine_linear_pair(surface, setup_a.ray, setup_a.ds, hit_a.s, hit_a.iterations, setup_a.active, setup_b.ray,
+                            setup_b.ds, hit_b.s, hit_b.iterations, setup_b.active);
+}
+
 DisplacementProgram::QdmBudget DisplacementProgram::qdm_budget(const Setup& setup) const {
   const UvDerivatives& d = setup.d;
   QdmBudget budget{Float(0.0f), Int(technique_.max_iterations)};
@@ -458,8 +472,9 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
         Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
         Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
         trace::qdm_pair(walk_a, walk_b);
-        shade_hits<V>(a, setup_a, refine_qdm_hit(surface, setup_a, walk_a.hit()), setup_a.ds, out_a, b, setup_b,
-                      refine_qdm_hit(surface, setup_b, walk_b.hit()), setup_b.ds, out_b);
+        Hit hit_a = walk_a.hit(), hit_b = walk_b.hit();
+        refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
+        shade_hits<V>(a, setup_a, hit_a, setup_a.ds, out_a, b, setup_b, hit_b, setup_b.ds, out_b);
       } else {  // relief and POM: their loops run at the core's throughput already; one after the other
         Float ds_a = setup_a.ds, ds_b = setup_b.ds;
         const Hit hit_a = trace<V>(surface, setup_a, ds_a);

@@ -105,6 +105,8 @@ private:
   // A QDM walk's hit on the box surface, refined on the filtered one as the technique asks.
   template <class Surface>
   Hit refine_qdm_hit(const Surface& surface, const Setup& setup, Hit hit) const;
+  void refine_qdm_hits(const SingleLayerSurface& surface, const Setup& setup_a, Hit& hit_a, const Setup& setup_b,
+                       Hit& hit_b) const;
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
                        const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
   template <class Surface>
