@@ -127,7 +127,7 @@ Float BlendedSurface::bound(const Float* hmax, const Float* wmax) const {
   return combine(hmax, wmax);
 }
 
-Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const Int& cy) const {
+Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, const Int& cell_y) const {
   const simd::IntMask coarse = level >= Int(1);
   Float result(0.0f);
   if (xsimd::any(coarse)) {
@@ -135,13 +135,18 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cx, const I
     lanes.narrow(simd::float_mask(coarse));
     const Int period = Int(texture_.period) >> level;
     Float texel[4];
-    texture_.combined->load(xsimd::max(level - Int(1), Int(0)), wrap_cell(cx, period), wrap_cell(cy, period), texel);
+    texture_.combined->load(xsimd::max(level - Int(1), Int(0)), wrap_cell(cell_x, period), wrap_cell(cell_y, period),
+                            texel);
     result = texel[0];
   }
   if (!xsimd::all(coarse)) {
     FetchLanes lanes;
     lanes.narrow(~simd::float_mask(coarse));
-    // Level 0: the exact box value, as the combined tree was built from.
+    // Level 0: the exact box value, as the combined tree was built from. The coarse lanes' values are dropped
+    // below; they read one fixed cell instead of their own small indices, which sit at the weight map's wrap edge
+    // and sent most batches' bilinear weight samples to the per-texel path (3 in 5 on the terrain).
+    const Int middle(width() / 2);
+    const Int cx = xsimd::select(coarse, middle, cell_x), cy = xsimd::select(coarse, middle, cell_y);
     Float h[kMaxLayers], w[kMaxLayers];
     if (texture_.layer_heights != nullptr && !fetch_recorder_listens()) {
       // The same decoded heights as each layer's chain holds at level 0 (wrap: power-of-two sizes).
