@@ -3,6 +3,7 @@
 // the draw stage fills it, any kernel consumes it.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -45,6 +46,23 @@ struct TileCounters : TileCounts {
     const int bin = int(std::min<std::uint64_t>(n, kIterationBins));
     iteration_histogram[std::size_t(bin)] += lanes;
     histogram_bins = std::max(histogram_bins, bin + 1);
+  }
+  // The lanes set in `pass`, lane l having run iterations[l] (whole numbers): each in its bin, and their sum in
+  // iterations_useful. The sum and the histogram's bound are kept in registers and stored once: updated in the
+  // members lane by lane, each lane waited on the last one's store (the histogram may alias them), which cost a
+  // QDM frame 5 % in the tile write.
+  void count_lanes(const float* iterations, std::uint32_t pass) {
+    std::uint64_t useful = 0;
+    int bins = histogram_bins;
+    for (; pass != 0; pass &= pass - 1) {
+      const auto n = std::uint64_t(iterations[std::countr_zero(pass)]);
+      const int bin = int(std::min<std::uint64_t>(n, kIterationBins));
+      useful += n;
+      ++iteration_histogram[std::size_t(bin)];
+      bins = std::max(bins, bin + 1);
+    }
+    iterations_useful += useful;
+    histogram_bins = bins;
   }
   // Back to all zero.
   void reset();

@@ -482,12 +482,7 @@ private:
       counters_.iterations_useful += n * lanes;
       counters_.count_iterations(n, lanes);
     } else {
-      for (int l = 0; l < kLanes; ++l) {
-        if (!((pass >> l) & 1u)) continue;
-        const auto n = std::uint64_t(iterations[l]);
-        counters_.iterations_useful += n;
-        counters_.count_iterations(n, 1);
-      }
+      counters_.count_lanes(iterations, pass);
     }
     counters_.iterations_executed += std::uint64_t(longest) * kLanes;
     ++counters_.batches_shaded;
