@@ -103,7 +103,8 @@ void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
 
 // Stage by stage, a's and b's work side by side: each stage of one batch is a chain of dependent operations
 // (derivatives, LOD, the sample's addresses, its loads, the filter), and the other batch's same stage next to it
-// gives the core independent work to overlap with it.
+// gives the core independent work to overlap with it. Sparse batches whose covered lanes fit in one run packed
+// (shade_packed).
 void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                       ShadeOutput& out_b) const {
   const UvDerivatives da = derivatives(a), db = derivatives(b);

@@ -11,7 +11,8 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 Float bilinear_patch(const Ray& ray, const Float& ds, const Float& s_start, Float& iterations, Mask active,
                      const HeightField& surface, int max_iterations);
 
-// The ray's depth below the surface at depth s, from the surface height h there (positive: the ray is above it).
+// The surface's depth minus the ray's at ray depth s, from the surface height h there (positive: the ray is above
+// the surface).
 inline Float gap(const Float& ds, const Float& h, const Float& s) { return ds * (Float(1.0f) - h) - s; }
 
 // The linear refinement between depths lo and hi from the gaps there: where the line through them crosses zero if
