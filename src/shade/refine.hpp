@@ -24,6 +24,12 @@ inline Float linear_crossing(const Float& lo, const Float& hi, const Float& gap_
   return xsimd::select(bracket, lo + (hi - lo) * t, xsimd::select(gap_lo <= Float(0.0f), lo, hi));
 }
 
+// Where the refinement of a box-surface hit at depth s starts: one level-0 texel step before it, at least 0.
+template <class Surface>
+Float bracket_start(const Surface& surface, const Ray& ray, const Float& s) {
+  return xsimd::max(s - texel_step(ray, float(surface.width()), float(surface.height())), Float(0.0f));
+}
+
 // Between the last texel step before a box-surface hit and the hit, against the filtered (bilinear) surface.
 // Recorded false: no texture-cache recorder listens (refine() picks).
 template <bool Recorded, class Surface>
@@ -33,9 +39,7 @@ Float refine_as(const Surface& surface, const Ray& ray, const Float& ds, const F
   LoopLanes<Recorded> lanes(FetchPhase::Refine);
   lanes.narrow(active);
   const Float lod0(0.0f);
-  const Float step = texel_step(ray, float(surface.width()), float(surface.height()));
-  Float lo = xsimd::max(s_hit - step, Float(0.0f)), hi = s_hit;
-  // The surface's depth minus the ray's at s (positive: the ray is above the surface).
+  Float lo = bracket_start(surface, ray, s_hit), hi = s_hit;
   const auto gap_at = [&](const Float& s) __attribute__((always_inline)) {
     return gap(ds, surface_height<Recorded>(surface, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod0), s);
   };
@@ -68,13 +72,10 @@ template <class Surface>
 void refine_linear_pair(const Surface& surface, const Ray& ray_a, const Float& ds_a, Float& s_a, Float& iterations_a,
                         Mask active_a, const Ray& ray_b, const Float& ds_b, Float& s_b, Float& iterations_b,
                         Mask active_b) {
-  const auto lo_of = [&](const Ray& ray, const Float& s) __attribute__((always_inline)) {
-    return xsimd::max(s - texel_step(ray, float(surface.width()), float(surface.height())), Float(0.0f));
-  };
   const auto height_at = [&](const Ray& ray, const Float& s) __attribute__((always_inline)) {
     return surface_height<false>(surface, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, Float(0.0f));
   };
-  const Float lo_a = lo_of(ray_a, s_a), lo_b = lo_of(ray_b, s_b);
+  const Float lo_a = bracket_start(surface, ray_a, s_a), lo_b = bracket_start(surface, ray_b, s_b);
   const Float h_lo_a = height_at(ray_a, lo_a), h_hi_a = height_at(ray_a, s_a);
   const Float h_lo_b = height_at(ray_b, lo_b), h_hi_b = height_at(ray_b, s_b);
   iterations_a += count(active_a) * Float(2.0f);
