@@ -67,7 +67,7 @@ Float refine_as(const Surface& surface, const Ray& ray, const Float& ds, const F
 
 // The linear refinement (refine_as with QdmRefinement::Linear, no recorder) of two batches' hits at once, s_a and
 // s_b in, refined out: the four surface samples' loads, which often miss the cache, go side by side instead of one
-// batch's after the other's (the QDM frame 1.018x). Each lane's result is refine_as's.
+// batch's after the other's (the QDM frame 1.011-1.018x). Each lane's result is refine_as's.
 template <class Surface>
 void refine_linear_pair(const Surface& surface, const Ray& ray_a, const Float& ds_a, Float& s_a, Float& iterations_a,
                         Mask active_a, const Ray& ray_b, const Float& ds_b, Float& s_b, Float& iterations_b,
