@@ -166,7 +166,7 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
   return result;
 }
 
-Float BlendedSurface::cell_max(const Int& level, const Int& cx, const Int& cy) const {
+Float BlendedSurface::tree_max(const Int& level, const Int& cx, const Int& cy) const {
   if (texture_.combined) return combined_cell_max(level, cx, cy);
   Float hmax[kMaxLayers];
   for (int i = 0; i < count_; ++i)

@@ -58,7 +58,12 @@ public:
   const SingleLayerSurface& layer(int i) const { return layers_[i]; }
 
   simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const;
-  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
+  // Recorded false: the caller knows no texture-cache recorder listens (a paired walk); the blend's fetches ask
+  // for themselves either way, so both give the same code.
+  template <bool Recorded = true>
+  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
+    return tree_max(level, cx, cy);
+  }
   // The highest height anywhere the batch's queries go.
   simd::Float max_height() const;
   simd::Float cell_max_filtered(const simd::Float& u, const simd::Float& v, const simd::Float& level) const;
@@ -74,6 +79,7 @@ private:
                      simd::Float* w) const;
   simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
   void find_present();
+  simd::Float tree_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
   simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
   bool present(int i) const { return (present_ >> i) & 1u; }
   // fetch(layer i), recorded for the texture cache only in the lanes where layer i has weight: on its own, the

@@ -455,6 +455,7 @@ void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, con
   (this->*shade_pair_)(a, out_a, b, out_b);
 }
 
+// QDM over a blend: both walks interleaved, each over its batch's own blended surface, then each batch's hit shaded.
 // Single-layer QDM, relief and POM: both batches set up and traced (QDM's walks interleaved), then the surface at
 // each hit and its lighting, stage by stage, each batch's chains of dependent operations beside the other's. Any
 // other program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
@@ -462,6 +463,23 @@ template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
   constexpr TechniqueKind kind = V::technique;
+  if constexpr (kind == TechniqueKind::Qdm) {
+    if (layers_.size() > 1) {  // a blend: both walks interleaved, then each batch's surface and lighting
+      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+      const LayerSurfaces layers = layer_surfaces();
+      const BlendedSurface surface_a = blended_surface(layers, a, setup_a), surface_b = blended_surface(layers, b, setup_b);
+      const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
+      using Walk = trace::QdmWalk<V, BlendedSurface, false>;  // no recorder listens to paired batches
+      Walk walk_a(surface_a, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
+      Walk walk_b(surface_b, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
+      trace::qdm_pair(walk_a, walk_b);
+      const Hit hit_a = refine_qdm_hit(surface_a, setup_a, walk_a.hit());
+      const Hit hit_b = refine_qdm_hit(surface_b, setup_b, walk_b.hit());
+      shade_hit<V>(a, setup_a, surface_a, hit_a, setup_a.ds, out_a);
+      shade_hit<V>(b, setup_b, surface_b, hit_b, setup_b.ds, out_b);
+      return;
+    }
+  }
   if constexpr (pairs_technique(kind)) {
     if (layers_.size() == 1) {
       const Setup setup_a = setup_for(a), setup_b = setup_for(b);
@@ -502,7 +520,7 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
 }
 
 bool DisplacementProgram::pairs_batches() const {
-  return pairs_technique(technique_.kind) && layers_.size() == 1;
+  return (pairs_technique(technique_.kind) && layers_.size() == 1) || technique_.kind == TechniqueKind::Qdm;
 }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
@@ -532,29 +550,36 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
 template <class V>
 void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) const {
   const Setup setup = setup_for(in);
-  const int count = int(layers_.size());
-  if (count == 1) {
+  if (layers_.size() == 1) {
     shade_surface<V>(in, setup, layer_surface(0), out);
     return;
   }
-  const SingleLayerSurface surfaces[BlendedSurface::kMaxLayers] = {
-      layer_surface(0), layer_surface(1), layer_surface(std::min(2, count - 1)), layer_surface(std::min(3, count - 1))};
+  const LayerSurfaces layers = layer_surfaces();
+  shade_surface<V>(in, setup, blended_surface(layers, in, setup), out);
+}
+
+DisplacementProgram::LayerSurfaces DisplacementProgram::layer_surfaces() const {
+  const int count = int(layers_.size());
+  return {layer_surface(0), layer_surface(std::min(1, count - 1)), layer_surface(std::min(2, count - 1)),
+          layer_surface(std::min(3, count - 1))};
+}
+
+BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers, const Fragments& in,
+                                                    const Setup& setup) const {
+  const int count = int(layers_.size());
   if (blend_.weights.mode == WeightMode::Vertex) {
     const Float w[BlendedSurface::kMaxLayers] = {in.varyings[kWeight0], in.varyings[kWeight1],
                                                  count > 2 ? in.varyings[kWeight2] : Float(0.0f),
                                                  count > 3 ? in.varyings[kWeight3] : Float(0.0f)};
-    shade_surface<V>(in, setup, BlendedSurface(surfaces, count, blend_.op, w), out);
-    return;
+    return BlendedSurface(layers.data(), count, blend_.op, w);
   }
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
   const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_,
                               layer_heights_};
-  const BlendedSurface surface(surfaces, count, blend_.op, weights,
-                               xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1), xsimd::min(ray.v0, v1),
-                               xsimd::max(ray.v0, v1));
-  shade_surface<V>(in, setup, surface, out);
+  return BlendedSurface(layers.data(), count, blend_.op, weights, xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1),
+                        xsimd::min(ray.v0, v1), xsimd::max(ray.v0, v1));
 }
 
 template <class V>

@@ -3,6 +3,7 @@
 // techniques (one file each: relief.hpp, pom.hpp, qdm.hpp, cone_step.hpp, then refine.hpp), then the surface
 // shaded at the hit as in normal mapping. Up to four layers are blended into one surface (blended_surface.hpp)
 // and their colours by the material's blend operator. Optionally the exact fp64 reference is traced too, for the error AOVs.
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -72,10 +73,14 @@ private:
                       const Variant& variant);
 
   SingleLayerSurface layer_surface(int i) const;
+  // A blend's layers (the last one repeated past the layer count) and its surface for one batch.
+  using LayerSurfaces = std::array<SingleLayerSurface, BlendedSurface::kMaxLayers>;
+  LayerSurfaces layer_surfaces() const;
+  BlendedSurface blended_surface(const LayerSurfaces& layers, const Fragments& in, const Setup& setup) const;
   Setup setup_for(const Fragments& in) const;
   template <class V>
   void shade_variant(const Fragments& in, ShadeOutput& out) const;
-  // The techniques whose single-layer batches are shaded in pairs (shade_pair_variant).
+  // The techniques whose single-layer batches are shaded in pairs (shade_pair_variant); QDM's blended ones are too.
   static constexpr bool pairs_technique(TechniqueKind k) {
     return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
   }

@@ -95,8 +95,8 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
 // when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
-// a 4-layer blend with per-pixel weights (not paired), on its combined quadtree and on the product of the layers'
-// and weights' trees; surface_blend_4layers under QDM, its 4 layers blended by vertex weights (not paired); plane
+// a 4-layer blend with per-pixel weights (paired), on its combined quadtree and on the product of the layers'
+// and weights' trees; surface_blend_4layers under QDM, its 4 layers blended by vertex weights (paired); plane
 // normal mapping (paired, no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
