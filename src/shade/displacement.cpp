@@ -348,10 +348,12 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
   } else {
     const int count = surface.layer_count();
     Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
-    if (blend_.op != BlendOperator::Alpha) {
-      for (int i = 0; i < count; ++i) h[i] = surface.layer(i).height(hu, hv, setup.height_lod);
-    }
     surface.weights_at(hu, hv, w);
+    if (blend_.op != BlendOperator::Alpha) {
+      // A layer whose weight is 0 in every lane has factor 0 whatever its height (blend_factors): not fetched.
+      for (int i = 0; i < count; ++i)
+        h[i] = xsimd::any(w[i] != Float(0.0f)) ? surface.layer(i).height(hu, hv, setup.height_lod) : Float(0.0f);
+    }
     blend_factors(blend_.op, blend_.width, count, h, w, f);
     for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
     for (int c = 0; c < 3; ++c) tangent_normal[c] = Float(0.0f);
