@@ -1,9 +1,11 @@
 #include "shade/displacement.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <type_traits>
 
+#include "core/lane_packing.hpp"
 #include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
@@ -316,6 +318,7 @@ void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, con
   SurfaceAtHit at;
   surface_at_hit(setup, surface, hit, ds, at);
   light_hit<V>(in, setup, surface, at, ds, out);
+  if (technique_.write_depth) displaced_depth(in, setup.d, setup.frame, setup.ray, at.hit.s, out);
 }
 
 template <class Surface>
@@ -350,9 +353,16 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
     Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
     surface.weights_at(hu, hv, w);
     if (blend_.op != BlendOperator::Alpha) {
-      // A layer whose weight is 0 in every lane has factor 0 whatever its height (blend_factors): not fetched.
-      for (int i = 0; i < count; ++i)
-        h[i] = xsimd::any(w[i] != Float(0.0f)) ? surface.layer(i).height(hu, hv, setup.height_lod) : Float(0.0f);
+      // A lane whose weight of a layer is 0 gets factor 0 from it whatever its height (blend_factors): only the
+      // lanes with weight fetch a layer's height (as the texture cache counts them), none where no lane has any.
+      for (int i = 0; i < count; ++i) {
+        const Mask weighted = w[i] != Float(0.0f);
+        h[i] = Float(0.0f);
+        if (!xsimd::any(weighted)) continue;
+        FetchLanes layer_lanes;
+        layer_lanes.narrow(weighted);
+        h[i] = surface.layer(i).height(hu, hv, setup.height_lod);
+      }
     }
     blend_factors(blend_.op, blend_.width, count, h, w, f);
     for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
@@ -384,8 +394,6 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
 template <class V, class Surface>
 void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, const Surface& surface,
                                     const SurfaceAtHit& at, const Float& ds, ShadeOutput& out) const {
-  const UvDerivatives& d = setup.d;
-  const Ray& ray = setup.ray;
   const Hit& hit = at.hit;
   const TangentFrame& frame = setup.frame;
   const Vec3 shading_normal =
@@ -400,8 +408,7 @@ void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, con
   out.hit_depth = hit.s;
   out.error_texels = out.missed = Float(0.0f);
   if constexpr (V::technique != TechniqueKind::Normal)
-    if (reference_) reference_errors(ray, ds, hit, in.covered, out);
-  if (technique_.write_depth) displaced_depth(in, d, frame, ray, hit.s, out);
+    if (reference_) reference_errors(setup.ray, ds, hit, in.covered, out);
 }
 
 // Self-shadowing per light and ambient occlusion at the hit, then the lighting model.
@@ -469,6 +476,11 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
     if (layers_.size() > 1) {  // a blend: both walks interleaved, then each batch's surface and lighting
       const Setup setup_a = setup_for(a), setup_b = setup_for(b);
       const LayerSurfaces layers = layer_surfaces();
+      const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
+      if (simd::LanePacking::fits(covered_a, covered_b)) {
+        shade_packed<V>(layers, a, setup_a, out_a, b, setup_b, out_b, simd::LanePacking(covered_a, covered_b));
+        return;
+      }
       const BlendedSurface surface_a = blended_surface(layers, a, setup_a), surface_b = blended_surface(layers, b, setup_b);
       const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
       using Walk = trace::QdmWalk<V, BlendedSurface, false>;  // no recorder listens to paired batches
@@ -508,6 +520,59 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
   shade_variant<V>(b, out_b);
 }
 
+// Past the setup (whose derivatives read whole quads) a blended batch's work is lane by lane: the covered lanes of
+// both batches are traced and shaded as one batch, and each batch gets its own lanes back. The displaced depth
+// reads quads again (the world position's derivatives): each batch's, from its own lanes' hits.
+template <class V>
+void DisplacementProgram::shade_packed(const LayerSurfaces& layers, const Fragments& a, const Setup& setup_a,
+                                       ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, ShadeOutput& out_b,
+                                       const simd::LanePacking& packing) const {
+  const auto pack = [&](const Float& x, const Float& y) { return packing.pack(x, y); };
+  const auto pack3 = [&](const Vec3& x, const Vec3& y) { return Vec3{pack(x.x, y.x), pack(x.y, y.y), pack(x.z, y.z)}; };
+  const int lanes_used = std::popcount(simd::to_bits(a.covered)) + std::popcount(simd::to_bits(b.covered));
+  const Mask used = simd::from_bits((1u << lanes_used) - 1u);
+  Fragments in;
+  in.pixel_x = pack(a.pixel_x, b.pixel_x);
+  in.pixel_y = pack(a.pixel_y, b.pixel_y);
+  for (int k = 0; k < varying_count(); ++k) in.varyings[k] = pack(a.varyings[k], b.varyings[k]);
+  in.view_depth = pack(a.view_depth, b.view_depth);
+  in.covered = used;
+  Setup setup;
+  setup.d = {pack(setup_a.d.dudx, setup_b.d.dudx), pack(setup_a.d.dvdx, setup_b.d.dvdx),
+             pack(setup_a.d.dudy, setup_b.d.dudy), pack(setup_a.d.dvdy, setup_b.d.dvdy)};
+  setup.frame = {pack3(setup_a.frame.t, setup_b.frame.t), pack3(setup_a.frame.b, setup_b.frame.b),
+                 pack3(setup_a.frame.n, setup_b.frame.n)};
+  setup.view = pack3(setup_a.view, setup_b.view);
+  setup.view_tangent = pack3(setup_a.view_tangent, setup_b.view_tangent);
+  setup.ds = pack(setup_a.ds, setup_b.ds);
+  setup.ray = {pack(setup_a.ray.u0, setup_b.ray.u0), pack(setup_a.ray.v0, setup_b.ray.v0),
+               pack(setup_a.ray.du, setup_b.ray.du), pack(setup_a.ray.dv, setup_b.ray.dv)};
+  setup.active = used;
+  setup.height_lod = pack(setup_a.height_lod, setup_b.height_lod);
+  const BlendedSurface surface = blended_surface(layers, in, setup);
+  Float ds = setup.ds;
+  const Hit hit = trace<V>(surface, setup, ds);
+  SurfaceAtHit at;
+  surface_at_hit(setup, surface, hit, ds, at);
+  ShadeOutput lit;
+  light_hit<V>(in, setup, surface, at, ds, lit);
+  const auto unpack = [&](const Fragments& batch, const Setup& batch_setup, ShadeOutput& out, auto lanes) {
+    out = lit;
+    for (int c = 0; c < 3; ++c) {
+      out.color[c] = lanes(lit.color[c]);
+      out.normal[c] = lanes(lit.normal[c]);
+    }
+    for (Float ShadeOutput::*f : {&ShadeOutput::iterations, &ShadeOutput::hit_u, &ShadeOutput::hit_v,
+                                  &ShadeOutput::hit_depth, &ShadeOutput::error_texels, &ShadeOutput::missed,
+                                  &ShadeOutput::shadow, &ShadeOutput::ao})
+      out.*f = lanes(lit.*f);
+    if (technique_.write_depth)
+      displaced_depth(batch, batch_setup.d, batch_setup.frame, batch_setup.ray, lanes(at.hit.s), out);
+  };
+  unpack(a, setup_a, out_a, [&](const Float& v) { return packing.first(v); });
+  unpack(b, setup_b, out_b, [&](const Float& v) { return packing.second(v); });
+}
+
 // shade_hit() of two single-layer batches, stage by stage: the surface at each hit, then the lighting of each.
 template <class V>
 void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const Float& ds_a,
@@ -519,6 +584,10 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
   surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
   light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
   light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
+  if (technique_.write_depth) {
+    displaced_depth(a, setup_a.d, setup_a.frame, setup_a.ray, at_a.hit.s, out_a);
+    displaced_depth(b, setup_b.d, setup_b.frame, setup_b.ray, at_b.hit.s, out_b);
+  }
 }
 
 bool DisplacementProgram::pairs_batches() const {

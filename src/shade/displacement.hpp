@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/lane_packing.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "shade/blended_surface.hpp"
@@ -88,8 +89,8 @@ private:
   void shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
-  // Everything after the trace: the surface's colour and normal at the hit, lighting, AOVs, depth; in two stages
-  // (a pair of batches runs each stage for both side by side).
+  // Everything after the trace: the surface's colour and normal at the hit, lighting and AOVs (light_hit), then the
+  // displaced depth; in stages (a pair of batches runs each stage for both side by side).
   struct SurfaceAtHit;
   template <class V, class Surface>
   void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
@@ -97,6 +98,10 @@ private:
   template <class Surface>
   void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
                       SurfaceAtHit& at) const;
+  template <class V>
+  void shade_packed(const LayerSurfaces& layers, const Fragments& a, const Setup& setup_a, ShadeOutput& out_a,
+                    const Fragments& b, const Setup& setup_b, ShadeOutput& out_b,
+                    const simd::LanePacking& packing) const;
   template <class V>
   void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const simd::Float& ds_a,
                   ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
