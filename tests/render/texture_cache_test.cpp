@@ -95,9 +95,10 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
 // when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
-// a 4-layer blend with per-pixel weights (paired), on its combined quadtree and on the product of the layers'
-// and weights' trees; surface_blend_4layers under QDM, its 4 layers blended by vertex weights (paired); plane
-// normal mapping (paired, no trace).
+// a 4-layer blend with per-pixel weights (paired, and packed where two batches' covered lanes fit one), with and
+// without the displaced depth, on its combined quadtree and on the product of the layers' and weights' trees;
+// surface_blend_4layers under QDM, its 4 layers blended by vertex weights (paired); plane normal mapping (paired,
+// no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
     const char* scene;
@@ -107,6 +108,7 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
                         {"objects_displaced",
                          {{"/materials/floor/technique/name", "\"csm\""}, {"/materials/stone_box/technique/name", "\"rcsm\""}}},
                         {"terrain", {}},
+                        {"terrain", {{"/materials/ground/technique/write_depth", "true"}}},
                         {"terrain", {{"/materials/ground/blend/quadtree", "\"product\""}}},
                         {"surface_blend_4layers", {{"/materials/blend/technique/name", "\"qdm\""}}},
                         {"plane", {}}};
@@ -122,7 +124,7 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
       ASSERT_TRUE(on.texture_cache.enabled);
       RenderOptions options;
       options.isa = isa;
-      options.aovs = {Aov::Depth, Aov::Normal, Aov::Iterations, Aov::HitUV, Aov::HitDepth};
+      options.aovs = {Aov::Depth, Aov::Normal, Aov::Iterations, Aov::HitUV, Aov::HitDepth, Aov::Shadow, Aov::Ao};
       const Frame a = render_frame(off, options), b = render_frame(on, options);
       EXPECT_TRUE(same_bits(a.color, b.color));
       ASSERT_EQ(a.aovs.size(), b.aovs.size());
