@@ -464,7 +464,8 @@ void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, con
   (this->*shade_pair_)(a, out_a, b, out_b);
 }
 
-// QDM over a blend: both walks interleaved, each over its batch's own blended surface, then each batch's hit shaded.
+// QDM, relief and POM over a blend: two batches whose covered lanes fit one run as one (shade_packed); else both
+// are traced (QDM's walks interleaved), each over its own blended surface, and each batch's hit shaded.
 // Single-layer QDM, relief and POM: both batches set up and traced (QDM's walks interleaved), then the surface at
 // each hit and its lighting, stage by stage, each batch's chains of dependent operations beside the other's. Any
 // other program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
@@ -472,9 +473,9 @@ template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
   constexpr TechniqueKind kind = V::technique;
-  if constexpr (kind == TechniqueKind::Qdm) {
-    if (layers_.size() > 1) {  // a blend: both walks interleaved, then each batch's surface and lighting
-      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+  if constexpr (pairs_technique(kind)) {
+    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
+    if (layers_.size() > 1) {  // a blend: packed, or both traced (QDM's walks interleaved), then each shaded
       const LayerSurfaces layers = layer_surfaces();
       const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
       if (simd::LanePacking::fits(covered_a, covered_b)) {
@@ -482,42 +483,49 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
         return;
       }
       const BlendedSurface surface_a = blended_surface(layers, a, setup_a), surface_b = blended_surface(layers, b, setup_b);
-      const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
-      using Walk = trace::QdmWalk<V, BlendedSurface, false>;  // no recorder listens to paired batches
-      Walk walk_a(surface_a, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
-      Walk walk_b(surface_b, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
-      trace::qdm_pair(walk_a, walk_b);
-      const Hit hit_a = refine_qdm_hit(surface_a, setup_a, walk_a.hit());
-      const Hit hit_b = refine_qdm_hit(surface_b, setup_b, walk_b.hit());
-      shade_hit<V>(a, setup_a, surface_a, hit_a, setup_a.ds, out_a);
-      shade_hit<V>(b, setup_b, surface_b, hit_b, setup_b.ds, out_b);
-      return;
-    }
-  }
-  if constexpr (pairs_technique(kind)) {
-    if (layers_.size() == 1) {
-      const Setup setup_a = setup_for(a), setup_b = setup_for(b);
-      const SingleLayerSurface surface = layer_surface(0);
+      Float ds_a = setup_a.ds, ds_b = setup_b.ds;  // POM fades them with distance
+      Hit hit_a, hit_b;
       if constexpr (kind == TechniqueKind::Qdm) {
-        const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
-        using Walk = trace::QdmWalk<V, SingleLayerSurface, false>;  // no recorder listens to paired batches
-        Walk walk_a(surface, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
-        Walk walk_b(surface, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
-        trace::qdm_pair(walk_a, walk_b);
-        Hit hit_a = walk_a.hit(), hit_b = walk_b.hit();
-        refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
-        shade_hits<V>(a, setup_a, hit_a, setup_a.ds, out_a, b, setup_b, hit_b, setup_b.ds, out_b);
-      } else {  // relief and POM: their loops run at the core's throughput already; one after the other
-        Float ds_a = setup_a.ds, ds_b = setup_b.ds;
-        const Hit hit_a = trace<V>(surface, setup_a, ds_a);
-        const Hit hit_b = trace<V>(surface, setup_b, ds_b);
-        shade_hits<V>(a, setup_a, hit_a, ds_a, out_a, b, setup_b, hit_b, ds_b, out_b);
+        walk_pair<V>(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
+        hit_a = refine_qdm_hit(surface_a, setup_a, hit_a);
+        hit_b = refine_qdm_hit(surface_b, setup_b, hit_b);
+      } else {
+        hit_a = trace<V>(surface_a, setup_a, ds_a);
+        hit_b = trace<V>(surface_b, setup_b, ds_b);
       }
+      shade_hit<V>(a, setup_a, surface_a, hit_a, ds_a, out_a);
+      shade_hit<V>(b, setup_b, surface_b, hit_b, ds_b, out_b);
       return;
     }
+    const SingleLayerSurface surface = layer_surface(0);
+    if constexpr (kind == TechniqueKind::Qdm) {
+      Hit hit_a, hit_b;
+      walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
+      refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
+      shade_hits<V>(a, setup_a, hit_a, setup_a.ds, out_a, b, setup_b, hit_b, setup_b.ds, out_b);
+    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
+      Float ds_a = setup_a.ds, ds_b = setup_b.ds;
+      const Hit hit_a = trace<V>(surface, setup_a, ds_a);
+      const Hit hit_b = trace<V>(surface, setup_b, ds_b);
+      shade_hits<V>(a, setup_a, hit_a, ds_a, out_a, b, setup_b, hit_b, ds_b, out_b);
+    }
+    return;
   }
   shade_variant<V>(a, out_a);
   shade_variant<V>(b, out_b);
+}
+
+// Two batches' QDM walks to their ends, a step of each per round: their hits on the box surface.
+template <class V, class Surface>
+void DisplacementProgram::walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a,
+                                    const Surface& surface_b, const Setup& setup_b, Hit& hit_b) const {
+  const QdmBudget budget_a = qdm_budget(setup_a), budget_b = qdm_budget(setup_b);
+  using Walk = trace::QdmWalk<V, Surface, false>;  // no recorder listens to paired batches
+  Walk walk_a(surface_a, setup_a.ray, setup_a.ds, budget_a.stop_level, budget_a.cap, setup_a.active);
+  Walk walk_b(surface_b, setup_b.ray, setup_b.ds, budget_b.stop_level, budget_b.cap, setup_b.active);
+  trace::qdm_pair(walk_a, walk_b);
+  hit_a = walk_a.hit();
+  hit_b = walk_b.hit();
 }
 
 // Past the setup (whose derivatives read whole quads) a blended batch's work is lane by lane: the covered lanes of
@@ -590,9 +598,7 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
   }
 }
 
-bool DisplacementProgram::pairs_batches() const {
-  return (pairs_technique(technique_.kind) && layers_.size() == 1) || technique_.kind == TechniqueKind::Qdm;
-}
+bool DisplacementProgram::pairs_batches() const { return pairs_technique(technique_.kind); }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
   const Float& u = in.varyings[kU];

@@ -81,7 +81,7 @@ private:
   Setup setup_for(const Fragments& in) const;
   template <class V>
   void shade_variant(const Fragments& in, ShadeOutput& out) const;
-  // The techniques whose single-layer batches are shaded in pairs (shade_pair_variant); QDM's blended ones are too.
+  // The techniques whose batches are shaded in pairs (shade_pair_variant).
   static constexpr bool pairs_technique(TechniqueKind k) {
     return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
   }
@@ -98,6 +98,9 @@ private:
   template <class Surface>
   void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
                       SurfaceAtHit& at) const;
+  template <class V, class Surface>
+  void walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
+                 const Setup& setup_b, Hit& hit_b) const;
   template <class V>
   void shade_packed(const LayerSurfaces& layers, const Fragments& a, const Setup& setup_a, ShadeOutput& out_a,
                     const Fragments& b, const Setup& setup_b, ShadeOutput& out_b,

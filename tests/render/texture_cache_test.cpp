@@ -97,8 +97,8 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
 // a 4-layer blend with per-pixel weights (paired, and packed where two batches' covered lanes fit one), with and
 // without the displaced depth, on its combined quadtree and on the product of the layers' and weights' trees;
-// surface_blend_4layers under QDM, its 4 layers blended by vertex weights (paired); plane normal mapping (paired,
-// no trace).
+// surface_blend_4layers under POM and QDM, its 4 layers blended by vertex weights (paired, and packed where they
+// fit); plane normal mapping (paired, no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
     const char* scene;
@@ -110,6 +110,7 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
                         {"terrain", {}},
                         {"terrain", {{"/materials/ground/technique/write_depth", "true"}}},
                         {"terrain", {{"/materials/ground/blend/quadtree", "\"product\""}}},
+                        {"surface_blend_4layers", {}},
                         {"surface_blend_4layers", {{"/materials/blend/technique/name", "\"qdm\""}}},
                         {"plane", {}}};
   for (const Case& c : cases) {
