@@ -570,10 +570,13 @@ void DisplacementProgram::shade_packed(const LayerSurfaces& layers, const Fragme
       out.color[c] = lanes(lit.color[c]);
       out.normal[c] = lanes(lit.normal[c]);
     }
-    for (Float ShadeOutput::*f : {&ShadeOutput::iterations, &ShadeOutput::hit_u, &ShadeOutput::hit_v,
-                                  &ShadeOutput::hit_depth, &ShadeOutput::error_texels, &ShadeOutput::missed,
-                                  &ShadeOutput::shadow, &ShadeOutput::ao})
+    for (Float ShadeOutput::*f : {&ShadeOutput::hit_u, &ShadeOutput::hit_v, &ShadeOutput::hit_depth,
+                                  &ShadeOutput::error_texels, &ShadeOutput::missed, &ShadeOutput::shadow,
+                                  &ShadeOutput::ao})
       out.*f = lanes(lit.*f);
+    // The rasterizer counts a batch's executed iterations from its longest lane, uncovered lanes included: they
+    // ran none, as in a batch shaded alone (lanes() leaves them undefined, another batch's count on some ISAs).
+    out.iterations = xsimd::select(batch.covered, lanes(lit.iterations), Float(0.0f));
     if (technique_.write_depth)
       displaced_depth(batch, batch_setup.d, batch_setup.frame, batch_setup.ray, lanes(at.hit.s), out);
   };
