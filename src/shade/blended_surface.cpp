@@ -127,10 +127,12 @@ Float BlendedSurface::bound(const Float* hmax, const Float* wmax) const {
   return combine(hmax, wmax);
 }
 
-Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, const Int& cell_y) const {
+Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, const Int& cell_y,
+                                        const simd::Mask& needed) const {
   const simd::IntMask coarse = level >= Int(1);
+  const simd::Mask fine = ~simd::float_mask(coarse);
   Float result(0.0f);
-  if (xsimd::any(coarse)) {
+  if (xsimd::any(~fine & needed)) {
     FetchLanes lanes;  // the batch reads the tree for every lane; only the coarse ones need it
     lanes.narrow(simd::float_mask(coarse));
     const Int period = Int(texture_.period) >> level;
@@ -139,9 +141,9 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
                             texel);
     result = texel[0];
   }
-  if (!xsimd::all(coarse)) {
+  if (xsimd::any(fine & needed)) {
     FetchLanes lanes;
-    lanes.narrow(~simd::float_mask(coarse));
+    lanes.narrow(fine);
     // Level 0: the exact box value, as the combined tree was built from. The coarse lanes' values are dropped
     // below; they read one fixed cell instead of their own small indices, which sit at the weight map's wrap edge
     // and sent most batches' bilinear weight samples to the per-texel path (3 in 5 on the terrain).
@@ -166,8 +168,8 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
   return result;
 }
 
-Float BlendedSurface::tree_max(const Int& level, const Int& cx, const Int& cy) const {
-  if (texture_.combined) return combined_cell_max(level, cx, cy);
+Float BlendedSurface::tree_max(const Int& level, const Int& cx, const Int& cy, const simd::Mask& needed) const {
+  if (texture_.combined) return combined_cell_max(level, cx, cy, needed);
   Float hmax[kMaxLayers];
   for (int i = 0; i < count_; ++i)
     hmax[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(level, cx, cy); }) : Float(0.0f);
@@ -184,7 +186,7 @@ Float BlendedSurface::tree_max(const Int& level, const Int& cx, const Int& cy) c
   for (int i = 0; i < count_; ++i) wmax[i] = xsimd::min(wmax[i], weights_[i]);
   Float result = bound(hmax, wmax);
   const simd::IntMask texel = level == Int(0);
-  if (xsimd::any(texel)) {
+  if (xsimd::any(simd::float_mask(texel) & needed)) {
     FetchLanes lanes;
     lanes.narrow(simd::float_mask(texel));
     // Level 0: the box value with the weights at the texel centre (unwrapped: the weight map does not repeat

@@ -59,10 +59,12 @@ public:
 
   simd::Float height(const simd::Float& u, const simd::Float& v, const simd::Float& lod) const;
   // Recorded false: the caller knows no texture-cache recorder listens (a paired walk); the blend's fetches ask
-  // for themselves either way, so both give the same code.
+  // for themselves either way, so both give the same code. Only the lanes in `needed` get their value: the
+  // level-0 box value and the coarse cells are each read only where a needed lane is at such a level.
   template <bool Recorded = true>
-  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
-    return tree_max(level, cx, cy);
+  simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
+                       const simd::Mask& needed = simd::Mask(true)) const {
+    return tree_max(level, cx, cy, needed);
   }
   // The highest height anywhere the batch's queries go.
   simd::Float max_height() const;
@@ -79,8 +81,9 @@ private:
                      simd::Float* w) const;
   simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
   void find_present();
-  simd::Float tree_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
-  simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const;
+  simd::Float tree_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const simd::Mask& needed) const;
+  simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
+                                const simd::Mask& needed) const;
   bool present(int i) const { return (present_ >> i) & 1u; }
   // fetch(layer i), recorded for the texture cache only in the lanes where layer i has weight: on its own, the
   // batch reads a layer for every lane as soon as one lane needs it.

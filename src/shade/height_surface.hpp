@@ -3,8 +3,9 @@
 // Heights h in [0, 1] over the UV plane, 1 at the polygon: at depth scale ds the surface lies at depth
 // ds * (1 - h). Two views of one surface:
 //   height(u, v, lod)            the filtered surface as the material's technique fetches it;
-//   cell_max(level, cx, cy)      a conservative maximum over a cell of the level-0 texel grid (wrap addressing),
-//                                exact at level 0 (the box surface QDM intersects).
+//   cell_max(level, cx, cy, needed)  a conservative maximum over a cell of the level-0 texel grid (wrap
+//                                addressing), exact at level 0 (the box surface QDM intersects), in the lanes of
+//                                `needed` (every lane by default; the others get any value).
 // SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (shade/blend.hpp) combines
 // up to four. Both are small per-batch values; the algorithms are templates over the surface type.
 #include <cstdint>
@@ -111,7 +112,8 @@ public:
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes). Recorded
   // false: the caller knows the texture-cache recorder does not listen (sampling_code::fetch).
   template <bool Recorded = true>
-  [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) const {
+  [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
+                                              const simd::Mask& /*needed: one load serves every lane*/ = simd::Mask(true)) const {
     const TextureSampler& t = textures_->tree;
     simd::Float texel[4];
     if (!load_inline<Recorded>(textures_->inline_max_chain, true, t.view(), level, cx, cy, texel))

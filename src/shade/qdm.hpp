@@ -41,9 +41,9 @@ public:
     if constexpr (V::filtered_max)
       hmax = surface_.cell_max_filtered(ray_.u0 + ray_.du * s_, ray_.v0 + ray_.dv * s_, xsimd::to_float(level_));
     else if constexpr (Recorded)
-      hmax = surface_.cell_max(level_, cx_, cy_);
+      hmax = surface_.cell_max(level_, cx_, cy_, active_);
     else
-      hmax = surface_.template cell_max<false>(level_, cx_, cy_);
+      hmax = surface_.template cell_max<false>(level_, cx_, cy_, active_);
     const Float top_depth = ds_ * (Float(1.0f) - hmax);
     const Mask below = active_ & (s_ >= top_depth);
     const IntMask at_stop = level_ <= stop_;
