@@ -81,7 +81,8 @@ private:
                      simd::Float* w) const;
   simd::Float bound(const simd::Float* hmax, const simd::Float* wmax) const;
   void find_present();
-  simd::Float tree_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const simd::Mask& needed) const;
+  simd::Float tree_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
+                       const simd::Mask& needed) const;
   simd::Float combined_cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
                                 const simd::Mask& needed) const;
   bool present(int i) const { return (present_ >> i) & 1u; }

@@ -110,10 +110,11 @@ public:
   }
 
   // The highest level-0 height in cell (cx, cy) of `level`; indices wrap (power-of-two level sizes). Recorded
-  // false: the caller knows the texture-cache recorder does not listen (sampling_code::fetch).
+  // false: the caller knows the texture-cache recorder does not listen (sampling_code::fetch). One load serves
+  // every lane, so the lanes that need the value change nothing.
   template <bool Recorded = true>
   [[gnu::always_inline]] simd::Float cell_max(const simd::Int& level, const simd::Int& cx, const simd::Int& cy,
-                                              const simd::Mask& /*needed: one load serves every lane*/ = simd::Mask(true)) const {
+                                              const simd::Mask& /*needed*/ = simd::Mask(true)) const {
     const TextureSampler& t = textures_->tree;
     simd::Float texel[4];
     if (!load_inline<Recorded>(textures_->inline_max_chain, true, t.view(), level, cx, cy, texel))

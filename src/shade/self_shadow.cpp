@@ -106,7 +106,8 @@ ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared
   Mask occluded = zero != zero;
   CappedLoop loop(Int(desc.max_iterations), FetchPhase::Shadow);
   while (loop.next(active)) {
-    const Float top_depth = p.ds * (Float(1.0f) - surface.cell_max(level, origin.x(level, cx), origin.y(level, cy), active));
+    const Float hmax = surface.cell_max(level, origin.x(level, cx), origin.y(level, cy), active);
+    const Float top_depth = p.ds * (Float(1.0f) - hmax);
     // A rising ray is lowest where it enters the cell, at c.
     const Mask below = active & (p.s - c > top_depth);
     const Mask hit = below & float_mask(level == Int(0));
