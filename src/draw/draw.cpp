@@ -142,8 +142,10 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
     DisplacementInputs inputs;
     for (const LayerPlan& l : m.layers) {
       const DerivedAsset* ao = derived(l.ao);
+      const DerivedAsset* twin = derived(l.twin);
       inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max),
-                               ao ? ao->texture.get() : nullptr});
+                               ao ? ao->texture.get() : nullptr,
+                               twin && !twin->twin_texels->empty() ? twin->twin_texels->data() : nullptr});
     }
     if (const DerivedAsset* w = derived(m.weights); w && m.weight_mode == WeightMode::Pixel) inputs.weights = w->texture.get();
     if (const DerivedAsset* c = derived(m.combined_quadtree)) {

@@ -18,8 +18,9 @@ public:
                                         const LightRig& lights) const override {
     if (material.technique.kind == TechniqueKind::Normal && inputs.layers.size() == 1) {
       const LayerInputs& l = inputs.layers[0];
-      return std::make_unique<NormalMappingProgram>(program_variant(material), *l.albedo, *l.normal, material.sampling, material.lighting,
-                                                    material.layers[0].specular, lights);
+      return std::make_unique<NormalMappingProgram>(program_variant(material), *l.albedo, *l.normal, l.twin_texels,
+                                                    material.sampling, material.lighting, material.layers[0].specular,
+                                                    lights);
     }
     return std::make_unique<DisplacementProgram>(inputs, material, lights);
   }

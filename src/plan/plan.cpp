@@ -19,6 +19,7 @@
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/image.hpp"
 #include "qdmr/texture/layer_heights.hpp"
+#include "qdmr/texture/twin_texels.hpp"
 
 namespace qdmr {
 namespace {
@@ -275,6 +276,7 @@ const char* derived_kind_name(DerivedKind kind) {
     case DerivedKind::LayerAoMap: return "layer_ao_map";
     case DerivedKind::ConeMap: return "cone_map";
     case DerivedKind::BilinearBound: return "bilinear_bound";
+    case DerivedKind::TwinTexels: return "twin_texels";
   }
   return "?";
 }
@@ -321,6 +323,23 @@ public:
     };
     std::string heights;
     for (const LayerPlan& l : m.layers) heights += (l.height >= 0 ? plan_.textures[std::size_t(l.height)].key : "-") + "|";
+
+    // Albedo and normal map interleaved where the program samples them as twins (TwinSampler: RGBA8 chains of one
+    // size, the albedo with its decoded copy, a linear filter with wrap addressing, not the 6-bit precision).
+    const SamplingDesc& sampling = desc.sampling;
+    const bool twin_state = sampling.address == AddressMode::Wrap && sampling.precision != SamplePrecision::Hw6 &&
+                            (sampling.filter == Filter::Bilinear || sampling.filter == Filter::Trilinear);
+    for (std::size_t layer = 0; layer < m.layers.size() && twin_state; ++layer) {
+      LayerPlan& l = m.layers[layer];
+      if (l.albedo < 0 || l.normal < 0) continue;
+      const TextureRequest &a = plan_.textures[std::size_t(l.albedo)], &n = plan_.textures[std::size_t(l.normal)];
+      const std::uint64_t bytes = twin_texels_bytes(a.width, a.height);
+      if (a.format != TexelFormat::RGBA8 || !a.srgb || n.format != TexelFormat::RGBA8 || n.srgb || a.width != n.width ||
+          a.height != n.height || bytes == 0)
+        continue;
+      l.twin = add(DerivedKind::TwinTexels, a.key + "|" + n.key, where + "/layers/" + std::to_string(layer), {}, index,
+                   bytes, l.albedo, 0, l.normal);
+    }
 
     if (m.blend) {
       const WeightsDesc& w = desc.blend.weights;
@@ -401,11 +420,12 @@ public:
 
 private:
   int add(DerivedKind kind, const std::string& key, const std::string& where, std::vector<int> inputs, std::uint32_t material,
-          std::uint64_t bytes, int texture = -1, int side = 0) {
+          std::uint64_t bytes, int texture = -1, int side = 0, int second_texture = -1) {
     const std::string full = std::string(derived_kind_name(kind)) + "|" + key;
     for (std::size_t i = 0; i < plan_.derived.size(); ++i)
       if (plan_.derived[i].key == full) return int(i);
-    plan_.derived.push_back({kind, full, where, std::move(inputs), texture, int(material), side, bytes});
+    DerivedPlan d{kind, full, where, std::move(inputs), texture, second_texture, int(material), side, bytes};
+    plan_.derived.push_back(std::move(d));
     return int(plan_.derived.size() - 1);
   }
 

@@ -9,6 +9,7 @@
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/height_texture.hpp"
+#include "qdmr/texture/twin_texels.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr {
@@ -232,6 +233,10 @@ private:
                           TexelFormat::R16, MipReduce::Box);
         break;
       }
+      case DerivedKind::TwinTexels:
+        out.twin_texels = std::make_shared<const std::vector<float>>(interleave_twin_texels(
+            *assets_.textures[std::size_t(d.texture)], *assets_.textures[std::size_t(d.second_texture)]));
+        break;
       case DerivedKind::HeightField:
         out.field = std::make_shared<const HeightField>(
             height_field(*assets_.textures[std::size_t(d.texture)], desc.sampling.address));

@@ -16,6 +16,7 @@ struct LayerInputs {
   const Texture* height = nullptr;      // box-filtered heights (techniques, height blending)
   const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
   const Texture* ao = nullptr;          // baked AO of this layer's heights (R16), when the material bakes AO
+  const float* twin_texels = nullptr;   // albedo and normal map interleaved (qdmr/texture/twin_texels.hpp), or null
 };
 
 struct DisplacementInputs {

@@ -56,7 +56,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   ao_sampler.filter = Filter::Bilinear;
   for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
     const LayerInputs& l = inputs.layers[i];
-    Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_), std::nullopt, std::nullopt,
+    Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_, l.twin_texels), std::nullopt, std::nullopt,
                 i < material.layers.size() ? material.layers[i].specular : SpecularFromAlbedo{}};
     if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, technique_.height_fetch);
     if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);

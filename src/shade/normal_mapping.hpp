@@ -12,9 +12,12 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
-  NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const SamplingDesc& sampling,
-                       const LightingDesc& lighting, const SpecularFromAlbedo& specular, const LightRig& lights)
-      : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling)), lod_mode_(sampling.lod),
+  // twin_texels: the two maps interleaved (qdmr/texture/twin_texels.hpp), or null.
+  NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const float* twin_texels,
+                       const SamplingDesc& sampling, const LightingDesc& lighting, const SpecularFromAlbedo& specular,
+                       const LightRig& lights)
+      : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling), twin_texels),
+        lod_mode_(sampling.lod),
         lighting_(lighting), specular_(specular), lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;

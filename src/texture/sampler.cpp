@@ -84,9 +84,10 @@ constexpr SamplerKey twin_second_key(std::size_t i) {
 }
 
 template <SamplerKey KA, SamplerKey KB>
-void sample_twin_fixed(const TextureView& a, const TextureView& b, const SamplerState& s, const Float& u,
-                       const Float& v, const Float& lod, const UvAhead* ahead, Float* out_a, Float* out_b) {
-  sample_twin_with(KA, KB, a, b, s, u, v, lod, ahead, out_a, out_b);
+void sample_twin_fixed(const TextureView& a, const TextureView& b, const float* interleaved, const SamplerState& s,
+                       const Float& u, const Float& v, const Float& lod, const UvAhead* ahead, Float* out_a,
+                       Float* out_b) {
+  sample_twin_with(KA, KB, a, b, interleaved, s, u, v, lod, ahead, out_a, out_b);
 }
 
 struct TwinEntry {
@@ -219,7 +220,9 @@ TextureSampler::TextureSampler(const Texture& texture, const SamplerState& state
   load_wrapped_ = e ? e->wrapped : &load_generic_wrapped;
 }
 
-TwinSampler::TwinSampler(const Texture& first, const Texture& second, const SamplerState& state)
-    : first_(first, state), second_(second, state), twin_(twin_sample_function(first_, second_)) {}
+TwinSampler::TwinSampler(const Texture& first, const Texture& second, const SamplerState& state,
+                         const float* interleaved)
+    : first_(first, state), second_(second, state), twin_(twin_sample_function(first_, second_)),
+      interleaved_(first.srgb && !first.linear.empty() ? interleaved : nullptr) {}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -170,39 +170,45 @@ struct UvAhead {
   simd::Float du, dv;
 };
 
-using TwinSampleFunction = void (*)(const TextureView& a, const TextureView& b, const SamplerState&,
-                                    const simd::Float& u, const simd::Float& v, const simd::Float& lod,
-                                    const UvAhead* ahead, simd::Float* out_a, simd::Float* out_b);
+using TwinSampleFunction = void (*)(const TextureView& a, const TextureView& b, const float* interleaved,
+                                    const SamplerState&, const simd::Float& u, const simd::Float& v,
+                                    const simd::Float& lod, const UvAhead* ahead, simd::Float* out_a,
+                                    simd::Float* out_b);
 
 // Two textures a program samples at the same coordinates under one sampler state, such as its albedo and its
 // normal map. Where both are RGBA8 chains of one size and the key is a common one, a texel sits at the same offset
 // in both, so one address computation and one offset per lane serve both textures (sample_twin_with in
-// sampling_code.hpp); otherwise, and while a texture-cache recorder listens, two samples. The same bits either way.
+// sampling_code.hpp), and with the two interleaved (twin_texels.hpp) one load per tap; otherwise, and while a
+// texture-cache recorder listens, two samples. The same bits either way.
 class TwinSampler {
 public:
-  TwinSampler(const Texture& first, const Texture& second, const SamplerState& state);
+  // interleaved: interleave_twin_texels(first, second), or null.
+  TwinSampler(const Texture& first, const Texture& second, const SamplerState& state,
+              const float* interleaved = nullptr);
 
   const TextureSampler& first() const { return first_; }
   const TextureSampler& second() const { return second_; }
   bool shares_addresses() const { return twin_ != nullptr; }
   // Both textures at (u, v), each with its LOD (equal wherever the two share addresses: one size, same_lod_as):
-  // the first's four channels, the second's rgb; its alpha is 1, not sampled (the second is a normal map, whose
-  // alpha nothing reads: the shared path skips its division and filter). ahead, if given, where the quad below
-  // will sample (a prefetch hint where the two share addresses).
+  // each one's rgb; both alphas are 1, not sampled (an albedo's alpha and a normal map's, which nothing reads: the
+  // shared path skips their filters, and the interleaved texels hold no albedo alpha). ahead, if given, where the
+  // quad below will sample (a prefetch hint where the two share addresses).
   void sample(const simd::Float& u, const simd::Float& v, const simd::Float& first_lod, const simd::Float& second_lod,
               simd::Float* first_out, simd::Float* second_out, const UvAhead* ahead = nullptr) const {
     if (twin_ != nullptr && !fetch_recorder_listens()) {
-      twin_(first_.view(), second_.view(), first_.state(), u, v, first_lod, ahead, first_out, second_out);
+      twin_(first_.view(), second_.view(), interleaved_, first_.state(), u, v, first_lod, ahead, first_out,
+            second_out);
       return;
     }
     first_.sample(u, v, first_lod, first_out);
     second_.sample(u, v, second_lod, second_out);
-    second_out[3] = simd::Float(1.0f);
+    first_out[3] = second_out[3] = simd::Float(1.0f);
   }
 
 private:
   TextureSampler first_, second_;
   TwinSampleFunction twin_;
+  const float* interleaved_;
 };
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

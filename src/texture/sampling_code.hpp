@@ -339,11 +339,12 @@ QDMR_SAMPLER_INLINE void fetch_rgba8_pair_at(const TextureView& view, const Samp
 
 // Prefetches, in each lane, the bilinear footprint's row that a sample at (u, v) on `info`'s level reads and a
 // sample at (u - du, v - dv) does not (its top row if dv < 0, its bottom row otherwise), in both twin textures (a's
-// decoded copy where its samples read that): a hint for a later sample there (UvAhead), made where the rasterizer
-// moves by (du, dv) per quad row. u and v reduced by the address mode. Plain float arithmetic: a prefetch changes
-// no result, and a texel off by one costs at most a miss.
+// decoded copy where its samples read that; the interleaved texels where there are some): a hint for a later
+// sample there (UvAhead), made where the rasterizer moves by (du, dv) per quad row. u and v reduced by the address
+// mode. Plain float arithmetic: a prefetch changes no result, and a texel off by one costs at most a miss.
 QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
-                                              const Float& u, const Float& v, const Float& dv, const LevelInfo& info) {
+                                              const float* interleaved, const Float& u, const Float& v,
+                                              const Float& dv, const LevelInfo& info) {
   const Float w = xsimd::to_float(info.width), h = xsimd::to_float(info.height);
   const Int x = xsimd::to_int(xsimd::floor(u * w - Float(0.5f)));
   const Int y = xsimd::to_int(xsimd::floor(v * h + xsimd::select(dv > Float(0.0f), Float(0.5f), Float(-0.5f))));
@@ -352,6 +353,10 @@ QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const Sampl
   (info.offset + (address(y, info.height, ka.address, pow2) * info.width + address(x, info.width, ka.address, pow2)) *
                      Int(4))
       .store_aligned(o);
+  if (interleaved != nullptr) {
+    for (int lane = 0; lane < kLanes; ++lane) __builtin_prefetch(interleaved + o[lane]);
+    return;
+  }
   const Texture &a = va.texture(), &b = vb.texture();
   const bool a_decoded = ka.srgb && !a.linear.empty();
   for (int lane = 0; lane < kLanes; ++lane) {
@@ -363,22 +368,34 @@ QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const Sampl
   }
 }
 
-// sample_level() of two textures (twin_keys) at once: out[0..3] texture a's channels, out[4..6] texture b's rgb
-// (b's alpha is not filtered: no division for it). Never recorded: the caller knows no texture-cache recorder
-// listens.
+// sample_level() of two textures (twin_keys) at once: out[0..2] texture a's rgb, out[4..6] texture b's rgb (the
+// alphas are not filtered; out[3] is 1). interleaved: the two interleaved (twin_texels.hpp), or null.
+// Never recorded: the caller knows no texture-cache recorder listens.
 QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
-                                           const SamplerKey& kb, const Float& u, const Float& v, const LevelInfo& info,
-                                           bool linear, Float* out) {
+                                           const SamplerKey& kb, const float* interleaved, const Float& u,
+                                           const Float& v, const LevelInfo& info, bool linear, Float* out) {
   if (!linear) {
     Int x, y;
     point_texel(va, ka, u, v, info, x, y);
     fetch(va, ka, info, x, y, out, false);
     fetch(vb, kb, info, x, y, out + 4, false);
+    out[3] = Float(1.0f);
     return;
   }
   const BilinearTaps t = bilinear_taps(va, ka, u, v, info);
   Float a00[4], a10[4], a01[4], a11[4], b00[4], b10[4], b01[4], b11[4];
-  if (t.adjacent) {
+  if (t.adjacent && interleaved != nullptr) {
+    // Per tap one 16-byte texel: a's rgb, then b's code, decoded as its chain's texel would be.
+    alignas(64) std::int32_t top[kLanes], bottom[kLanes];
+    (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
+    (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
+    simd::load_f32x4_pair_at(interleaved, top, ka.fetch, a00, a10);
+    simd::load_f32x4_pair_at(interleaved, bottom, ka.fetch, a01, a11);
+    decode(kb, xsimd::bitwise_cast<Int>(a00[3]), b00, 3);
+    decode(kb, xsimd::bitwise_cast<Int>(a10[3]), b10, 3);
+    decode(kb, xsimd::bitwise_cast<Int>(a01[3]), b01, 3);
+    decode(kb, xsimd::bitwise_cast<Int>(a11[3]), b11, 3);
+  } else if (t.adjacent) {
     alignas(64) std::int32_t top[kLanes], bottom[kLanes];
     (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
     (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
@@ -390,7 +407,8 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
     fetch_taps(va, ka, info, t, a00, a10, a01, a11, false);
     fetch_taps(vb, kb, info, t, b00, b10, b01, b11, false);
   }
-  filter_taps(ka, t, a00, a10, a01, a11, out);
+  filter_taps(ka, t, a00, a10, a01, a11, out, 3);
+  out[3] = Float(1.0f);
   filter_taps(kb, t, b00, b10, b01, b11, out + 4, 3);
 }
 
@@ -453,14 +471,14 @@ QDMR_SAMPLER_INLINE void sample_with(const SamplerKey& k, const TextureView& vie
                 out);
 }
 
-// sample_with() of two textures alike (twin_keys, one chain layout) at the same coordinates and LOD: out_a and
-// out_b's rgb get what sample_with() gives each, from one address computation; out_b's alpha is 1 (the second
-// texture is a normal map, whose alpha nothing reads). Never recorded. ahead (optional): where
-// the quad below samples, prefetched on the finest level this sample reads.
+// sample_with() of two textures alike (twin_keys, one chain layout) at the same coordinates and LOD: the rgb of
+// out_a and out_b get what sample_with() gives each, from one address computation; both alphas are 1 (an albedo's
+// and a normal map's, which nothing reads). interleaved: the two interleaved (twin_texels.hpp), or null. Never
+// recorded. ahead (optional): where the quad below samples, prefetched on the finest level this sample reads.
 QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey& kb, const TextureView& va,
-                                          const TextureView& vb, const SamplerState& s, const Float& u,
-                                          const Float& v, const Float& lod, const UvAhead* ahead, Float* out_a,
-                                          Float* out_b) {
+                                          const TextureView& vb, const float* interleaved, const SamplerState& s,
+                                          const Float& u, const Float& v, const Float& lod, const UvAhead* ahead,
+                                          Float* out_a, Float* out_b) {
   float first_texel[8];
   for (int c = 0; c < 4; ++c) {
     first_texel[c] = va.first_texel()[std::size_t(c)];
@@ -474,17 +492,20 @@ QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey
                   if (finest && ahead != nullptr) {
                     const Float au = u + ahead->du, av = v + ahead->dv;
                     const Mask finite = is_finite(au) & is_finite(av);
-                    prefetch_twin_texels(va, ka, vb, reduce(xsimd::select(finite, au, Float(0.0f)), ka.address),
+                    prefetch_twin_texels(va, ka, vb, interleaved,
+                                         reduce(xsimd::select(finite, au, Float(0.0f)), ka.address),
                                          reduce(xsimd::select(finite, av, Float(0.0f)), ka.address), ahead->dv,
                                          info);
                   }
                   finest = false;
-                  sample_level_twin(va, ka, vb, kb, ru, rv, info, linear, level_out);
+                  sample_level_twin(va, ka, vb, kb, interleaved, ru, rv, info, linear, level_out);
                 },
                 out);
-  for (int c = 0; c < 4; ++c) out_a[c] = out[c];
-  for (int c = 0; c < 3; ++c) out_b[c] = out[4 + c];
-  out_b[3] = Float(1.0f);
+  for (int c = 0; c < 3; ++c) {
+    out_a[c] = out[c];
+    out_b[c] = out[4 + c];
+  }
+  out_a[3] = out_b[3] = Float(1.0f);
 }
 
 // wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.

@@ -46,7 +46,13 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
       EXPECT_EQ(plan.textures[i].bytes, assets.textures[i]->bytes()) << shipped.name << " " << plan.textures[i].where;
     for (std::size_t i = 0; i < plan.derived.size(); ++i) {
       const DerivedAsset& d = assets.derived[i];
-      EXPECT_TRUE(d.texture || d.field || d.cones) << plan.derived[i].key << " was not built";
+      EXPECT_TRUE(d.texture || d.field || d.cones || d.twin_texels) << plan.derived[i].key << " was not built";
+      if (plan.derived[i].kind == DerivedKind::TwinTexels) {
+        // Interleaved albedo and normal map: as many floats as the albedo's decoded copy, none of them missing.
+        ASSERT_TRUE(d.twin_texels) << plan.derived[i].key;
+        EXPECT_FALSE(d.twin_texels->empty()) << plan.derived[i].key;
+        EXPECT_EQ(plan.derived[i].bytes, d.twin_texels->size() * sizeof(float)) << plan.derived[i].key;
+      }
       if (plan.derived[i].kind == DerivedKind::CombinedQuadtree) {
         // What the plan counts for it: the tree, and the layers' level-0 heights side by side (every shipped
         // blend's layers keep decoded copies, so it has them).
@@ -100,9 +106,10 @@ TEST(PrepareReuse, ACameraChangeRebuildsNothingADepthScaleChangeOnlyItsDerivedDa
   const FramePlan other_plan = plan_frame(other);
   const Assets rebuilt = prepare(other_plan, &assets, &plan);
   ASSERT_FALSE(rebuilt.built.empty());
+  // (The interleaved albedo and normal map hold the normal map, made from the heights.)
   for (const std::string& item : rebuilt.built)
     EXPECT_TRUE(item.find("texture height") == 0 || item.find("texture normal") == 0 || item.find("texture albedo") == 0 ||
-                item.find("height_field") == 0 || item.find("cone_map") == 0)
+                item.find("height_field") == 0 || item.find("cone_map") == 0 || item.find("twin_texels") == 0)
         << item;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "program/variant.hpp"
+#include "qdmr/texture/twin_texels.hpp"
 #include "shade/height_surface.hpp"
 #include "texture/sampler.hpp"
 #include "texture/sampler_test_util.hpp"
@@ -667,8 +668,9 @@ TEST(TextureSampler, CellMaxIsLoadWrapped) {
   }
 }
 
-// A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler (the
-// normal map's rgb; its alpha is not sampled and is 1 on every path), for every sampler state, on both fetch paths, with and without the albedo's decoded sRGB copy, power-of-two and
+// A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler (their
+// rgb; the alphas are not sampled and are 1 on every path), for every sampler state, on both fetch paths, with and
+// without the albedo's decoded sRGB copy, with and without the two interleaved (twin_texels.hpp), power-of-two and
 // other sizes, lanes with non-finite coordinates, lanes at the wrap and clamp edges, batches that skip the coarse
 // level, and with and without a prefetch hint (UvAhead). It shares addresses exactly where sampler.cpp
 // instantiates a twin: RGBA8 chains of one size, the second not sRGB, bilinear or trilinear with wrap, exact or
@@ -692,46 +694,50 @@ TEST(TwinSampler, GivesEachTextureTheBitsOfItsOwnSampler) {
     const Texture albedo = chain(c.w, c.h, c.srgb, c.decoded_copy), normal = chain(c.w, c.h, false, false);
     ASSERT_EQ(albedo.linear.empty(), !c.decoded_copy);
     int shared = 0, expected_shared = 0;
-    for (const SamplerState& state : every_sampler_state()) {
-      const TwinSampler twin(albedo, normal, state);
-      const TextureSampler first(albedo, state), second(normal, state);
-      const bool common = state.address == AddressMode::Wrap && state.precision != SamplePrecision::Hw6 &&
-                          (state.filter == Filter::Bilinear || state.filter == Filter::Trilinear) &&
-                          state.fetch == SamplerState{}.fetch;
-      EXPECT_EQ(twin.shares_addresses(), common) << filter_name(state.filter) << " " << c.w << "x" << c.h;
-      shared += twin.shares_addresses() ? 1 : 0;
-      expected_shared += common ? 1 : 0;
-      for (int round = 0; round < 12; ++round) {
-        Lanes u, v, l;
-        for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
-        if (round == 0) u[1 % kLanes] = kNaN, v[2 % kLanes] = -kInf, l[3 % kLanes] = kNaN;
-        if (round % 3 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
-          for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
-        if (round % 4 == 2)  // whole LODs: no lane weighs the coarse level
-          for (int i = 0; i < kLanes; ++i) l[i] = std::floor(l[i]) - state.lod_bias;
-        Float a[4], b[4], twin_a[4], twin_b[4];
-        first.sample(load(u), load(v), load(l), a);
-        second.sample(load(u), load(v), load(l), b);
-        twin.sample(load(u), load(v), load(l), load(l), twin_a, twin_b);
-        // A prefetch hint, however odd (non-finite, huge, pointing off the texture), changes no bit.
-        Lanes du, dv;
-        for (int i = 0; i < kLanes; ++i) du[i] = coord(rng), dv[i] = -coord(rng);
-        if (round == 0) du[0] = kNaN, dv[1 % kLanes] = kInf, du[2 % kLanes] = -1e30f, dv[3 % kLanes] = 3e38f;
-        const UvAhead ahead{load(du), load(dv)};
-        Float hinted_a[4], hinted_b[4];
-        twin.sample(load(u), load(v), load(l), load(l), hinted_a, hinted_b, &ahead);
-        for (int ch = 0; ch < 4; ++ch)
-          for (int i = 0; i < kLanes; ++i) {
-            ASSERT_EQ(bits(lanes(hinted_a[ch])[i]), bits(lanes(twin_a[ch])[i])) << "hinted, channel " << ch;
-            ASSERT_EQ(bits(lanes(hinted_b[ch])[i]), bits(lanes(twin_b[ch])[i])) << "hinted, channel " << ch;
-            ASSERT_EQ(bits(lanes(twin_a[ch])[i]), bits(lanes(a[ch])[i]))
-                << filter_name(state.filter) << " first, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
-            // The second texture's alpha is not sampled: 1.
-            ASSERT_EQ(bits(lanes(twin_b[ch])[i]), ch < 3 ? bits(lanes(b[ch])[i]) : bits(1.0f))
-                << filter_name(state.filter) << " second, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
-          }
+    const std::vector<float> interleaved = interleave_twin_texels(albedo, normal);
+    ASSERT_EQ(interleaved.empty(), !(c.srgb && c.decoded_copy));
+    for (const SamplerState& state : every_sampler_state())
+      for (const float* texels : {static_cast<const float*>(nullptr), interleaved.empty() ? nullptr : interleaved.data()}) {
+        const TwinSampler twin(albedo, normal, state, texels);
+        const TextureSampler first(albedo, state), second(normal, state);
+        const bool common = state.address == AddressMode::Wrap && state.precision != SamplePrecision::Hw6 &&
+                            (state.filter == Filter::Bilinear || state.filter == Filter::Trilinear) &&
+                            state.fetch == SamplerState{}.fetch;
+        EXPECT_EQ(twin.shares_addresses(), common) << filter_name(state.filter) << " " << c.w << "x" << c.h;
+        shared += twin.shares_addresses() ? 1 : 0;
+        expected_shared += common ? 1 : 0;
+        for (int round = 0; round < 12; ++round) {
+          Lanes u, v, l;
+          for (int i = 0; i < kLanes; ++i) u[i] = coord(rng), v[i] = coord(rng), l[i] = lod(rng);
+          if (round == 0) u[1 % kLanes] = kNaN, v[2 % kLanes] = -kInf, l[3 % kLanes] = kNaN;
+          if (round % 3 == 1)  // every lane inside one row pair: the paired loads run for the whole batch
+            for (int i = 0; i < kLanes; ++i) u[i] = 0.25f + 0.01f * float(i), v[i] = 0.5f + 0.02f * float(i);
+          if (round % 4 == 2)  // whole LODs: no lane weighs the coarse level
+            for (int i = 0; i < kLanes; ++i) l[i] = std::floor(l[i]) - state.lod_bias;
+          Float a[4], b[4], twin_a[4], twin_b[4];
+          first.sample(load(u), load(v), load(l), a);
+          second.sample(load(u), load(v), load(l), b);
+          twin.sample(load(u), load(v), load(l), load(l), twin_a, twin_b);
+          // A prefetch hint, however odd (non-finite, huge, pointing off the texture), changes no bit.
+          Lanes du, dv;
+          for (int i = 0; i < kLanes; ++i) du[i] = coord(rng), dv[i] = -coord(rng);
+          if (round == 0) du[0] = kNaN, dv[1 % kLanes] = kInf, du[2 % kLanes] = -1e30f, dv[3 % kLanes] = 3e38f;
+          const UvAhead ahead{load(du), load(dv)};
+          Float hinted_a[4], hinted_b[4];
+          twin.sample(load(u), load(v), load(l), load(l), hinted_a, hinted_b, &ahead);
+          for (int ch = 0; ch < 4; ++ch)
+            for (int i = 0; i < kLanes; ++i) {
+              ASSERT_EQ(bits(lanes(hinted_a[ch])[i]), bits(lanes(twin_a[ch])[i])) << "hinted, channel " << ch;
+              ASSERT_EQ(bits(lanes(hinted_b[ch])[i]), bits(lanes(twin_b[ch])[i])) << "hinted, channel " << ch;
+              ASSERT_EQ(bits(lanes(twin_a[ch])[i]), ch < 3 ? bits(lanes(a[ch])[i]) : bits(1.0f))
+                  << filter_name(state.filter) << " first, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h
+                  << (texels ? ", interleaved" : "");
+              // Neither alpha is sampled: 1.
+              ASSERT_EQ(bits(lanes(twin_b[ch])[i]), ch < 3 ? bits(lanes(b[ch])[i]) : bits(1.0f))
+                  << filter_name(state.filter) << " second, channel " << ch << " lane " << i << ", " << c.w << "x" << c.h;
+            }
+        }
       }
-    }
     EXPECT_GT(shared, 0) << c.w << "x" << c.h;
     EXPECT_EQ(shared, expected_shared);
   }

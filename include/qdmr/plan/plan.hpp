@@ -56,6 +56,7 @@ enum class DerivedKind {
   LayerAoMap,        // baked AO of one layer's heights
   ConeMap,           // csm, rcsm
   BilinearBound,     // qdm with bilinear-patch refinement: max-quadtree of the 3x3 maxima
+  TwinTexels,        // a layer's albedo and normal map interleaved per texel (qdmr/texture/twin_texels.hpp)
 };
 const char* derived_kind_name(DerivedKind kind);
 
@@ -64,7 +65,8 @@ struct DerivedPlan {
   std::string key;      // content key: equal keys build equal data
   std::string where;    // scene field, for messages
   std::vector<int> inputs;  // derived items it is made from (built before it)
-  int texture = -1;     // the height texture it is made from (HeightField), else -1
+  int texture = -1;     // the texture it is made from (HeightField: the heights; TwinTexels: the albedo), else -1
+  int second_texture = -1;  // TwinTexels: the normal map
   int material = -1;    // the first material that asked for it
   int side = 0;         // ao maps: the map's width
   std::uint64_t bytes = 0;  // what it keeps
@@ -81,6 +83,7 @@ struct LayerPlan {
   int height_max = -1;       // max-quadtree (qdm, hard or qdm_soft shadows, coarse AO)
   int field = -1;            // derived HeightField of the height (layer 0: reference, cones; any: baked AO)
   int ao = -1;               // derived LayerAoMap
+  int twin = -1;             // derived TwinTexels
 };
 
 struct MaterialPlan {
