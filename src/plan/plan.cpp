@@ -325,11 +325,8 @@ public:
     for (const LayerPlan& l : m.layers) heights += (l.height >= 0 ? plan_.textures[std::size_t(l.height)].key : "-") + "|";
 
     // Albedo and normal map interleaved where the program samples them as twins (TwinSampler: RGBA8 chains of one
-    // size, the albedo with its decoded copy, a linear filter with wrap addressing, not the 6-bit precision).
-    const SamplingDesc& sampling = desc.sampling;
-    const bool twin_state = sampling.address == AddressMode::Wrap && sampling.precision != SamplePrecision::Hw6 &&
-                            (sampling.filter == Filter::Bilinear || sampling.filter == Filter::Trilinear);
-    for (std::size_t layer = 0; layer < m.layers.size() && twin_state; ++layer) {
+    // size, the albedo with its decoded copy, under a sampling whose twins share addresses).
+    for (std::size_t layer = 0; layer < m.layers.size() && twin_sampling(desc.sampling); ++layer) {
       LayerPlan& l = m.layers[layer];
       if (l.albedo < 0 || l.normal < 0) continue;
       const TextureRequest &a = plan_.textures[std::size_t(l.albedo)], &n = plan_.textures[std::size_t(l.normal)];

@@ -4,6 +4,11 @@
 
 namespace qdmr {
 
+bool twin_sampling(const SamplingDesc& sampling) {
+  return sampling.address == AddressMode::Wrap && sampling.precision != SamplePrecision::Hw6 &&
+         (sampling.filter == Filter::Bilinear || sampling.filter == Filter::Trilinear);
+}
+
 std::uint64_t twin_texels_bytes(int width, int height) {
   return linear_copy_bytes(width, height, TexelFormat::RGBA8, true);  // as many floats as the decoded copy
 }

@@ -7,9 +7,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
+
+// Whether a material's sampling lets its TwinSampler share addresses (the states sampler.cpp instantiates twins
+// for: bilinear or trilinear with wrap addressing, exact or 8-bit precision), so its interleaved texels are read.
+bool twin_sampling(const SamplingDesc& sampling);
 
 // What interleave_twin_texels() keeps for an albedo chain of width x height: as much as its decoded copy (16 bytes
 // per texel; 0 where the chain is too large to keep one, and then makes none).
