@@ -151,6 +151,7 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
     if (const DerivedAsset* c = derived(m.combined_quadtree)) {
       inputs.combined = c->texture.get();
       inputs.layer_heights = c->layer_heights.get();
+      inputs.box_values = c->box_values ? c->box_values->data() : nullptr;
       inputs.combined_period = assets.derived[std::size_t(m.combined_surface)].field->width;
     }
     if (const DerivedAsset* a = derived(m.blend_ao)) {

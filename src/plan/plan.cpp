@@ -16,6 +16,7 @@
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/image.hpp"
 #include "qdmr/texture/layer_heights.hpp"
@@ -367,7 +368,7 @@ public:
         const std::string& combined_key = plan_.derived[std::size_t(m.combined_surface)].key;
         if (c.combined_quadtree)
           m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + combined_key, where + "/blend/quadtree",
-                                    {m.combined_surface}, index, c.combined_bytes);
+                                    {m.combined_surface, m.weights}, index, c.combined_bytes);
         if (c.blend_ao) {
           AoDesc ao = desc.ao;
           ao.resolution = c.ao_side;
@@ -526,11 +527,13 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
                           : "'combined' needs blend/weights/scale to be a whole number of repeats (use 'product')");
       if (fits) {
         choices.combined_quadtree = true;
-        // The tree, and the layers' level-0 heights side by side (LayerHeights) for the walk's level-0 cells.
+        // The tree, the layers' level-0 heights side by side (LayerHeights) and, from them, the blended level-0
+        // values of the period (blend_box_values) for the walk's level-0 cells.
         std::vector<TexelFormat> formats;
         for (const LayerPlan& l : plan.layers) formats.push_back(textures[std::size_t(l.height_max)].format);
-        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16) +
-                                 layer_heights_bytes(h.width, h.height, formats);
+        const std::uint64_t heights = layer_heights_bytes(h.width, h.height, formats);
+        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16) + heights +
+                                 blend_box_values_bytes(h.width, h.height, int(scale), heights);
       }
     }
   }

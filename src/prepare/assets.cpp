@@ -8,6 +8,7 @@
 
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/twin_texels.hpp"
 #include "texture/blend_weights.hpp"
@@ -221,8 +222,12 @@ private:
         out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field));
         std::vector<const Texture*> chains;
         for (const LayerPlan& l : m.layers) chains.push_back(assets_.textures[std::size_t(l.height_max)].get());
-        if (LayerHeights heights = interleave_layer_heights(chains); heights.width > 0)
+        if (LayerHeights heights = interleave_layer_heights(chains); heights.width > 0) {
           out.layer_heights = std::make_shared<const LayerHeights>(std::move(heights));
+          std::vector<float> values = blend_box_values(
+              {input(1).texture.get(), m.weights_scale, out.layer_heights.get(), desc.blend.op, int(m.layers.size())});
+          if (!values.empty()) out.box_values = std::make_shared<const std::vector<float>>(std::move(values));
+        }
         break;
       }
       case DerivedKind::BlendAoMap: {

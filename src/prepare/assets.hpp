@@ -23,6 +23,7 @@ namespace qdmr {
 struct DerivedAsset {
   std::shared_ptr<const Texture> texture;
   std::shared_ptr<const LayerHeights> layer_heights;  // a combined quadtree's: its walk's level-0 cells, when made
+  std::shared_ptr<const std::vector<float>> box_values;  // with them: its level 0 (qdmr/texture/blend_box_values.hpp)
   std::shared_ptr<const HeightField> field;
   std::shared_ptr<const ConeMap> cones;
   std::shared_ptr<const std::vector<float>> twin_texels;  // TwinTexels (qdmr/texture/twin_texels.hpp)

@@ -25,6 +25,7 @@ struct DisplacementInputs {
   const Texture* combined = nullptr;      // blending per pixel: the precomputed combined quadtree (optional)
   int combined_period = 0;                // its period in level-0 texels (layers' size x repeats of the weights)
   const LayerHeights* layer_heights = nullptr;  // with it: the layers' level-0 heights side by side (optional)
+  const float* box_values = nullptr;      // with those: the tree's level 0 over the period (blend_box_values)
   const Texture* blend_ao = nullptr;      // baked AO of a blend's combined surface over the weights span (R16)
   int blend_ao_scale = 1;                 // ... sampled at UV / this (the whole number of repeats it spans)
   const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height

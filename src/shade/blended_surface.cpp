@@ -20,7 +20,42 @@ Int wrap_cell(const Int& i, const Int& p) {
   return xsimd::select(r >= p, r - p, r);
 }
 
+// The weights of `count` layers at (u, v) (layer UV), sampled bilinearly from the weight texture.
+void sample_weights(const WeightTexture& t, int count, const Float& u, const Float& v, Float* w) {
+  const Float inv(1.0f / t.scale);
+  Float texel[4];
+  t.view->sample(u * inv, v * inv, Float(0.0f), texel);
+  for (int i = 0; i < count; ++i) w[i] = texel[i];
+}
+
 }  // namespace
+
+Float combine_layers(BlendOperator op, int count, const Float* h, const Float* w) {
+  if (op == BlendOperator::Alpha) {
+    Float sum_wh(0.0f), sum_w(0.0f);
+    for (int i = 0; i < count; ++i) {
+      sum_wh += w[i] * h[i];
+      sum_w += w[i];
+    }
+    return xsimd::select(sum_w > Float(0.0f), sum_wh / sum_w, Float(0.0f));
+  }
+  Float top(0.0f);
+  for (int i = 0; i < count; ++i) top = xsimd::max(top, w[i] * h[i]);
+  return top;
+}
+
+Float level0_box_value(const WeightTexture& weights, int width, int height, BlendOperator op, int count,
+                       unsigned present, simd::FetchPath fetch, const Int& cx, const Int& cy) {
+  // The same decoded heights as each layer's chain holds at level 0 (wrap: power-of-two sizes).
+  const LayerHeights& lh = *weights.layer_heights;
+  const Int texel = (cy & Int(lh.height - 1)) * Int(lh.width) + (cx & Int(lh.width - 1));
+  Float all[BlendedSurface::kMaxLayers], h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers];
+  simd::load_f32x4(lh.texels.data(), texel * Int(4), fetch, all);
+  for (int i = 0; i < count; ++i) h[i] = (present >> i) & 1u ? all[i] : Float(0.0f);
+  sample_weights(weights, count, (xsimd::to_float(cx) + Float(0.5f)) / Float(float(width)),
+                 (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height)), w);
+  return combine_layers(op, count, h, w);
+}
 
 SamplerState weight_sampler_state(const SamplerState& material) {
   SamplerState s;
@@ -88,25 +123,10 @@ void BlendedSurface::weights_at(const Float& u, const Float& v, Float* w) const 
     for (int i = 0; i < count_; ++i) w[i] = weights_[i];
     return;
   }
-  const Float inv(1.0f / texture_.scale);
-  Float texel[4];
-  texture_.view->sample(u * inv, v * inv, Float(0.0f), texel);
-  for (int i = 0; i < count_; ++i) w[i] = texel[i];
+  sample_weights(texture_, count_, u, v, w);
 }
 
-Float BlendedSurface::combine(const Float* h, const Float* w) const {
-  if (op_ == BlendOperator::Alpha) {
-    Float sum_wh(0.0f), sum_w(0.0f);
-    for (int i = 0; i < count_; ++i) {
-      sum_wh += w[i] * h[i];
-      sum_w += w[i];
-    }
-    return xsimd::select(sum_w > Float(0.0f), sum_wh / sum_w, Float(0.0f));
-  }
-  Float top(0.0f);
-  for (int i = 0; i < count_; ++i) top = xsimd::max(top, w[i] * h[i]);
-  return top;
-}
+Float BlendedSurface::combine(const Float* h, const Float* w) const { return combine_layers(op_, count_, h, w); }
 
 Float BlendedSurface::height(const Float& u, const Float& v, const Float& lod) const {
   Float h[kMaxLayers], w[kMaxLayers];
@@ -141,31 +161,37 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
                             texel);
     result = texel[0];
   }
-  if (xsimd::any(fine & needed)) {
-    FetchLanes lanes;
-    lanes.narrow(fine);
-    // Level 0: the exact box value, as the combined tree was built from. The coarse lanes' values are dropped
-    // below; they read one fixed cell instead of their own small indices, which sit at the weight map's wrap edge
-    // and sent most batches' bilinear weight samples to the per-texel path (3 in 5 on the terrain).
-    const Int middle(width() / 2);
-    const Int cx = xsimd::select(coarse, middle, cell_x), cy = xsimd::select(coarse, middle, cell_y);
-    Float h[kMaxLayers], w[kMaxLayers];
-    if (texture_.layer_heights != nullptr && !fetch_recorder_listens()) {
-      // The same decoded heights as each layer's chain holds at level 0 (wrap: power-of-two sizes).
-      const LayerHeights& lh = *texture_.layer_heights;
-      const Int texel = (cy & Int(lh.height - 1)) * Int(lh.width) + (cx & Int(lh.width - 1));
-      Float all[kMaxLayers];
-      simd::load_f32x4(lh.texels.data(), texel * Int(4), sampler().fetch, all);
-      for (int i = 0; i < count_; ++i) h[i] = present(i) ? all[i] : Float(0.0f);
-    } else {
-      for (int i = 0; i < count_; ++i)
-        h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);
+  if (!xsimd::any(fine & needed)) return result;
+  // Level 0: the exact box value, as the combined tree was built from.
+  const bool fast = texture_.layer_heights != nullptr && !fetch_recorder_listens();
+  if (fast && texture_.box_values != nullptr) {
+    // From the period's table where every needed level-0 lane is inside the period (a cell outside it reads its
+    // weights at other coordinates than the cell it repeats, so its value may differ in the last bit).
+    const int period = texture_.period;
+    const simd::IntMask inside =
+        (cell_x >= Int(0)) & (cell_x < Int(period)) & (cell_y >= Int(0)) & (cell_y < Int(period));
+    if (!xsimd::any(fine & needed & ~simd::float_mask(inside))) {
+      const Int cell = xsimd::select(inside & ~coarse, cell_y * Int(period) + cell_x, Int(0));
+      const Float value = simd::load_f32(texture_.box_values, cell, sampler().fetch);
+      return xsimd::select(simd::float_mask(coarse), result, value);
     }
-    weights_at((xsimd::to_float(cx) + Float(0.5f)) / Float(float(width())),
-               (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height())), w);
-    result = xsimd::select(simd::float_mask(coarse), result, combine(h, w));
   }
-  return result;
+  FetchLanes lanes;
+  lanes.narrow(fine);
+  // The coarse lanes' values are dropped below; they read one fixed cell instead of their own small indices,
+  // which sit at the weight map's wrap edge and sent most batches' bilinear weight samples to the per-texel path
+  // (3 in 5 on the terrain).
+  const Int middle(width() / 2);
+  const Int cx = xsimd::select(coarse, middle, cell_x), cy = xsimd::select(coarse, middle, cell_y);
+  if (fast)
+    return xsimd::select(simd::float_mask(coarse), result,
+                         level0_box_value(texture_, width(), height(), op_, count_, present_, sampler().fetch, cx, cy));
+  Float h[kMaxLayers], w[kMaxLayers];
+  for (int i = 0; i < count_; ++i)
+    h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);
+  weights_at((xsimd::to_float(cx) + Float(0.5f)) / Float(float(width())),
+             (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height())), w);
+  return xsimd::select(simd::float_mask(coarse), result, combine(h, w));
 }
 
 Float BlendedSurface::tree_max(const Int& level, const Int& cx, const Int& cy, const simd::Mask& needed) const {

@@ -26,10 +26,23 @@ struct WeightTexture {
   // With it, optional: the layers' level-0 heights side by side, read at the walk's level-0 cells (one load per
   // lane for every layer) while no texture-cache recorder listens (it sees each layer's chain read).
   const LayerHeights* layer_heights = nullptr;
+  // With those, optional: the blended box surface's level-0 value of every cell of one period (period x period
+  // floats, row by row; texture/blend_box_values.hpp), which the walk's level-0 cells inside that period read
+  // instead of blending the layers' heights and the weights there (while no recorder listens).
+  const float* box_values = nullptr;
 };
 
 // The state weight textures are sampled with, from the material's.
 SamplerState weight_sampler_state(const SamplerState& material);
+
+// The blend operator applied to layer heights h and weights w of `count` layers.
+simd::Float combine_layers(BlendOperator op, int count, const simd::Float* h, const simd::Float* w);
+
+// The blended box surface's value at level-0 cells (cx, cy) of layers `width` x `height` texels: the layers'
+// level-0 heights (weights.layer_heights) and the weight texture sampled bilinearly at the cell's centre, blended
+// by `op`. Layers outside `present` count as height 0 (every lane's weight of them is 0).
+simd::Float level0_box_value(const WeightTexture& weights, int width, int height, BlendOperator op, int count,
+                             unsigned present, simd::FetchPath fetch, const simd::Int& cx, const simd::Int& cy);
 
 class BlendedSurface {
 public:

@@ -74,6 +74,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     combined_.emplace(*inputs.combined, sampler_);
     combined_period_ = inputs.combined_period;
     layer_heights_ = inputs.layer_heights;
+    if (layer_heights_ != nullptr) box_values_ = inputs.box_values;
   }
   if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
     throw Error("displacement program", "per-pixel blending needs a weight texture");
@@ -657,7 +658,7 @@ BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers,
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
   const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_,
-                              layer_heights_};
+                              layer_heights_, box_values_};
   return BlendedSurface(layers.data(), count, blend_.op, weights, xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1),
                         xsimd::min(ray.v0, v1), xsimd::max(ray.v0, v1));
 }

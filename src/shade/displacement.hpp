@@ -141,6 +141,7 @@ private:
   std::optional<TextureSampler> combined_;
   int combined_period_ = 0;
   const LayerHeights* layer_heights_ = nullptr;  // with combined_ only
+  const float* box_values_ = nullptr;            // with layer_heights_ only
   std::optional<TextureSampler> blend_ao_;
   int blend_ao_scale_ = 1;
   const ConeMap* cones_;

@@ -54,10 +54,13 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
         EXPECT_EQ(plan.derived[i].bytes, d.twin_texels->size() * sizeof(float)) << plan.derived[i].key;
       }
       if (plan.derived[i].kind == DerivedKind::CombinedQuadtree) {
-        // What the plan counts for it: the tree, and the layers' level-0 heights side by side (every shipped
-        // blend's layers keep decoded copies, so it has them).
+        // What the plan counts for it: the tree, the layers' level-0 heights side by side and the blended
+        // level-0 values of the period (every shipped blend's layers keep decoded copies and are square, so it
+        // has both).
         ASSERT_TRUE(d.layer_heights) << plan.derived[i].key;
-        EXPECT_EQ(plan.derived[i].bytes, d.texture->bytes() + d.layer_heights->texels.size() * sizeof(float));
+        ASSERT_TRUE(d.box_values) << plan.derived[i].key;
+        EXPECT_EQ(plan.derived[i].bytes, d.texture->bytes() + d.layer_heights->texels.size() * sizeof(float) +
+                                             d.box_values->size() * sizeof(float));
       }
     }
     // Prepared again with the first assets as the previous ones: nothing is built, everything shared.

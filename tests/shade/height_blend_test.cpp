@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <random>
 
 #include "displacement_test_util.hpp"
 #include "shade/self_shadow.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {
@@ -356,6 +358,79 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
       }
     }
   EXPECT_EQ(wrong, 0) << "of " << checked << " starts";
+}
+
+// The blend's level-0 box values over one period (blend_box_values, from the best kernel this CPU runs) are the
+// values a walk computes at its level-0 cells, bit for bit, for every operator: a walk reading them keeps its bits.
+// Checked over every cell of the period, on the surface without the table (layer chains, and the interleaved
+// heights) and with it, in batches that mix level-0 cells inside the period, outside it and coarse cells.
+TEST(HeightBlend, BoxValuesAreTheLevelZeroValuesAWalkComputes) {
+  const int n = 16, repeats = 3, period = n * repeats;
+  std::vector<Image> heights;
+  for (int i = 0; i < kLayers; ++i) heights.push_back(random_heights(n, 900u + std::uint32_t(i)));
+  // 8 weight texels over 48 layer texels: cell centres fall between weight texels, so the weights are filtered.
+  const Texture weights = make_weight_texture(random_weights(8, 91));
+  std::vector<Texture> box, maxima;
+  for (const Image& h : heights) {
+    box.push_back(make_mip_texture(h, TexelFormat::R16, false, MipReduce::Box));
+    maxima.push_back(make_mip_texture(h, TexelFormat::R16, false, MipReduce::Max));
+    add_linear_copy(maxima.back());
+  }
+  std::vector<const Texture*> chains;
+  for (const Texture& t : maxima) chains.push_back(&t);
+  const LayerHeights interleaved = interleave_layer_heights(chains);
+  ASSERT_EQ(interleaved.width, n);
+  SamplerState sampler;
+  sampler.filter = Filter::Point;
+  std::vector<HeightLayerTextures> layer_textures;
+  for (int i = 0; i < kLayers; ++i)
+    layer_textures.emplace_back(box[std::size_t(i)], &maxima[std::size_t(i)], sampler, HeightFetch::Point);
+  const std::vector<SingleLayerSurface> layers(layer_textures.begin(), layer_textures.end());
+  const TextureSampler weight_view(weights, weight_sampler_state(sampler));
+  std::vector<const Texture*> box_pointers;
+  for (const Texture& t : box) box_pointers.push_back(&t);
+  for (BlendOperator op : {BlendOperator::Height, BlendOperator::Alpha, BlendOperator::HeightWidth}) {
+    const std::vector<float> values = blend_box_values({&weights, repeats, &interleaved, op, kLayers});
+    ASSERT_EQ(values.size(), std::size_t(period) * std::size_t(period));
+    const Texture tree = combined_quadtree(combined_surface(box_pointers, weights, repeats, op));
+    const TextureSampler tree_view(tree, sampler);
+    const WeightTexture chains_only{&weight_view, float(repeats), &tree_view, period};
+    const WeightTexture with_heights{&weight_view, float(repeats), &tree_view, period, &interleaved};
+    const WeightTexture with_values{&weight_view, float(repeats), &tree_view, period, &interleaved, values.data()};
+    // Every query of the batches stays in the whole weight span (all layers present wherever they have weight).
+    const simd::Float lo(-1.0f), hi(float(repeats) + 1.0f);
+    const auto surface = [&](const WeightTexture& w) {
+      return BlendedSurface(layers.data(), kLayers, op, w, lo, hi, lo, hi);
+    };
+    const BlendedSurface a = surface(chains_only), b = surface(with_heights), c = surface(with_values);
+    const auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+    int checked = 0;
+    for (int y = -1; y <= period; ++y)
+      for (int x = -simd::kLanes; x < period + simd::kLanes; x += simd::kLanes) {
+        alignas(64) std::int32_t cx[simd::kLanes], levels[simd::kLanes];
+        for (int l = 0; l < simd::kLanes; ++l) {
+          cx[l] = x + l;
+          levels[l] = (x + l + y) % 7 == 3 ? 1 : 0;  // now and then a coarse lane, whose cell is cx / 2
+          if (levels[l] == 1) cx[l] = (x + l) / 2;
+        }
+        const simd::Int level = simd::Int::load_aligned(levels), cells = simd::Int::load_aligned(cx);
+        const simd::Int row = xsimd::select(level == simd::Int(1), simd::Int(y / 2), simd::Int(y));
+        alignas(64) float va[simd::kLanes], vb[simd::kLanes], vc[simd::kLanes];
+        a.cell_max(level, cells, row).store_aligned(va);
+        b.cell_max(level, cells, row).store_aligned(vb);
+        c.cell_max(level, cells, row).store_aligned(vc);
+        for (int l = 0; l < simd::kLanes; ++l) {
+          ASSERT_EQ(bits(vb[l]), bits(va[l])) << "cell " << cx[l] << ", " << y << " level " << levels[l];
+          ASSERT_EQ(bits(vc[l]), bits(va[l])) << "cell " << cx[l] << ", " << y << " level " << levels[l];
+          const bool in_period = levels[l] == 0 && cx[l] >= 0 && cx[l] < period && y >= 0 && y < period;
+          if (in_period) {
+            ASSERT_EQ(bits(values[std::size_t(y) * std::size_t(period) + std::size_t(cx[l])]), bits(va[l]));
+            ++checked;
+          }
+        }
+      }
+    EXPECT_GT(checked, period * period / 2) << "most of the period's cells were compared";
+  }
 }
 
 }  // namespace
