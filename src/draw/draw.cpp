@@ -152,7 +152,9 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       inputs.combined = c->texture.get();
       inputs.layer_heights = c->layer_heights.get();
       inputs.box_values = c->box_values ? c->box_values->data() : nullptr;
-      inputs.combined_period = assets.derived[std::size_t(m.combined_surface)].field->width;
+      const HeightField& combined = *assets.derived[std::size_t(m.combined_surface)].field;
+      inputs.combined_period_u = combined.width;
+      inputs.combined_period_v = combined.height;
     }
     if (const DerivedAsset* a = derived(m.blend_ao)) {
       inputs.blend_ao = a->texture.get();

@@ -23,7 +23,7 @@ struct DisplacementInputs {
   std::vector<LayerInputs> layers;        // 1 .. 4
   const Texture* weights = nullptr;       // blending per pixel: RGBA8 weight texture with a max chain
   const Texture* combined = nullptr;      // blending per pixel: the precomputed combined quadtree (optional)
-  int combined_period = 0;                // its period in level-0 texels (layers' size x repeats of the weights)
+  int combined_period_u = 0, combined_period_v = 0;  // its periods in level-0 texels (layers' size x repeats)
   const LayerHeights* layer_heights = nullptr;  // with it: the layers' level-0 heights side by side (optional)
   const float* box_values = nullptr;      // with those: the tree's level 0 over the period (blend_box_values)
   const Texture* blend_ao = nullptr;      // baked AO of a blend's combined surface over the weights span (R16)

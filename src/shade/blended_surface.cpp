@@ -155,10 +155,9 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
   if (xsimd::any(~fine & needed)) {
     FetchLanes lanes;  // the batch reads the tree for every lane; only the coarse ones need it
     lanes.narrow(simd::float_mask(coarse));
-    const Int period = Int(texture_.period) >> level;
     Float texel[4];
-    texture_.combined->load(xsimd::max(level - Int(1), Int(0)), wrap_cell(cell_x, period), wrap_cell(cell_y, period),
-                            texel);
+    texture_.combined->load(xsimd::max(level - Int(1), Int(0)), wrap_cell(cell_x, Int(texture_.period_u) >> level),
+                            wrap_cell(cell_y, Int(texture_.period_v) >> level), texel);
     result = texel[0];
   }
   if (!xsimd::any(fine & needed)) return result;
@@ -167,7 +166,7 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
   if (fast && texture_.box_values != nullptr) {
     // From the period's table where every needed level-0 lane is inside the period (a cell outside it reads its
     // weights at other coordinates than the cell it repeats, so its value may differ in the last bit).
-    const int period = texture_.period;
+    const int period = texture_.period_u;  // = period_v: the table is made for square periods only
     const simd::IntMask inside =
         (cell_x >= Int(0)) & (cell_x < Int(period)) & (cell_y >= Int(0)) & (cell_y < Int(period));
     if (!xsimd::any(fine & needed & ~simd::float_mask(inside))) {

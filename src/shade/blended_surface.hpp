@@ -19,14 +19,14 @@ struct WeightTexture {
   const TextureSampler* view = nullptr;
   float scale = 1.0f;                 // weight-map UV = layer UV / scale
   // Optional precomputed combined quadtree: level k holds the maxima of the blended box surface over cells of
-  // level k + 1, over one period of `period` level-0 texels per side (the layers' size times the whole number
+  // level k + 1, over one period of period_u x period_v level-0 texels (the layers' size times the whole number
   // of repeats the weights span); values rounded up, so it stays conservative.
   const TextureSampler* combined = nullptr;
-  int period = 0;
+  int period_u = 0, period_v = 0;
   // With it, optional: the layers' level-0 heights side by side, read at the walk's level-0 cells (one load per
   // lane for every layer) while no texture-cache recorder listens (it sees each layer's chain read).
   const LayerHeights* layer_heights = nullptr;
-  // With those, optional: the blended box surface's level-0 value of every cell of one period (period x period
+  // With those, optional: the blended box surface's level-0 value of every cell of one (square) period (period_u²
   // floats, row by row; texture/blend_box_values.hpp), which the walk's level-0 cells inside that period read
   // instead of blending the layers' heights and the weights there (while no recorder listens).
   const float* box_values = nullptr;

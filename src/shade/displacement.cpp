@@ -72,7 +72,8 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   if (inputs.weights) weights_.emplace(*inputs.weights, weight_sampler_state(sampler_));
   if (inputs.combined) {
     combined_.emplace(*inputs.combined, sampler_);
-    combined_period_ = inputs.combined_period;
+    combined_period_u_ = inputs.combined_period_u;
+    combined_period_v_ = inputs.combined_period_v;
     layer_heights_ = inputs.layer_heights;
     if (layer_heights_ != nullptr) box_values_ = inputs.box_values;
   }
@@ -657,8 +658,8 @@ BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers,
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
-  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_,
-                              layer_heights_, box_values_};
+  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_u_,
+                              combined_period_v_, layer_heights_, box_values_};
   return BlendedSurface(layers.data(), count, blend_.op, weights, xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1),
                         xsimd::min(ray.v0, v1), xsimd::max(ray.v0, v1));
 }

@@ -139,7 +139,7 @@ private:
   std::vector<Layer> layers_;
   std::optional<TextureSampler> weights_;
   std::optional<TextureSampler> combined_;
-  int combined_period_ = 0;
+  int combined_period_u_ = 0, combined_period_v_ = 0;
   const LayerHeights* layer_heights_ = nullptr;  // with combined_ only
   const float* box_values_ = nullptr;            // with layer_heights_ only
   std::optional<TextureSampler> blend_ao_;

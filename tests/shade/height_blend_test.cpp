@@ -42,7 +42,8 @@ public:
       std::vector<const Texture*> layers;
       for (const Texture& h : heights_) layers.push_back(&h);
       combined_ = combined_quadtree(combined_surface(layers, weights_, int(scale), op));
-      period_ = heights[0].width * int(scale);
+      period_u_ = heights[0].width * int(scale);
+      period_v_ = heights[0].height * int(scale);
     }
   }
 
@@ -55,9 +56,10 @@ public:
     DisplacementInputs inputs;
     for (std::size_t i = 0; i < heights_.size(); ++i) inputs.layers.push_back({&flat_, &flat_, &heights_[i], &maxima_[i]});
     inputs.weights = &weights_;
-    if (period_ > 0) {
+    if (period_u_ > 0) {
       inputs.combined = &combined_;
-      inputs.combined_period = period_;
+      inputs.combined_period_u = period_u_;
+      inputs.combined_period_v = period_v_;
     }
     LightRig rig;
     rig.camera_position = glm::vec3(0.0f);
@@ -67,25 +69,29 @@ public:
 private:
   std::vector<Texture> heights_, maxima_;
   Texture weights_, flat_, combined_;
-  int period_ = 0;
+  int period_u_ = 0, period_v_ = 0;
   MaterialDesc material_;
 };
 
-Image random_heights(int size, std::uint32_t seed) {
+Image random_heights(int width, int height, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  Image img(size, size, 1);
+  Image img(width, height, 1);
   for (float& t : img.texels) t = unit(rng);
   return img;
 }
 
-Image random_weights(int size, std::uint32_t seed) {
+Image random_heights(int size, std::uint32_t seed) { return random_heights(size, size, seed); }
+
+Image random_weights(int width, int height, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  Image img(size, size, 4);
+  Image img(width, height, 4);
   for (float& t : img.texels) t = unit(rng) < 0.3f ? 0.0f : unit(rng);  // some layers absent
   return img;
 }
+
+Image random_weights(int size, std::uint32_t seed) { return random_weights(size, size, seed); }
 
 TechniqueDesc qdm_box() {
   TechniqueDesc t;
@@ -97,18 +103,21 @@ TechniqueDesc qdm_box() {
 }
 
 // Every texel centre and corner as an origin, 16 azimuths, 5 elevations: all the ways into a small map.
-std::vector<TechniqueRay> exhaustive_rays(int size) {
+std::vector<TechniqueRay> exhaustive_rays(int width, int height) {
   std::vector<TechniqueRay> rays;
-  for (int y = 0; y < 2 * size; ++y)
-    for (int x = 0; x < 2 * size; ++x)
+  for (int y = 0; y < 2 * height; ++y)
+    for (int x = 0; x < 2 * width; ++x)
       for (double elevation : {80.0, 45.0, 20.0, 8.0, 2.0})
         for (int a = 0; a < 16; ++a) {
           const double azimuth = 2.0 * std::numbers::pi * (a + 0.25) / 16.0;
           const double reach = 1.0 / std::tan(elevation * std::numbers::pi / 180.0);
-          rays.push_back({(x * 0.5 + 0.25) / size, (y * 0.5 + 0.25) / size, reach * std::cos(azimuth), reach * std::sin(azimuth)});
+          rays.push_back({(x * 0.5 + 0.25) / width, (y * 0.5 + 0.25) / height, reach * std::cos(azimuth),
+                          reach * std::sin(azimuth)});
         }
   return rays;
 }
+
+std::vector<TechniqueRay> exhaustive_rays(int size) { return exhaustive_rays(size, size); }
 
 // The height-blend box surface the weight texture defines when it matches the layers texel for texel (scale 1,
 // same size): bilinear weights at a texel centre are that texel's stored weights, so H0 = max_i(w_i h_i) exactly.
@@ -126,17 +135,18 @@ HeightField combined_field(const std::vector<Image>& heights, const BlendHarness
   return f;
 }
 
+// Square layers, and layers twice as wide as high (whose combined quadtree repeats with another period in v).
 TEST(HeightBlend, QdmhbNeverSkipsAnIntersectionOfTheBlendedSurface) {
-  for (int size : {8, 16}) {
+  for (const auto& [width, height] : {std::pair{8, 8}, std::pair{16, 16}, std::pair{16, 8}}) {
     std::vector<Image> heights;
-    for (int i = 0; i < kLayers; ++i) heights.push_back(random_heights(size, 100u + std::uint32_t(size + i)));
-    const Image weights = random_weights(size, 7u + std::uint32_t(size));
+    for (int i = 0; i < kLayers; ++i) heights.push_back(random_heights(width, height, 100u + std::uint32_t(width + i)));
+    const Image weights = random_weights(width, height, 7u + std::uint32_t(width));
     for (const auto& [ds, combined] : {std::pair{0.05, false}, std::pair{0.3, false}, std::pair{0.05, true}, std::pair{0.3, true}}) {
       TechniqueDesc t = qdm_box();
       t.depth_scale = float(ds);
       const BlendHarness harness(heights, weights, 1.0f, t, BlendOperator::Height, WeightMode::Pixel, combined);
       const HeightField field = combined_field(heights, harness);
-      const std::vector<TechniqueRay> rays = exhaustive_rays(size);
+      const std::vector<TechniqueRay> rays = exhaustive_rays(width, height);
       const std::vector<TechniqueResult> results = harness.run(rays);
       int wrong = 0;
       double worst = 0.0;
@@ -150,7 +160,8 @@ TEST(HeightBlend, QdmhbNeverSkipsAnIntersectionOfTheBlendedSurface) {
         // as single-layer QDM); a skipped column would be off by at least a texel.
         if (e > 1e-3) ++wrong;
       }
-      EXPECT_EQ(wrong, 0) << size << "^2, depth " << ds << (combined ? ", combined quadtree" : ", product bound") << ": "
+      EXPECT_EQ(wrong, 0) << width << "x" << height << ", depth " << ds
+                          << (combined ? ", combined quadtree" : ", product bound") << ": "
                           << rays.size() << " rays, worst " << worst << " texels";
     }
   }
@@ -341,7 +352,7 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
         const simd::Float fu = simd::Float::load_aligned(u), fv = simd::Float::load_aligned(v), fs = simd::Float::load_aligned(s);
         const simd::Float fdu = simd::Float(static_cast<float>(du)), fdv = simd::Float(static_cast<float>(dv));
         const simd::Float u1 = fu + fdu * fs, v1 = fv + fdv * fs;
-        const WeightTexture w{&weight_view, 2.0f, precomputed ? &combined_view : nullptr, 2 * n};
+        const WeightTexture w{&weight_view, 2.0f, precomputed ? &combined_view : nullptr, 2 * n, 2 * n};
         const BlendedSurface surface(layers.data(), kLayers, BlendOperator::Height, w,
                                      xsimd::min(fu, u1), xsimd::max(fu, u1), xsimd::min(fv, v1), xsimd::max(fv, v1));
         const ShadowResult r = self_shadow(surface, desc, ShadowRay{fu, fv, fs, fdu, fdv, simd::Float(float(ds))}, simd::Float(0.0f),
@@ -394,9 +405,10 @@ TEST(HeightBlend, BoxValuesAreTheLevelZeroValuesAWalkComputes) {
     ASSERT_EQ(values.size(), std::size_t(period) * std::size_t(period));
     const Texture tree = combined_quadtree(combined_surface(box_pointers, weights, repeats, op));
     const TextureSampler tree_view(tree, sampler);
-    const WeightTexture chains_only{&weight_view, float(repeats), &tree_view, period};
-    const WeightTexture with_heights{&weight_view, float(repeats), &tree_view, period, &interleaved};
-    const WeightTexture with_values{&weight_view, float(repeats), &tree_view, period, &interleaved, values.data()};
+    const WeightTexture chains_only{&weight_view, float(repeats), &tree_view, period, period};
+    const WeightTexture with_heights{&weight_view, float(repeats), &tree_view, period, period, &interleaved};
+    const WeightTexture with_values{&weight_view, float(repeats), &tree_view, period, period, &interleaved,
+                                    values.data()};
     // Every query of the batches stays in the whole weight span (all layers present wherever they have weight).
     const simd::Float lo(-1.0f), hi(float(repeats) + 1.0f);
     const auto surface = [&](const WeightTexture& w) {
