@@ -9,8 +9,8 @@
 #include <random>
 
 #include "displacement_test_util.hpp"
-#include "shade/self_shadow.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
+#include "shade/self_shadow.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {
