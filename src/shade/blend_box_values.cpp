@@ -30,8 +30,7 @@ void blend_box_values(const BlendBoxSource& source, float* out) {
       alignas(64) std::int32_t cells[kLanes];
       alignas(64) float values[kLanes];
       for (int l = 0; l < kLanes; ++l) cells[l] = std::min(x + l, period - 1);
-      level0_box_value(weights, heights.width, heights.height, source.op, source.layers, all_layers, state.fetch,
-                       Int::load_aligned(cells), Int(y))
+      level0_box_value(weights, source.op, source.layers, all_layers, state.fetch, Int::load_aligned(cells), Int(y))
           .store_aligned(values);
       std::copy_n(values, std::min(kLanes, period - x), row + x);
     }

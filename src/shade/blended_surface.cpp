@@ -44,16 +44,16 @@ Float combine_layers(BlendOperator op, int count, const Float* h, const Float* w
   return top;
 }
 
-Float level0_box_value(const WeightTexture& weights, int width, int height, BlendOperator op, int count,
-                       unsigned present, simd::FetchPath fetch, const Int& cx, const Int& cy) {
+Float level0_box_value(const WeightTexture& weights, BlendOperator op, int count, unsigned present,
+                       simd::FetchPath fetch, const Int& cx, const Int& cy) {
   // The same decoded heights as each layer's chain holds at level 0 (wrap: power-of-two sizes).
   const LayerHeights& lh = *weights.layer_heights;
   const Int texel = (cy & Int(lh.height - 1)) * Int(lh.width) + (cx & Int(lh.width - 1));
   Float all[BlendedSurface::kMaxLayers], h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers];
   simd::load_f32x4(lh.texels.data(), texel * Int(4), fetch, all);
   for (int i = 0; i < count; ++i) h[i] = (present >> i) & 1u ? all[i] : Float(0.0f);
-  sample_weights(weights, count, (xsimd::to_float(cx) + Float(0.5f)) / Float(float(width)),
-                 (xsimd::to_float(cy) + Float(0.5f)) / Float(float(height)), w);
+  sample_weights(weights, count, (xsimd::to_float(cx) + Float(0.5f)) / Float(float(lh.width)),
+                 (xsimd::to_float(cy) + Float(0.5f)) / Float(float(lh.height)), w);
   return combine_layers(op, count, h, w);
 }
 
@@ -184,7 +184,7 @@ Float BlendedSurface::combined_cell_max(const Int& level, const Int& cell_x, con
   const Int cx = xsimd::select(coarse, middle, cell_x), cy = xsimd::select(coarse, middle, cell_y);
   if (fast)
     return xsimd::select(simd::float_mask(coarse), result,
-                         level0_box_value(texture_, width(), height(), op_, count_, present_, sampler().fetch, cx, cy));
+                         level0_box_value(texture_, op_, count_, present_, sampler().fetch, cx, cy));
   Float h[kMaxLayers], w[kMaxLayers];
   for (int i = 0; i < count_; ++i)
     h[i] = present(i) ? layer_fetch(i, [&](const auto& l) { return l.cell_max(Int(0), cx, cy); }) : Float(0.0f);

@@ -38,11 +38,11 @@ SamplerState weight_sampler_state(const SamplerState& material);
 // The blend operator applied to layer heights h and weights w of `count` layers.
 simd::Float combine_layers(BlendOperator op, int count, const simd::Float* h, const simd::Float* w);
 
-// The blended box surface's value at level-0 cells (cx, cy) of layers `width` x `height` texels: the layers'
-// level-0 heights (weights.layer_heights) and the weight texture sampled bilinearly at the cell's centre, blended
-// by `op`. Layers outside `present` count as height 0 (every lane's weight of them is 0).
-simd::Float level0_box_value(const WeightTexture& weights, int width, int height, BlendOperator op, int count,
-                             unsigned present, simd::FetchPath fetch, const simd::Int& cx, const simd::Int& cy);
+// The blended box surface's value at level-0 cells (cx, cy) of the layers' texel grid: the layers' level-0
+// heights (weights.layer_heights, whose size is the grid's) and the weight texture sampled bilinearly at the
+// cell's centre, blended by `op`. Layers outside `present` count as height 0 (every lane's weight of them is 0).
+simd::Float level0_box_value(const WeightTexture& weights, BlendOperator op, int count, unsigned present,
+                             simd::FetchPath fetch, const simd::Int& cx, const simd::Int& cy);
 
 class BlendedSurface {
 public:
