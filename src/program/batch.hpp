@@ -30,6 +30,9 @@ struct ShadeOutput {
   simd::Float depth, view_depth;
 };
 
+// The most batches a program's group (ShadingProgram::shade_group) may hold.
+inline constexpr int kMaxGroupBatches = 8;
+
 class ShadingProgram : public Program {
 public:
   using Program::Program;
@@ -44,6 +47,16 @@ public:
     shade(b, out_b);
   }
   virtual bool pairs_batches() const { return false; }
+  // Up to group_batches() batches (of a pairs_batches() program) that write no pixel in common, with at most
+  // group_lanes() covered lanes in all, at once, with the same results as shade() of each: a program that packs
+  // sparse batches' covered lanes into fewer batches asks for more than a pair. By default, in pairs.
+  virtual void shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+    int k = 0;
+    for (; k + 1 < n; k += 2) shade_pair(*in[k], *out[k], *in[k + 1], *out[k + 1]);
+    if (k < n) shade(*in[k], *out[k]);
+  }
+  virtual int group_batches() const { return 2; }  // at most kMaxGroupBatches
+  virtual int group_lanes() const { return 2 * simd::kLanes; }
 };
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

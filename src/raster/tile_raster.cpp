@@ -161,7 +161,7 @@ public:
   // Shades what is still held back: call once after the tile's last triangle.
   void flush() {
     flush_packed();
-    if (waiting_ >= 0) shade_waiting();
+    if (held_count_ > 0) shade_held();
   }
 
 private:
@@ -179,10 +179,10 @@ private:
     const ShadingProgram* program = nullptr;
   };
 
-  // The slot neither waiting for a partner, nor packing, nor `busy`.
+  // The slot neither held back, nor packing, nor `busy`.
   int free_slot(int busy) const {
     int slot = 0;
-    while (slot == waiting_ || slot == packing_ || slot == busy) ++slot;
+    while (((held_slots_ >> slot) & 1u) != 0 || slot == packing_ || slot == busy) ++slot;
     return slot;
   }
 
@@ -269,23 +269,21 @@ private:
     slots_[packing_].pass = 0;
   }
 
-  // A batch ready to shade: now, or paired with the next one when the program interleaves two.
+  // A batch ready to shade: now, or held back for a group (a pair, or more: ShadingProgram::shade_group) when the
+  // program shades batches together.
   void ready(int slot) {
     PendingBatch& p = slots_[slot];
     if (recorder_ == nullptr && p.program->pairs_batches()) {
       // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one
-      // of its pixels is tested), so the second one's early depth test may run before the first one's write.
-      if (waiting_ >= 0 && slots_[waiting_].program != p.program) shade_waiting();
-      if (waiting_ < 0) {
-        waiting_ = slot;
-        return;
-      }
-      PendingBatch& first = slots_[waiting_];
-      waiting_ = -1;
-      ShadeOutput out[2];
-      p.program->shade_pair(first.in, out[0], p.in, out[1]);
-      finish(first, out[0]);
-      finish(p, out[1]);
+      // of its pixels is tested), so a later one's early depth test may run before an earlier one's write.
+      const int lanes = std::popcount(p.pass);
+      if (held_count_ > 0 &&
+          (slots_[held_[0]].program != p.program || held_lanes_ + lanes > p.program->group_lanes()))
+        shade_held();
+      held_[held_count_++] = slot;
+      held_slots_ |= 1u << slot;
+      held_lanes_ += lanes;
+      if (held_count_ >= std::min(p.program->group_batches(), kMaxGroupBatches)) shade_held();
       return;
     }
     ShadeOutput out;
@@ -308,12 +306,31 @@ private:
     finish(p, out);
   }
 
-  void shade_waiting() {
-    PendingBatch& p = slots_[waiting_];
-    waiting_ = -1;
-    ShadeOutput out;
-    p.program->shade(p.in, out);
-    finish(p, out);
+  // Shades the batches held back, as one group.
+  void shade_held() {
+    const Fragments* in[kMaxGroupBatches];
+    ShadeOutput out[kMaxGroupBatches];
+    ShadeOutput* out_of[kMaxGroupBatches];
+    for (int k = 0; k < held_count_; ++k) {
+      in[k] = &slots_[held_[k]].in;
+      out_of[k] = &out[k];
+    }
+    const ShadingProgram& program = *slots_[held_[0]].program;
+    if (held_count_ == 1)
+      program.shade(*in[0], out[0]);
+    else
+      program.shade_group(in, out_of, held_count_);
+    for (int k = 0; k < held_count_; ++k) finish(slots_[held_[k]], out[k]);
+    held_count_ = 0;
+    held_lanes_ = 0;
+    held_slots_ = 0;
+  }
+
+  // Whether a batch held back will write a pixel of the batch at (x, y) that has its lane in `inside`.
+  bool held_writes_any_of(int x, int y, std::uint32_t inside) const {
+    for (int k = 0; k < held_count_; ++k)
+      if (writes_any_of(slots_[held_[k]], x, y, inside)) return true;
+    return false;
   }
 
   // Coverage, early depth test and interpolation of the batch at (x, y) into slots_[slot]; false when no lane
@@ -352,7 +369,7 @@ private:
     // A held-back batch that will write one of these pixels writes it before the early depth test reads it.
     // Quads at the same place with no pixel in common (two triangles sharing a quad) stay held back together.
     if (packed_quads_ > 0 && writes_any_of(slots_[packing_], x, y, inside)) flush_packed(slot);
-    if (waiting_ >= 0 && writes_any_of(slots_[waiting_], x, y, inside)) shade_waiting();
+    if (held_count_ > 0 && held_writes_any_of(x, y, inside)) shade_held();
 
     Float stored;
     if (whole) {
@@ -504,11 +521,14 @@ private:
   // program (only where a batch holds several quads; not while the recorder attributes fetches to triangles'
   // batches as a GPU issues them).
   const bool packs_quads_ = simd::kQuadsPerBatch > 1 && recorder_ == nullptr;
-  // Three slots: the batch being prepared, one waiting for a partner (-1: none), the packing batch with
-  // packed_quads_ quads so far.
-  PendingBatch slots_[3];
-  int waiting_ = -1;
-  int packing_ = 2;
+  // The slots: the batch being prepared, the batches held back for a group (held_count_ of them, in held_, with
+  // held_lanes_ covered lanes in all; held_slots_: bit i for slot i), the packing batch with packed_quads_ quads
+  // so far.
+  PendingBatch slots_[kMaxGroupBatches + 2];
+  int held_[kMaxGroupBatches] = {};
+  int held_count_ = 0, held_lanes_ = 0;
+  std::uint32_t held_slots_ = 0;
+  int packing_ = kMaxGroupBatches + 1;
   int packed_quads_ = 0;
   bool any_aov_ = false;  // an AOV plane other than cache_misses (filled after the tile) is asked for
   Float lane_centre_x_, lane_centre_y_;  // each lane's pixel centre from the batch origin (dx + 0.5, dy + 0.5)

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <type_traits>
 
-#include "core/lane_packing.hpp"
+#include "core/lane_compaction.hpp"
 #include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
@@ -46,7 +46,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
                      inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      shade_(variant.shade), shade_pair_(variant.shade_pair), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
+      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
@@ -466,39 +466,38 @@ void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, con
   (this->*shade_pair_)(a, out_a, b, out_b);
 }
 
-// QDM, relief and POM over a blend: two batches whose covered lanes fit one run as one (shade_packed); else both
-// are traced (QDM's walks interleaved), each over its own blended surface, and each batch's hit shaded.
-// Single-layer QDM, relief and POM: both batches set up and traced (QDM's walks interleaved), then the surface at
-// each hit and its lighting, stage by stage, each batch's chains of dependent operations beside the other's. Any
-// other program shades one batch after the other (pairs_batches() is false for them; this is the fallback).
+void DisplacementProgram::shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  (this->*shade_group_)(in, out, n);
+}
+
+// A blend's sparse batches are packed into fewer (shade_compacted): up to eight at once, with at most four
+// batches' worth of covered lanes (the grouping that left the terrain the fewest packed batches, docs/performance.md).
+static_assert(simd::LaneCompaction::kMaxBatches <= kMaxGroupBatches);
+
+int DisplacementProgram::group_batches() const {
+  return pairs_batches() && layers_.size() > 1 ? simd::LaneCompaction::kMaxBatches : ShadingProgram::group_batches();
+}
+
+int DisplacementProgram::group_lanes() const {
+  return pairs_batches() && layers_.size() > 1 ? 4 * simd::kLanes : ShadingProgram::group_lanes();
+}
+
+// QDM, relief and POM over a blend: shade_group_variant() of the two. Single-layer QDM, relief and POM: both
+// batches set up and traced (QDM's walks interleaved), then the surface at each hit and its lighting, stage by
+// stage, each batch's chains of dependent operations beside the other's. Any other program shades one batch after
+// the other (pairs_batches() is false for them; this is the fallback).
 template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
   constexpr TechniqueKind kind = V::technique;
   if constexpr (pairs_technique(kind)) {
-    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
-    if (layers_.size() > 1) {  // a blend: packed, or both traced (QDM's walks interleaved), then each shaded
-      const LayerSurfaces layers = layer_surfaces();
-      const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
-      if (simd::LanePacking::fits(covered_a, covered_b)) {
-        shade_packed<V>(layers, a, setup_a, out_a, b, setup_b, out_b, simd::LanePacking(covered_a, covered_b));
-        return;
-      }
-      const BlendedSurface surface_a = blended_surface(layers, a, setup_a), surface_b = blended_surface(layers, b, setup_b);
-      Float ds_a = setup_a.ds, ds_b = setup_b.ds;  // POM fades them with distance
-      Hit hit_a, hit_b;
-      if constexpr (kind == TechniqueKind::Qdm) {
-        walk_pair<V>(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
-        hit_a = refine_qdm_hit(surface_a, setup_a, hit_a);
-        hit_b = refine_qdm_hit(surface_b, setup_b, hit_b);
-      } else {
-        hit_a = trace<V>(surface_a, setup_a, ds_a);
-        hit_b = trace<V>(surface_b, setup_b, ds_b);
-      }
-      shade_hit<V>(a, setup_a, surface_a, hit_a, ds_a, out_a);
-      shade_hit<V>(b, setup_b, surface_b, hit_b, ds_b, out_b);
+    if (layers_.size() > 1) {
+      const Fragments* const in[2] = {&a, &b};
+      ShadeOutput* const out[2] = {&out_a, &out_b};
+      shade_group_variant<V>(in, out, 2);
       return;
     }
+    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
     const SingleLayerSurface surface = layer_surface(0);
     if constexpr (kind == TechniqueKind::Qdm) {
       Hit hit_a, hit_b;
@@ -517,6 +516,33 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
   shade_variant<V>(b, out_b);
 }
 
+// QDM, relief and POM over a blend: n batches whose covered lanes fit fewer run as those (shade_compacted); else
+// each is traced over its own blended surface, two at a time (QDM's walks interleaved), and its hits shaded. Any
+// other program: ShadingProgram's pairs.
+template <class V>
+void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  if constexpr (pairs_technique(V::technique)) {
+    if (layers_.size() > 1) {
+      Setup setups[simd::LaneCompaction::kMaxBatches];
+      std::uint32_t covered[simd::LaneCompaction::kMaxBatches];
+      for (int k = 0; k < n; ++k) {
+        setups[k] = setup_for(*in[k]);
+        covered[k] = simd::to_bits(in[k]->covered);
+      }
+      const simd::LaneCompaction lanes(covered, n);
+      if (lanes.packed_batches() < n) {
+        shade_compacted<V>(in, setups, out, lanes);
+        return;
+      }
+      trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit, const Float& ds) {
+        shade_hit<V>(*in[k], setups[k], surface, hit, ds, *out[k]);
+      });
+      return;
+    }
+  }
+  ShadingProgram::shade_group(in, out, n);
+}
+
 // Two batches' QDM walks to their ends, a step of each per round: their hits on the box surface.
 template <class V, class Surface>
 void DisplacementProgram::walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a,
@@ -530,60 +556,111 @@ void DisplacementProgram::walk_pair(const Surface& surface_a, const Setup& setup
   hit_b = walk_b.hit();
 }
 
+// Traces batches 0 .. n - 1 over their blended surfaces, two at a time (QDM's walks interleaved, relief and POM
+// one after the other), and calls shade(k, surface, hit, ds) for each.
+template <class V, class Shade>
+void DisplacementProgram::trace_blended(const Fragments* const* in, const Setup* setups, int n,
+                                        const Shade& shade) const {
+  const LayerSurfaces layers = layer_surfaces();
+  for (int k = 0; k < n; k += 2) {
+    const BlendedSurface surface_a = blended_surface(layers, *in[k], setups[k]);
+    Float ds_a = setups[k].ds;  // POM fades it with distance
+    if (k + 1 == n) {
+      shade(k, surface_a, trace<V>(surface_a, setups[k], ds_a), ds_a);
+      return;
+    }
+    const BlendedSurface surface_b = blended_surface(layers, *in[k + 1], setups[k + 1]);
+    Float ds_b = setups[k + 1].ds;
+    Hit hit_a, hit_b;
+    if constexpr (V::technique == TechniqueKind::Qdm) {
+      walk_pair<V>(surface_a, setups[k], hit_a, surface_b, setups[k + 1], hit_b);
+      hit_a = refine_qdm_hit(surface_a, setups[k], hit_a);
+      hit_b = refine_qdm_hit(surface_b, setups[k + 1], hit_b);
+    } else {
+      hit_a = trace<V>(surface_a, setups[k], ds_a);
+      hit_b = trace<V>(surface_b, setups[k + 1], ds_b);
+    }
+    shade(k, surface_a, hit_a, ds_a);
+    shade(k + 1, surface_b, hit_b, ds_b);
+  }
+}
+
 // Past the setup (whose derivatives read whole quads) a blended batch's work is lane by lane: the covered lanes of
-// both batches are traced and shaded as one batch, and each batch gets its own lanes back. The displaced depth
-// reads quads again (the world position's derivatives): each batch's, from its own lanes' hits.
+// n batches are packed into as few batches as hold them (simd::LaneCompaction), traced (QDM's walks two at a time)
+// and shaded, and each batch gets its own lanes back. The displaced depth reads quads again (the world position's
+// derivatives): each batch's, from its own lanes' hits.
 template <class V>
-void DisplacementProgram::shade_packed(const LayerSurfaces& layers, const Fragments& a, const Setup& setup_a,
-                                       ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, ShadeOutput& out_b,
-                                       const simd::LanePacking& packing) const {
-  const auto pack = [&](const Float& x, const Float& y) { return packing.pack(x, y); };
-  const auto pack3 = [&](const Vec3& x, const Vec3& y) { return Vec3{pack(x.x, y.x), pack(x.y, y.y), pack(x.z, y.z)}; };
-  const int lanes_used = std::popcount(simd::to_bits(a.covered)) + std::popcount(simd::to_bits(b.covered));
-  const Mask used = simd::from_bits((1u << lanes_used) - 1u);
-  Fragments in;
-  in.pixel_x = pack(a.pixel_x, b.pixel_x);
-  in.pixel_y = pack(a.pixel_y, b.pixel_y);
-  for (int k = 0; k < varying_count(); ++k) in.varyings[k] = pack(a.varyings[k], b.varyings[k]);
-  in.view_depth = pack(a.view_depth, b.view_depth);
-  in.covered = used;
-  Setup setup;
-  setup.d = {pack(setup_a.d.dudx, setup_b.d.dudx), pack(setup_a.d.dvdx, setup_b.d.dvdx),
-             pack(setup_a.d.dudy, setup_b.d.dudy), pack(setup_a.d.dvdy, setup_b.d.dvdy)};
-  setup.frame = {pack3(setup_a.frame.t, setup_b.frame.t), pack3(setup_a.frame.b, setup_b.frame.b),
-                 pack3(setup_a.frame.n, setup_b.frame.n)};
-  setup.view = pack3(setup_a.view, setup_b.view);
-  setup.view_tangent = pack3(setup_a.view_tangent, setup_b.view_tangent);
-  setup.ds = pack(setup_a.ds, setup_b.ds);
-  setup.ray = {pack(setup_a.ray.u0, setup_b.ray.u0), pack(setup_a.ray.v0, setup_b.ray.v0),
-               pack(setup_a.ray.du, setup_b.ray.du), pack(setup_a.ray.dv, setup_b.ray.dv)};
-  setup.active = used;
-  setup.height_lod = pack(setup_a.height_lod, setup_b.height_lod);
-  const BlendedSurface surface = blended_surface(layers, in, setup);
-  Float ds = setup.ds;
-  const Hit hit = trace<V>(surface, setup, ds);
-  SurfaceAtHit at;
-  surface_at_hit(setup, surface, hit, ds, at);
-  ShadeOutput lit;
-  light_hit<V>(in, setup, surface, at, ds, lit);
-  const auto unpack = [&](const Fragments& batch, const Setup& batch_setup, ShadeOutput& out, auto lanes) {
-    out = lit;
+void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setup* setups, ShadeOutput* const* out,
+                                          const simd::LaneCompaction& lanes) const {
+  constexpr int kMax = simd::LaneCompaction::kMaxBatches;
+  const int packed = lanes.packed_batches();
+  Fragments packed_in[kMax];
+  Setup packed_setup[kMax];
+  for (int w = 0; w < packed; ++w) {
+    const auto pack = [&](auto field) { return lanes.pack(w, field); };
+    const auto pack3 = [&](auto vec) {
+      return Vec3{pack([&](int k) -> const Float& { return vec(k).x; }),
+                  pack([&](int k) -> const Float& { return vec(k).y; }),
+                  pack([&](int k) -> const Float& { return vec(k).z; })};
+    };
+    // Of the inputs, what reads them past the setup: the pixel (frame AO's noise), the vertex weights (the blended
+    // surface) and the covered lanes.
+    Fragments& f = packed_in[w];
+    f.pixel_x = pack([&](int k) -> const Float& { return in[k]->pixel_x; });
+    f.pixel_y = pack([&](int k) -> const Float& { return in[k]->pixel_y; });
+    for (int j = kWeight0; j < varying_count(); ++j)
+      f.varyings[j] = pack([&](int k) -> const Float& { return in[k]->varyings[j]; });
+    f.covered = lanes.used(w);
+    Setup& s = packed_setup[w];
+    s.d = {pack([&](int k) -> const Float& { return setups[k].d.dudx; }),
+           pack([&](int k) -> const Float& { return setups[k].d.dvdx; }),
+           pack([&](int k) -> const Float& { return setups[k].d.dudy; }),
+           pack([&](int k) -> const Float& { return setups[k].d.dvdy; })};
+    s.frame = {pack3([&](int k) -> const Vec3& { return setups[k].frame.t; }),
+               pack3([&](int k) -> const Vec3& { return setups[k].frame.b; }),
+               pack3([&](int k) -> const Vec3& { return setups[k].frame.n; })};
+    s.view = pack3([&](int k) -> const Vec3& { return setups[k].view; });
+    s.view_tangent = pack3([&](int k) -> const Vec3& { return setups[k].view_tangent; });
+    s.ds = pack([&](int k) -> const Float& { return setups[k].ds; });
+    s.ray = {pack([&](int k) -> const Float& { return setups[k].ray.u0; }),
+             pack([&](int k) -> const Float& { return setups[k].ray.v0; }),
+             pack([&](int k) -> const Float& { return setups[k].ray.du; }),
+             pack([&](int k) -> const Float& { return setups[k].ray.dv; })};
+    s.active = f.covered;
+    s.height_lod = pack([&](int k) -> const Float& { return setups[k].height_lod; });
+  }
+  const Fragments* packed_of[kMax];
+  for (int w = 0; w < packed; ++w) packed_of[w] = &packed_in[w];
+  ShadeOutput lit[kMax];
+  Float hit_s[kMax];
+  trace_blended<V>(packed_of, packed_setup, packed,
+                   [&](int w, const BlendedSurface& surface, const Hit& hit, const Float& ds) {
+                     SurfaceAtHit at;
+                     surface_at_hit(packed_setup[w], surface, hit, ds, at);
+                     light_hit<V>(packed_in[w], packed_setup[w], surface, at, ds, lit[w]);
+                     hit_s[w] = at.hit.s;
+                   });
+  for (int k = 0; k < lanes.batches(); ++k) {
+    const auto unpack = [&](Float ShadeOutput::*field) {
+      return lanes.unpack(k, [&](int w) -> const Float& { return lit[w].*field; });
+    };
+    ShadeOutput& o = *out[k];
+    o = lit[0];
     for (int c = 0; c < 3; ++c) {
-      out.color[c] = lanes(lit.color[c]);
-      out.normal[c] = lanes(lit.normal[c]);
+      o.color[c] = lanes.unpack(k, [&](int w) -> const Float& { return lit[w].color[c]; });
+      o.normal[c] = lanes.unpack(k, [&](int w) -> const Float& { return lit[w].normal[c]; });
     }
     for (Float ShadeOutput::*f : {&ShadeOutput::hit_u, &ShadeOutput::hit_v, &ShadeOutput::hit_depth,
                                   &ShadeOutput::error_texels, &ShadeOutput::missed, &ShadeOutput::shadow,
                                   &ShadeOutput::ao})
-      out.*f = lanes(lit.*f);
+      o.*f = unpack(f);
     // The rasterizer counts a batch's executed iterations from its longest lane, uncovered lanes included: they
-    // ran none, as in a batch shaded alone (lanes() leaves them undefined, another batch's count on some ISAs).
-    out.iterations = xsimd::select(batch.covered, lanes(lit.iterations), Float(0.0f));
+    // ran none, as in a batch shaded alone (unpack() leaves them undefined).
+    o.iterations = xsimd::select(in[k]->covered, unpack(&ShadeOutput::iterations), Float(0.0f));
     if (technique_.write_depth)
-      displaced_depth(batch, batch_setup.d, batch_setup.frame, batch_setup.ray, lanes(at.hit.s), out);
-  };
-  unpack(a, setup_a, out_a, [&](const Float& v) { return packing.first(v); });
-  unpack(b, setup_b, out_b, [&](const Float& v) { return packing.second(v); });
+      displaced_depth(*in[k], setups[k].d, setups[k].frame, setups[k].ray,
+                      lanes.unpack(k, [&](int w) -> const Float& { return hit_s[w]; }), o);
+  }
 }
 
 // shade_hit() of two single-layer batches, stage by stage: the surface at each hit, then the lighting of each.
@@ -666,7 +743,8 @@ BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers,
 
 template <class V>
 DisplacementProgram::Variant DisplacementProgram::variant() {
-  return {&DisplacementProgram::shade_variant<V>, &DisplacementProgram::shade_pair_variant<V>, V::options()};
+  return {&DisplacementProgram::shade_variant<V>, &DisplacementProgram::shade_pair_variant<V>,
+          &DisplacementProgram::shade_group_variant<V>, V::options()};
 }
 
 // Every combination of the trace options is instantiated (program/variant.hpp): 5 techniques, and for qdm

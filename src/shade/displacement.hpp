@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/lane_packing.hpp"
+#include "core/lane_compaction.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "shade/blended_surface.hpp"
@@ -40,6 +40,9 @@ public:
   void shade(const Fragments& in, ShadeOutput& out) const override;
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
   bool pairs_batches() const override;
+  void shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
+  int group_batches() const override;
+  int group_lanes() const override;
 
   using Ray = trace::Ray;
   using Hit = trace::Hit;
@@ -57,9 +60,11 @@ private:
   using ShadeFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&) const;
   using ShadePairFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&, const Fragments&,
                                                     ShadeOutput&) const;
+  using ShadeGroupFn = void (DisplacementProgram::*)(const Fragments* const*, ShadeOutput* const*, int) const;
   struct Variant {
     ShadeFn shade;
     ShadePairFn shade_pair;
+    ShadeGroupFn shade_group;
     TraceOptions options;
   };
   // QDM's lowest level and iteration cap per lane.
@@ -102,9 +107,12 @@ private:
   void walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
                  const Setup& setup_b, Hit& hit_b) const;
   template <class V>
-  void shade_packed(const LayerSurfaces& layers, const Fragments& a, const Setup& setup_a, ShadeOutput& out_a,
-                    const Fragments& b, const Setup& setup_b, ShadeOutput& out_b,
-                    const simd::LanePacking& packing) const;
+  void shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const;
+  template <class V, class Shade>
+  void trace_blended(const Fragments* const* in, const Setup* setups, int n, const Shade& shade) const;
+  template <class V>
+  void shade_compacted(const Fragments* const* in, const Setup* setups, ShadeOutput* const* out,
+                       const simd::LaneCompaction& lanes) const;
   template <class V>
   void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const simd::Float& ds_a,
                   ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
@@ -136,6 +144,7 @@ private:
 
   ShadeFn shade_;
   ShadePairFn shade_pair_;
+  ShadeGroupFn shade_group_;
   std::vector<Layer> layers_;
   std::optional<TextureSampler> weights_;
   std::optional<TextureSampler> combined_;

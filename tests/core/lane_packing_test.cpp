@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/lane_packing.hpp"
+#include "support/lane_values.hpp"
 
 namespace qdmr {
 namespace {
@@ -16,16 +17,8 @@ using simd::Float;
 using simd::kLanes;
 using simd::LanePacking;
 
-std::uint32_t bits_of(float f) { return std::bit_cast<std::uint32_t>(f); }
-
-// Distinct bit patterns per lane and per batch, among them a NaN with a payload and a negative zero.
-Float lanes_of(int batch) {
-  alignas(64) float v[kLanes];
-  for (int l = 0; l < kLanes; ++l) v[l] = float(100 * batch + l) + 0.25f;
-  v[1] = -0.0f;
-  v[kLanes - 1] = std::bit_cast<float>(0x7fc01234u + std::uint32_t(batch));
-  return Float::load_aligned(v);
-}
+using test::bits_of;
+using test::lanes_of;
 
 void expect_round_trip(std::uint32_t first, std::uint32_t second) {
   const Float a = lanes_of(1), b = lanes_of(2);

@@ -95,10 +95,10 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
 // when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
-// a 4-layer blend with per-pixel weights (paired, and packed where two batches' covered lanes fit one), with and
-// without the displaced depth, on its combined quadtree and on the product of the layers' and weights' trees;
-// surface_blend_4layers under POM and QDM, its 4 layers blended by vertex weights (paired, and packed where they
-// fit); plane normal mapping (paired, no trace).
+// a 4-layer blend with per-pixel weights (grouped: the covered lanes of up to eight sparse batches packed into
+// fewer), with and without the displaced depth, on its combined quadtree and on the product of the layers' and
+// weights' trees; surface_blend_4layers under POM and QDM, its 4 layers blended by vertex weights (grouped alike);
+// plane normal mapping (paired, no trace).
 TEST(TextureCache, LeavesTheImageAsItIs) {
   struct Case {
     const char* scene;
