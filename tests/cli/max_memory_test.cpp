@@ -426,8 +426,9 @@ TEST(MaxMemory, AoBakeEstimateCoversTheBakersPeak) {
 // order, handed on; or one channel spread to three), a 16-bit height with its from_height normals built beside it,
 // a procedural albedo (pattern and colours), and a procedural height behind normals and a max-quadtree. Before,
 // the plan counted only the finished textures: a 4096² file albedo peaked at 3 times the estimate.
-// Measured (Release, 2048²): the two file albedos 69.2 MiB for 69.3, the height with its normals 83.9 for 96.0, the
-// procedural albedo 80.0 for 80.0, the procedural height with normals and quadtree 90.7 for 106.7.
+// Measured (Release, 2048², an idle machine): the two file albedos 154.7 MiB for 154.7 (their finished textures
+// 106.7), the height with its normals 165.3 for 181.3 (117.3), the procedural albedo 154.7 for 154.7 (106.7), the
+// procedural height with normals and quadtree 192.1 for 213.3 (149.3).
 TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
 #ifdef QDMR_ADDRESS_SANITIZER
   GTEST_SKIP() << "under AddressSanitizer resident memory counts its shadow memory and quarantine";
@@ -475,8 +476,12 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
     const std::optional<std::uint64_t> measured =
         peak_growth([&] { EXPECT_EQ(prepare(plan).texture_bytes(), plan.texture_bytes); });
     if (!measured) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
-    // Two builds at once rarely peak together, so the estimate may exceed the peak by a third.
-    expect_estimate_covers(*measured, estimate, 0.75, c.layer + " (" + c.technique + ")");
+    // The finished textures are resident at the end whatever the schedule, but the working memory of builds that
+    // may run at once peaks together only where the scheduler runs them together: on a loaded machine they ran
+    // one after the other (the qdm case's peak 157.8 MiB of 213.3 in a CI run, 192 MiB on an idle one). So the
+    // floor is the finished textures.
+    expect_estimate_covers(*measured, estimate, double(plan.texture_bytes) / double(estimate),
+                           c.layer + " (" + c.technique + ")");
   }
 #endif
 }
