@@ -276,14 +276,18 @@ private:
     if (recorder_ == nullptr && p.program->pairs_batches()) {
       // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one
       // of its pixels is tested), so a later one's early depth test may run before an earlier one's write.
+      if (p.program != grouping_of_) {  // asked once per program, not per batch
+        grouping_of_ = p.program;
+        group_batches_ = std::min(p.program->group_batches(), kMaxGroupBatches);
+        group_lanes_ = p.program->group_lanes();
+      }
       const int lanes = std::popcount(p.pass);
-      if (held_count_ > 0 &&
-          (slots_[held_[0]].program != p.program || held_lanes_ + lanes > p.program->group_lanes()))
+      if (held_count_ > 0 && (slots_[held_[0]].program != p.program || held_lanes_ + lanes > group_lanes_))
         shade_held();
       held_[held_count_++] = slot;
       held_slots_ |= 1u << slot;
       held_lanes_ += lanes;
-      if (held_count_ >= std::min(p.program->group_batches(), kMaxGroupBatches)) shade_held();
+      if (held_count_ >= group_batches_) shade_held();
       return;
     }
     ShadeOutput out;
@@ -306,8 +310,30 @@ private:
     finish(p, out);
   }
 
-  // Shades the batches held back, as one group.
+  // Shades the batches held back, as one group (one batch alone, two as a pair: the usual cases, without the
+  // group's arrays).
   void shade_held() {
+    const ShadingProgram& program = *slots_[held_[0]].program;
+    if (held_count_ <= 2) {
+      ShadeOutput out[2];
+      PendingBatch& first = slots_[held_[0]];
+      if (held_count_ == 1) {
+        program.shade(first.in, out[0]);
+      } else {
+        program.shade_pair(first.in, out[0], slots_[held_[1]].in, out[1]);
+      }
+      finish(first, out[0]);
+      if (held_count_ == 2) finish(slots_[held_[1]], out[1]);
+    } else {
+      shade_held_group(program);
+    }
+    held_count_ = 0;
+    held_lanes_ = 0;
+    held_slots_ = 0;
+  }
+
+  // shade_held() of more than two batches (a function of its own: its arrays would make every pair's frame bigger).
+  [[gnu::noinline]] void shade_held_group(const ShadingProgram& program) {
     const Fragments* in[kMaxGroupBatches];
     ShadeOutput out[kMaxGroupBatches];
     ShadeOutput* out_of[kMaxGroupBatches];
@@ -315,15 +341,8 @@ private:
       in[k] = &slots_[held_[k]].in;
       out_of[k] = &out[k];
     }
-    const ShadingProgram& program = *slots_[held_[0]].program;
-    if (held_count_ == 1)
-      program.shade(*in[0], out[0]);
-    else
-      program.shade_group(in, out_of, held_count_);
+    program.shade_group(in, out_of, held_count_);
     for (int k = 0; k < held_count_; ++k) finish(slots_[held_[k]], out[k]);
-    held_count_ = 0;
-    held_lanes_ = 0;
-    held_slots_ = 0;
   }
 
   // Whether a batch held back will write a pixel of the batch at (x, y) that has its lane in `inside`.
@@ -527,6 +546,8 @@ private:
   PendingBatch slots_[kMaxGroupBatches + 2];
   int held_[kMaxGroupBatches] = {};
   int held_count_ = 0, held_lanes_ = 0;
+  const ShadingProgram* grouping_of_ = nullptr;  // the program group_batches_ and group_lanes_ are of
+  int group_batches_ = 2, group_lanes_ = 2 * kLanes;
   std::uint32_t held_slots_ = 0;
   int packing_ = kMaxGroupBatches + 1;
   int packed_quads_ = 0;
