@@ -64,6 +64,8 @@ public:
 
   int batches() const { return count_; }
   int packed_batches() const { return packed_; }
+  // The batch packed batch w's first lane comes from.
+  int first_source(int w) const { return first_source_[w]; }
   // The lanes of packed batch w that hold a working lane.
   Mask used(int w) const { return from_bits((1u << used_[w]) - 1u); }
 

@@ -27,6 +27,10 @@ struct ShadeOutput {
   // Programs that displace the surface may replace the polygon's depth (window depth, and distance along the
   // view axis for the depth AOV); the rasterizer then tests it again before writing (a late depth test).
   bool writes_depth = false;
+  // The lane-iterations the SIMD loops executed for this batch where its lanes ran packed with other batches'
+  // (ShadingProgram::shade_group; each packed batch counted once, with one of its batches); -1: the batch ran as
+  // itself, its longest lane's iterations times the lanes.
+  int executed_lane_iterations = -1;
   simd::Float depth, view_depth;
 };
 

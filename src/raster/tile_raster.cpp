@@ -520,7 +520,8 @@ private:
     } else {
       counters_.count_lanes(iterations, pass);
     }
-    counters_.iterations_executed += std::uint64_t(longest) * kLanes;
+    counters_.iterations_executed +=
+        out.executed_lane_iterations >= 0 ? std::uint64_t(out.executed_lane_iterations) : std::uint64_t(longest) * kLanes;
     ++counters_.batches_shaded;
     counters_.pixels_shaded += std::popcount(pass);
     counters_.quads_shaded += std::uint64_t(live_quads(pass));

@@ -641,6 +641,14 @@ void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setu
                      light_hit<V>(packed_in[w], packed_setup[w], surface, at, ds, lit[w]);
                      hit_s[w] = at.hit.s;
                    });
+  // What the packed batches' loops executed: each one's longest lane times the lanes, counted with the batch its
+  // first lane came from.
+  int executed[kMax] = {};
+  for (int w = 0; w < packed; ++w) {
+    alignas(64) float iterations[simd::kLanes];
+    xsimd::select(lanes.used(w), lit[w].iterations, Float(0.0f)).store_aligned(iterations);
+    executed[lanes.first_source(w)] += int(*std::max_element(iterations, iterations + simd::kLanes)) * simd::kLanes;
+  }
   for (int k = 0; k < lanes.batches(); ++k) {
     const auto unpack = [&](Float ShadeOutput::*field) {
       return lanes.unpack(k, [&](int w) -> const Float& { return lit[w].*field; });
@@ -655,9 +663,10 @@ void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setu
                                   &ShadeOutput::error_texels, &ShadeOutput::missed, &ShadeOutput::shadow,
                                   &ShadeOutput::ao})
       o.*f = unpack(f);
-    // The rasterizer counts a batch's executed iterations from its longest lane, uncovered lanes included: they
-    // ran none, as in a batch shaded alone (unpack() leaves them undefined).
+    // Uncovered lanes ran no iteration (unpack() leaves them undefined): the batch's useful iterations are its
+    // covered lanes'.
     o.iterations = xsimd::select(in[k]->covered, unpack(&ShadeOutput::iterations), Float(0.0f));
+    o.executed_lane_iterations = executed[k];
     if (technique_.write_depth)
       displaced_depth(*in[k], setups[k].d, setups[k].frame, setups[k].ray,
                       lanes.unpack(k, [&](int w) -> const Float& { return hit_s[w]; }), o);

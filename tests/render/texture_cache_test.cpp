@@ -140,15 +140,19 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
       EXPECT_EQ(a.stats.quads, b.stats.quads);
       EXPECT_EQ(a.stats.pixels_shaded, b.stats.pixels_shaded);
       EXPECT_EQ(a.stats.pixels_depth_failed, b.stats.pixels_depth_failed);
-      if (isa == Isa::Sse42) {  // one quad per batch: nothing to pack
+      // Rasterized batches: with one quad per batch there are no quads of different triangles to pack into one.
+      if (isa == Isa::Sse42) {
         EXPECT_EQ(a.stats.batches, b.stats.batches);
-        // Packed lanes count each batch's iterations as if it ran alone.
-        EXPECT_EQ(a.stats.lane_utilisation, b.stats.lane_utilisation);
       } else {
         EXPECT_LT(a.stats.batches, b.stats.batches);
-        if (traces) {  // the utilisation of loop iterations
-          EXPECT_GT(a.stats.lane_utilisation, b.stats.lane_utilisation);
-        }
+      }
+      // The loops' lane utilisation counts what they executed: more of it useful where quads were packed (not
+      // with one quad per batch) or a blend's groups packed sparse batches' lanes (every kernel).
+      const bool grouped = std::string(name) == "terrain" || std::string(name) == "surface_blend_4layers";
+      if (traces && (grouped || isa != Isa::Sse42)) {
+        EXPECT_GT(a.stats.lane_utilisation, b.stats.lane_utilisation);
+      } else {
+        EXPECT_EQ(a.stats.lane_utilisation, b.stats.lane_utilisation);
       }
     }
   }
