@@ -3,7 +3,8 @@
 // something reads depth after its tile (keeps_depth_plane): the tiles test depth in a tile-sized plane of their
 // own, in cache, and copy it out only then. Kept by the renderer from frame to frame (resize() keeps the memory
 // when the size allows), so a warm frame touches no new pages. Never cleared as a whole: each tile clears its
-// own pixels before drawing (clear_rect), in parallel.
+// own AOV pixels before drawing (clear_aovs) and writes every colour pixel, the background where nothing covers
+// it (raster_tile), in parallel.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -49,16 +50,10 @@ struct Framebuffer {
   }
 
   std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
-  void clear_rect(int x0, int y0, int x1, int y1) {  // inclusive bounds
+  void clear_aovs(int x0, int y0, int x1, int y1) {  // inclusive bounds
     const std::size_t n = std::size_t(x1 - x0 + 1);
     for (int y = y0; y <= y1; ++y) {
       const std::size_t first = index(x0, y);
-      float* rgb = color.data() + 3 * first;
-      for (std::size_t i = 0; i < n; ++i) {
-        rgb[3 * i] = background.x;
-        rgb[3 * i + 1] = background.y;
-        rgb[3 * i + 2] = background.z;
-      }
       for (int a = 0; a < kAovCount; ++a) {
         PixelBuffer& plane = aov[std::size_t(a)];
         if (plane.empty()) continue;

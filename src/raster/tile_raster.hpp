@@ -7,8 +7,8 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
-// Clears the tile's pixels, then draws every triangle binned to it, in submission order. The context's
-// programs must be this kernel's ShadingPrograms.
+// Draws every triangle binned to the tile, in submission order, over the background; writes every colour pixel of
+// the tile (and clears its AOV pixels first). The context's programs must be this kernel's ShadingPrograms.
 void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters);
 
