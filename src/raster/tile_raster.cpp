@@ -29,24 +29,26 @@ constexpr int lane_dx(int lane) { return (lane / 4) * 2 + (lane % 2); }
 constexpr int lane_dy(int lane) { return (lane % 4) / 2; }
 constexpr std::uint32_t kAllLanes = (1u << kLanes) - 1u;  // kLanes <= 16
 
-// The tile's depth plane: its pixels' window depths, tested and written while the tile is drawn, in cache (a
-// frame-sized plane would cost a fresh frame its first touch and every frame its memory traffic).
-struct TileDepth {
+// A plane of the tile's pixels, Channels floats each, rows `stride` pixels apart, pixel (x0, y0) at data.
+template <int Channels>
+struct TilePlane {
   float* data;
   int x0, y0;
-  std::size_t stride;  // floats per row: the tile's width rounded up to whole batches
-  float* at(int x, int y) const { return data + std::size_t(y - y0) * stride + std::size_t(x - x0); }
+  std::size_t stride;
+  float* at(int x, int y) const {
+    return data + std::size_t(Channels) * (std::size_t(y - y0) * stride + std::size_t(x - x0));
+  }
+  std::size_t row_floats() const { return std::size_t(Channels) * stride; }  // from a pixel to the one below
 };
 
-// Where the tile's colours go while it is drawn: linear rgb, 3 floats per pixel, rows `stride` pixels apart. A
-// thread's own tile colour plane (in cache while the tile draws, then streamed to the frame), or, for tiles too
-// large for that to pay, the frame's colour plane itself.
-struct TileColor {
-  float* data;  // pixel (x0, y0)
-  int x0, y0;
-  std::size_t stride;
-  float* at(int x, int y) const { return data + 3 * (std::size_t(y - y0) * stride + std::size_t(x - x0)); }
-};
+// The tile's depth plane: its pixels' window depths, tested and written while the tile is drawn, in cache (a
+// frame-sized plane would cost a fresh frame its first touch and every frame its memory traffic). Its stride is
+// the tile's width rounded up to whole batches.
+using TileDepth = TilePlane<1>;
+
+// Where the tile's colours go while it is drawn, linear rgb: a thread's own tile colour plane (in cache while the
+// tile draws, then streamed to the frame), or, for tiles too large for that to pay, the frame's colour plane.
+using TileColor = TilePlane<3>;
 
 using Int64 = xsimd::batch<std::int64_t, simd::Arch>;  // half a batch's lanes
 using Double = xsimd::batch<double, simd::Arch>;
@@ -408,7 +410,7 @@ private:
     if (whole) {
       // Lanes outside the triangle read their pixel's depth too: harmless, every test below is masked by inside.
       const float* row = depth_.at(x, y);
-      stored = simd::load_quad_rows(row, row + depth_.stride);
+      stored = simd::load_quad_rows(row, row + depth_.row_floats());
       stored.store_aligned(p.stored_depth);
     } else {
       for (int l = 0; l < kLanes; ++l)
@@ -472,9 +474,9 @@ private:
     if (any_aov_) lane_pixels(p, index);
     if (whole_rows) {  // no test per lane: two rows of pixels, written by row
       float* const depth = depth_.at(p.quad_x[0], p.quad_y[0]);
-      simd::store_quad_rows(z, depth, depth + depth_.stride);
+      simd::store_quad_rows(z, depth, depth + depth_.row_floats());
       float* const row0 = color_.at(p.quad_x[0], p.quad_y[0]);
-      simd::store_quad_rows_rgb(out.color[0], out.color[1], out.color[2], row0, row0 + 3 * color_.stride);
+      simd::store_quad_rows_rgb(out.color[0], out.color[1], out.color[2], row0, row0 + color_.row_floats());
     } else {
       alignas(64) float zs[kLanes], color[3][kLanes];
       for (int c = 0; c < 3; ++c) out.color[c].store_aligned(color[c]);
