@@ -1,7 +1,8 @@
 // The `qdmr` command's image backend: libqdmr_imageio.so, loaded on the first image read or write, so that
 // commands and jobs that touch no image file never load OpenImageIO (see backend.hpp). Looked for at
 // $QDMR_IMAGEIO_MODULE, beside the executable (a build tree), then where `cmake --install` puts it relative to
-// the executable (QDMR_IMAGEIO_RELATIVE_DIR, e.g. ../lib/qdmr).
+// the executable (QDMR_IMAGEIO_RELATIVE_DIR, e.g. ../lib/qdmr); then the same beside the shared object holding
+// this code, when that is not the executable (the Python module qdmr, which keeps a copy beside itself).
 #include <dlfcn.h>
 
 #include <cstdlib>
@@ -22,11 +23,19 @@ const Backend& load() {
   if (const char* forced = std::getenv("QDMR_IMAGEIO_MODULE"); forced && *forced) {
     candidates.emplace_back(forced);
   } else {
+    std::vector<std::filesystem::path> binaries;
     std::error_code ec;
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    if (!ec) {
-      candidates.push_back(exe.parent_path() / kModule);
-      candidates.push_back(exe.parent_path() / QDMR_IMAGEIO_RELATIVE_DIR / kModule);
+    if (!ec) binaries.push_back(exe);
+    // A shared object holding this code (the Python module): dladdr names it (for an executable, argv[0]).
+    Dl_info info{};
+    if (dladdr(reinterpret_cast<const void*>(&load), &info) != 0 && info.dli_fname && *info.dli_fname) {
+      const std::filesystem::path binary = std::filesystem::canonical(info.dli_fname, ec);
+      if (!ec && binary != exe) binaries.push_back(binary);
+    }
+    for (const std::filesystem::path& binary : binaries) {
+      candidates.push_back(binary.parent_path() / kModule);
+      candidates.push_back(binary.parent_path() / QDMR_IMAGEIO_RELATIVE_DIR / kModule);
     }
   }
   std::string tried, last_error = "not found";

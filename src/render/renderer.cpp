@@ -203,6 +203,8 @@ const Frame& Renderer::frame() const { return state_->frame; }
 
 Frame Renderer::take_frame() { return std::move(state_->frame); }
 
+void Renderer::recycle_frame(Frame frame) { state_->frame = std::move(frame); }
+
 Frame render_frame(const SceneDesc& scene, const RenderOptions& options) {
   Renderer renderer(options);
   renderer.set_scene(scene, options.aovs);

@@ -146,10 +146,16 @@ std::string study_label(const StudySpec& spec, const StudyConfig& config) {
 }
 
 StudySpec read_study_spec(const std::filesystem::path& file) {
+  return read_study_spec_json(scene_detail::parse_json_file(file, InputKind::StudySpec), file,
+                              std::filesystem::absolute(file).parent_path());
+}
+
+StudySpec read_study_spec_json(const nlohmann::json& document, const std::filesystem::path& name,
+                               const std::filesystem::path& base_dir) {
   StudySpec spec;
-  spec.file = file;
-  spec.document = scene_detail::parse_json_file(file, InputKind::StudySpec);
-  const scene_detail::Context context{file.string(), std::filesystem::absolute(file).parent_path()};
+  spec.file = name;
+  spec.document = document;
+  const scene_detail::Context context{name.string(), base_dir};
   const Value root(context, spec.document, "");
   const Object object(root, {"scene", "set", "width", "height", "frames", "warmup", "axes", "zip", "rules",
                              "metrics", "baseline", "diff_threshold", "keep", "group_by", "max_configurations",

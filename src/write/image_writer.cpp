@@ -93,22 +93,6 @@ Encoded encode(Container container, std::span<const float> pixels, bool srgb) {
   return encoded;
 }
 
-// Writes pixels (float, `channels` per pixel), atomically.
-void write_pixels(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
-                  bool srgb, const WriteOptions& write) {
-  const Container container = container_of(file);
-  const Encoded encoded = encode(container, pixels, srgb);
-  imageio::WriteSpec spec{width, height, channels, encoded.format, {}, {}, {}};
-  if (encoded.format != imageio::PixelType::Float) spec.strings.emplace_back("oiio:ColorSpace", "sRGB");
-  if (container == Container::Png)
-    spec.ints.emplace_back("png:compressionLevel", write.smallest_png ? kPngSmallestLevel : kPngFastLevel);
-  // TIFF keeps only its own tags: there the bits version is in Software (tag 305) alone.
-  spec.strings.emplace_back("qdmr:bits_version", std::to_string(kBitsVersion));
-  spec.strings.emplace_back("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");
-  if (write.timestamp) spec.strings.emplace_back("DateTime", local_time_now());
-  write_image_file(file, spec, encoded.data(), "image");
-}
-
 struct AovPixels {
   int channels = 0;
   std::vector<float> values;
@@ -150,8 +134,23 @@ AovPixels aov_pixels(const Frame& frame, Aov aov, Container container, const std
 
 }  // namespace
 
+void write_image(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
+                 bool srgb, const WriteOptions& write) {
+  const Container container = container_of(file);
+  const Encoded encoded = encode(container, pixels, srgb);
+  imageio::WriteSpec spec{width, height, channels, encoded.format, {}, {}, {}};
+  if (encoded.format != imageio::PixelType::Float) spec.strings.emplace_back("oiio:ColorSpace", "sRGB");
+  if (container == Container::Png)
+    spec.ints.emplace_back("png:compressionLevel", write.smallest_png ? kPngSmallestLevel : kPngFastLevel);
+  // TIFF keeps only its own tags: there the bits version is in Software (tag 305) alone.
+  spec.strings.emplace_back("qdmr:bits_version", std::to_string(kBitsVersion));
+  spec.strings.emplace_back("Software", std::string("qdmr ") + version() + " (bits version " + std::to_string(kBitsVersion) + ")");
+  if (write.timestamp) spec.strings.emplace_back("DateTime", local_time_now());
+  write_image_file(file, spec, encoded.data(), "image");
+}
+
 void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write) {
-  write_pixels(file, frame.width, frame.height, 3, frame.color, true, write);
+  write_image(file, frame.width, frame.height, 3, frame.color, true, write);
 }
 
 void write_stats(const RenderStats& stats, const std::filesystem::path& file) { write_json(stats.to_json(), file); }
@@ -162,7 +161,7 @@ void write_json(const nlohmann::json& document, const std::filesystem::path& fil
 
 void write_aov(const Frame& frame, Aov aov, const std::filesystem::path& file, const WriteOptions& write) {
   const AovPixels pixels = aov_pixels(frame, aov, container_of(file), file);
-  write_pixels(file, frame.width, frame.height, pixels.channels, pixels.values, false, write);
+  write_image(file, frame.width, frame.height, pixels.channels, pixels.values, false, write);
 }
 
 Image stored_pixels(const Frame& frame, std::optional<Aov> aov, const std::filesystem::path& file) {

@@ -72,3 +72,18 @@ if(NOT magic STREQUAL "762f3101")
   message(FATAL_ERROR "${command_image}: expected an OpenEXR file from the installed qdmr, its first bytes are ${magic}")
 endif()
 message(STATUS "installed qdmr command writes images through its module: ${command_image}")
+
+# The Python package (when the build has it): installed where Debian's python3 imports packages from this prefix
+# (PREFIX/lib/python3.X/dist-packages, on sys.path for /usr/local), standing alone: an EXR written through the image
+# module it keeps beside itself.
+if(DEFINED PYTHON_SITE AND PYTHON)
+  set(site "${prefix}/${PYTHON_SITE}")
+  if(NOT EXISTS "${site}/qdmr/__init__.py" OR NOT EXISTS "${site}/qdmr/libqdmr_imageio.so")
+    message(FATAL_ERROR "the Python package qdmr is not installed in ${site}")
+  endif()
+  set(python_image "${WORK_DIR}/python.exr")
+  run("${CMAKE_COMMAND}" -E env "PYTHONPATH=${site}" "${PYTHON}" -c
+    "import numpy, qdmr, sys; assert qdmr.__file__.startswith(sys.argv[1]), qdmr.__file__; qdmr.write_image(numpy.ones((4, 6, 3), numpy.float32), sys.argv[2]); assert qdmr.read_image(sys.argv[2]).shape == (4, 6, 3)"
+    "${site}" "${python_image}")
+  message(STATUS "installed Python package qdmr works: ${python_image}")
+endif()

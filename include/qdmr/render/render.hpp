@@ -76,6 +76,9 @@ public:
   const Frame& draw();
   const Frame& frame() const;
   Frame take_frame();  // moves the last frame out (the next draw allocates again)
+  // Hands back a frame that take_frame() returned and nobody needs any more: the next draw draws into its
+  // buffers instead of allocating new ones (the last frame, if not taken, is dropped).
+  void recycle_frame(Frame frame);
 
   Isa isa() const;
   int threads() const;

@@ -69,6 +69,9 @@ std::string study_label(const StudySpec& spec, const StudyConfig& config);
 
 // Throws qdmr::Error("SPEC: /pointer", what) for any mistake, before anything renders.
 StudySpec read_study_spec(const std::filesystem::path& file);
+// The same from an in-memory document: relative paths resolve against base_dir, messages name `name`.
+StudySpec read_study_spec_json(const nlohmann::json& document, const std::filesystem::path& name,
+                               const std::filesystem::path& base_dir);
 
 // Every configuration: the product of the axes (zipped axes as one), with the rules applied. Throws
 // qdmr::Error when there are none, or more than max_configurations without `force`.

@@ -3,6 +3,7 @@
 // folder and a rename, so a failed or killed write leaves the previous file (or none), never a torn one.
 #include <filesystem>
 #include <optional>
+#include <span>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -27,6 +28,11 @@ struct WriteOptions {
 // "qdmr:bits_version" and Software = "qdmr <version> (bits version N)" (qdmr/core/version.hpp; TIFF keeps
 // only the latter). Throws qdmr::Error.
 void write_frame(const Frame& frame, const std::filesystem::path& file, const WriteOptions& write = {});
+// Writes any image of `channels` floats per pixel, rows from the top, as write_frame writes the colour: PNG
+// 8-bit and TIFF 16-bit codes, sRGB-encoded when `srgb`, else linear and clamped to [0, 1]; EXR the floats as
+// they are. write_frame is this with 3 channels and srgb. Throws qdmr::Error.
+void write_image(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
+                 bool srgb, const WriteOptions& write = {});
 // Writes the stats as JSON.
 void write_stats(const RenderStats& stats, const std::filesystem::path& file);
 // Writes any JSON document (indented by 2), e.g. `qdmr bench --json`.

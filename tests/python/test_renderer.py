@@ -1,0 +1,134 @@
+# The Renderer from Python: pixels equal to the command's EXR, arrays that outlive draws and renderers, the GIL
+# released while drawing, plan and stats as the command prints them.
+import gc
+import json
+import os
+import threading
+import time
+
+import numpy
+import pytest
+
+import qdmr
+from conftest import PLANE, SMALL, run_cli
+
+QDM = {"/materials/bricks/technique/name": "qdm", "/materials/bricks/technique/depth_scale": 0.1}
+
+
+def bits(array):
+    """The float32 values as their bit patterns: equality of these is equality bit for bit (NaN included)."""
+    return numpy.ascontiguousarray(array, dtype=numpy.float32).view(numpy.uint32)
+
+
+def test_pixels_equal_the_commands_exr_bit_for_bit(cli, tmp_path):
+    color, depth, errors = tmp_path / "c.exr", tmp_path / "d.exr", tmp_path / "e.exr"
+    sets = [a for p, v in QDM.items() for a in ("--set", f"{p}={v}")]
+    run_cli(cli, "render", PLANE, "-o", str(color), "--width", "96", "--height", "54", "--threads", "2",
+            "--aov", f"depth={depth}", "--aov", f"error_texels={errors}", *sets)
+    scene = qdmr.load_scene(PLANE, {**SMALL, **QDM})
+    renderer = qdmr.Renderer(threads=1, tile=16)  # another thread count and tile size: the same bits
+    renderer.set_scene(scene, aovs=["depth", "error_texels"])
+    frame = renderer.draw()
+    assert frame.color.shape == (54, 96, 3) and frame.color.dtype == numpy.float32
+    assert frame["depth"].shape == (54, 96)
+    assert numpy.array_equal(bits(frame.color), bits(qdmr.read_image(color)))
+    assert numpy.array_equal(bits(frame["depth"]), bits(qdmr.read_image(depth)))
+    assert numpy.array_equal(bits(frame.aovs["error_texels"]), bits(qdmr.read_image(errors)))
+    # qdmr's own writer: the same bytes as the command's file.
+    qdmr.write_image(frame.color, tmp_path / "again.exr")
+    assert (tmp_path / "again.exr").read_bytes() == color.read_bytes()
+    assert not [p for p in os.listdir(tmp_path) if ".tmp" in p]  # no temporary left behind
+
+
+def test_plan_is_what_qdmr_plan_prints(cli):
+    scene = qdmr.load_scene(PLANE, ["/output/width=96", "/output/height=54"])  # --set text works too
+    renderer = qdmr.Renderer(threads=1)
+    renderer.set_scene(scene, aovs=["depth"])
+    printed = json.loads(run_cli(cli, "plan", PLANE, "--json", "--set", "/output/width=96", "--set",
+                                 "/output/height=54", "--aov", "depth"))
+    assert renderer.plan == printed
+    assert qdmr.plan(scene, aovs=["depth"]) == printed
+
+
+def test_stats_and_preparation_kept_across_scenes():
+    renderer = qdmr.Renderer(threads=1)
+    assert renderer.stats is None
+    renderer.set_scene(qdmr.load_scene(PLANE, SMALL))
+    first = renderer.draw().stats
+    assert first["prepare"]["items_built"] > 0 and renderer.stats == first
+    renderer.set_scene(qdmr.load_scene(PLANE, {**SMALL, "/camera/fov_deg": 30}))  # a new camera builds nothing
+    second = renderer.draw().stats
+    assert second["prepare"] == {"items_built": 0, "items_reused": first["prepare"]["items_built"]}
+
+
+def test_arrays_outlive_the_next_draw_and_the_renderer():
+    renderer = qdmr.Renderer(threads=2)
+    renderer.set_scene(qdmr.load_scene(PLANE, SMALL), aovs=["depth"])
+    frame = renderer.draw()
+    color, depth = frame.color, frame["depth"]
+    kept_color, kept_depth = color.copy(), depth.copy()
+    del frame
+    for fov in (30, 60, 40):  # other pixels drawn meanwhile, into recycled frames
+        renderer.set_scene(qdmr.load_scene(PLANE, {**SMALL, "/camera/fov_deg": fov}), aovs=["depth"])
+        other = renderer.draw().color
+        assert not numpy.array_equal(other, kept_color)
+    assert numpy.array_equal(bits(color), bits(kept_color))
+    last = renderer.draw()
+    del renderer
+    gc.collect()
+    assert numpy.array_equal(bits(color), bits(kept_color)) and numpy.array_equal(bits(depth), bits(kept_depth))
+    assert last.color.sum() > 0 and last.width == 96
+    assert not color.flags.writeable  # a view of the frame: read-only, so every array of it says the same
+
+
+def test_read_image_owns_its_pixels(tmp_path):
+    image = numpy.random.default_rng(7).random((5, 7, 4), dtype=numpy.float32)
+    qdmr.write_image(image, tmp_path / "x.exr")
+    back = qdmr.read_image(tmp_path / "x.exr")
+    assert numpy.array_equal(bits(back), bits(image))  # row 0 at the top both ways
+    qdmr.write_image(image[:, :, 0], tmp_path / "g.exr")
+    gray = qdmr.read_image(tmp_path / "g.exr")
+    assert gray.shape == (5, 7) and numpy.array_equal(gray, image[:, :, 0])
+    # PNG: 8-bit sRGB codes of a colour image, read back normalised.
+    qdmr.write_image(image[:, :, :3], tmp_path / "x.png")
+    png = qdmr.read_image(tmp_path / "x.png")
+    assert png.shape == (5, 7, 3) and numpy.array_equal(png * 255, numpy.round(png * 255))
+
+
+def test_two_threads_render_at_once():
+    # While one thread is inside draw() the other runs Python: the GIL is released. A held GIL would let the
+    # other thread run only before the draw starts (one switch interval, 5 ms), not across the draw.
+    scene = qdmr.load_scene(PLANE, {"/output/width": 1280, "/output/height": 720, **QDM})
+    a, b = qdmr.Renderer(threads=1), qdmr.Renderer(threads=1)
+    a.set_scene(scene)
+    b.set_scene(scene)
+    expected = bits(a.draw().color).copy()
+    intervals, ticks, results = {}, [], {}
+    stop = threading.Event()
+
+    def draw(name, renderer):
+        start = time.perf_counter()
+        results[name] = bits(renderer.draw().color)
+        intervals[name] = (start, time.perf_counter())
+
+    def spin():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+
+    spinner = threading.Thread(target=spin)
+    spinner.start()
+    threads = [threading.Thread(target=draw, args=(n, r)) for n, r in (("a", a), ("b", b))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    stop.set()
+    spinner.join()
+    for name in "ab":
+        start, end = intervals[name]
+        inside = [t for t in ticks if start < t < end]
+        # Ticks across at least half of each draw (draws take about 100 ms here).
+        assert inside and inside[-1] - inside[0] > 0.5 * (end - start), (name, end - start)
+        assert numpy.array_equal(results[name], expected)
+    (a_start, a_end), (b_start, b_end) = intervals["a"], intervals["b"]
+    assert max(a_start, b_start) < min(a_end, b_end)  # the two draws overlapped
