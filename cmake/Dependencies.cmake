@@ -7,6 +7,7 @@ find_package(xsimd CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(nlohmann_json CONFIG REQUIRED)
 find_package(tinyobjloader CONFIG REQUIRED)  # reports "2rc10": no version argument
+find_package(TinyGLTF 2.7 CONFIG REQUIRED)  # glTF 2.0 (mesh/gltf.cpp); its images go through qdmr's readers
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)  # SHA-1 (core/sha1.hpp); FindOpenSSL, Debian ships no config
 find_package(PNG REQUIRED)  # io/png_writer.hpp: PNG output without the image module; FindPNG
 find_package(JPEG REQUIRED)  # imageio/native_reader.hpp: JPEG textures without the image module; FindJPEG

@@ -70,6 +70,8 @@ const char* input_kind_name(InputKind kind) {
     case InputKind::Cache: return "cache file";
     case InputKind::Manifest: return "check manifest";
     case InputKind::StudySpec: return "study spec";
+    case InputKind::Gltf: return "glTF file";
+    case InputKind::GltfBuffer: return "glTF buffer";
   }
   return "file";
 }
@@ -83,6 +85,8 @@ std::uint64_t input_size_limit(InputKind kind) {
     case InputKind::Cache: return limits::kMaxImageFileBytes;
     case InputKind::Manifest: return limits::kMaxManifestFileBytes;
     case InputKind::StudySpec: return limits::kMaxSceneFileBytes;
+    case InputKind::Gltf: return limits::kMaxGltfFileBytes;
+    case InputKind::GltfBuffer: return limits::kMaxGltfFileBytes;
   }
   return 0;
 }

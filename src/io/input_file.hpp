@@ -12,7 +12,7 @@
 
 namespace qdmr {
 
-enum class InputKind { Scene, Obj, Mtl, Image, Cache, Manifest, StudySpec };
+enum class InputKind { Scene, Obj, Mtl, Image, Cache, Manifest, StudySpec, Gltf, GltfBuffer };
 
 const char* input_kind_name(InputKind kind);    // "scene file", "OBJ file", ...
 std::uint64_t input_size_limit(InputKind kind);  // bytes, see qdmr/core/limits.hpp

@@ -1,6 +1,10 @@
 #include "qdmr/load/load.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -14,22 +18,25 @@
 namespace qdmr {
 namespace {
 
-// OBJ objects: the mesh is read now, and an object without its own material takes the MTL materials, added
-// to the scene's as "<object>/<mtl name>" (made unique with a suffix when two objects share a name), each with
-// the entry of the object's `mtl` block named after it applied (`document`: the scene after --set).
-void resolve_obj_meshes(SceneDesc& scene, const nlohmann::json& document, const scene_detail::Context& context) {
+// OBJ and glTF objects: the mesh is read now, and an object without its own material takes the file's materials,
+// added to the scene's as "<object>/<name>" (made unique with a suffix when two objects share a name), each with
+// the entry of the object's `mtl` (OBJ) or `materials` (glTF) block named after it applied (`document`: the scene
+// after --set). `standalone`: the scene was made for a glTF file rendered on its own, whose messages name it.
+void resolve_file_meshes(SceneDesc& scene, const nlohmann::json& document, const scene_detail::Context& context,
+                         bool standalone = false) {
   const std::string file = scene.file.string();
   const scene_detail::Value objects(context, document.at("objects"), "/objects");
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     ObjectDesc& object = scene.objects[i];
-    if (object.mesh.kind != MeshKind::Obj) continue;
-    const std::string where = file + ": /objects/" + std::to_string(i) + "/mesh";
+    if (object.mesh.kind != MeshKind::Obj && object.mesh.kind != MeshKind::Gltf) continue;
+    const bool gltf = object.mesh.kind == MeshKind::Gltf;
+    const std::string where = standalone ? std::string() : file + ": /objects/" + std::to_string(i) + "/mesh";
     auto mesh = std::make_shared<MeshData>(build_mesh(object.mesh, where));
     if (object.material.empty()) {
       if (mesh->materials.empty())
         throw Error(file + ": /objects/" + std::to_string(i) + "/material", "required (the mesh has no MTL materials)");
       std::vector<MaterialDesc> materials = mesh->materials;
-      if (const auto overrides = objects.element(i).member("mtl")) {
+      if (const auto overrides = objects.element(i).member(gltf ? "materials" : "mtl")) {
         std::vector<std::string> names;
         for (const MaterialDesc& m : materials) names.push_back(m.name);
         for (const auto& item : overrides->json().items()) {
@@ -37,10 +44,14 @@ void resolve_obj_meshes(SceneDesc& scene, const nlohmann::json& document, const 
           const scene_detail::Value entry = *overrides->member(item.key());
           const auto at = std::find(names.begin(), names.end(), item.key());
           if (at == names.end())
-            entry.fail("unknown MTL material '" + scene_detail::shorten(item.key()) + "'" +
+            entry.fail(std::string(gltf ? "unknown glTF material '" : "unknown MTL material '") +
+                       scene_detail::shorten(item.key()) + "'" +
                        scene_detail::suggestion(item.key(), names, "the mesh's materials are"));
           const auto k = std::size_t(at - names.begin());
-          scene_detail::read_mtl_override(entry, materials[k], mesh->bump_maps[k]);
+          if (gltf)
+            scene_detail::read_gltf_override(entry, materials[k]);
+          else
+            scene_detail::read_mtl_override(entry, materials[k], mesh->bump_maps[k]);
         }
       }
       for (MaterialDesc& material : materials) {
@@ -54,9 +65,53 @@ void resolve_obj_meshes(SceneDesc& scene, const nlohmann::json& document, const 
   }
 }
 
+// A camera that frames the mesh: the default camera's direction (from -Y, above), the bounding sphere filling the
+// vertical field of view.
+CameraDesc framing_camera(const MeshData& mesh) {
+  glm::dvec3 lo(mesh.positions.front()), hi(mesh.positions.front());
+  for (const glm::vec3& p : mesh.positions) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  const double radius = std::max(0.5 * glm::length(hi - lo), 1e-3);
+  CameraDesc camera;
+  const double half_fov = 0.5 * double(camera.fov_y_deg) * 3.14159265358979323846 / 180.0;
+  const double distance = 1.1 * radius / std::sin(half_fov);
+  const glm::dvec3 from = glm::normalize(glm::dvec3(camera.position) - glm::dvec3(camera.target));
+  camera.position = glm::vec3(centre + distance * from);
+  camera.target = glm::vec3(centre);
+  camera.near = float(std::max(distance - 2.0 * radius, distance * 1e-3));
+  camera.far = float(distance + 2.0 * radius);
+  return camera;
+}
+
+bool is_gltf_file(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".gltf" || ext == ".glb";
+}
+
+// A glTF asset rendered without a scene file: one object drawing its default scene, the default lights, and the
+// asset's first camera or one framing it (unless --set gives a camera). Overrides reach /objects/0/materials.
+SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+  nlohmann::json document = {
+      {"objects", {{{"name", file.stem().string()}, {"mesh", {{"type", "gltf"}, {"file", file.filename().string()}}}}}}};
+  const scene_detail::Context context{file.string(), file.parent_path()};
+  if (!overrides.empty()) scene_detail::apply_overrides(document, overrides, context.file);
+  SceneDesc scene = scene_detail::validate_scene(document, context);
+  resolve_file_meshes(scene, document, context, true);
+  if (!document.contains("camera") && !scene.objects.empty() && scene.objects[0].obj_mesh) {
+    const MeshData& mesh = *scene.objects[0].obj_mesh;
+    scene.camera = mesh.cameras.empty() ? framing_camera(mesh) : mesh.cameras.front();
+  }
+  return scene;
+}
+
 }  // namespace
 
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+  if (is_gltf_file(file)) return load_gltf_asset(file, overrides);
   const nlohmann::json document = scene_detail::parse_json_file(file, InputKind::Scene);
   return load_scene_json(document, file, file.parent_path(), overrides);
 }
@@ -66,13 +121,13 @@ SceneDesc load_scene_json(const nlohmann::json& document, const std::filesystem:
   const scene_detail::Context context{name.string(), base_dir};
   if (overrides.empty()) {
     SceneDesc scene = scene_detail::validate_scene(document, context);
-    resolve_obj_meshes(scene, document, context);
+    resolve_file_meshes(scene, document, context);
     return scene;
   }
   nlohmann::json overridden = document;
   scene_detail::apply_overrides(overridden, overrides, context.file);
   SceneDesc scene = scene_detail::validate_scene(overridden, context);
-  resolve_obj_meshes(scene, overridden, context);
+  resolve_file_meshes(scene, overridden, context);
   return scene;
 }
 

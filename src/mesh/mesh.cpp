@@ -75,6 +75,8 @@ MeshData build_mesh(const MeshDesc& desc, const std::string& where) {
       return mesh_detail::make_grid(desc, where);
     case MeshKind::Obj:
       return mesh_detail::load_obj(desc, where + "/file");
+    case MeshKind::Gltf:
+      return mesh_detail::load_gltf(desc, where.empty() ? where : where + "/file");
   }
   throw Error(where, "unknown mesh kind");
 }

@@ -203,9 +203,11 @@ MeshPlan plan_mesh(const ObjectDesc& object, const std::string& mesh_key) {
       m.triangles = 2ull * std::uint64_t(d.resolution) * std::uint64_t(d.resolution);
       break;
     case MeshKind::Obj:
-      m.kind = "obj " + d.file.filename().string();
+    case MeshKind::Gltf:
+      m.kind = (d.kind == MeshKind::Obj ? "obj " : "gltf ") + d.file.filename().string();
       m.vertices = object.obj_mesh ? object.obj_mesh->vertex_count() : 0;
       m.triangles = object.obj_mesh ? object.obj_mesh->triangle_count() : 0;
+      if (object.obj_mesh) m.notes = object.obj_mesh->notes;
       break;
   }
   // position, normal, tangent, uv per vertex; three indices and a material id per triangle
@@ -232,6 +234,10 @@ std::string mesh_key(const ObjectDesc& object) {
   k("kind").v(int(d.kind));
   switch (d.kind) {
     case MeshKind::Obj: k("file").v(d.file.string())("uv_scale").v(d.uv_scale); break;
+    case MeshKind::Gltf:
+      k("file").v(d.file.string())("scene").v(d.gltf_scene.index).v(d.gltf_scene.name)("node").v(d.gltf_node.index)
+          .v(d.gltf_node.name);
+      break;
     case MeshKind::Grid:
       k("size").v(d.size)("uv_scale").v(d.uv_scale)("resolution").v(d.resolution)("height").v(d.height)("map")
           .v(source_key(d.height_map));
@@ -289,16 +295,17 @@ class Planner {
 public:
   Planner(const SceneDesc& scene, FramePlan& plan) : scene_(scene), plan_(plan), file_(scene.file.string()) {}
 
-  // `where` names the field that uses the material; MTL materials are named after it, scene materials by
-  // their own JSON pointer.
-  std::uint32_t material(const std::string& name, const std::string& where, bool from_mtl) {
+  // `where` names the field that uses the material; a file's materials (`file_kind` "MTL" or "glTF") are named
+  // after it, scene materials (`file_kind` null) by their own JSON pointer.
+  std::uint32_t material(const std::string& name, const std::string& where, const char* file_kind) {
     for (std::size_t i = 0; i < plan_.materials.size(); ++i)
       if (plan_.materials[i].name == name) return std::uint32_t(i);
     const MaterialDesc* desc = scene_.find_material(name);
     if (!desc) throw Error(where, "unknown material '" + name + "'");
     choices_.emplace_back();
     plan_.materials.push_back(plan_material(
-        *desc, from_mtl ? where + ": MTL material '" + name + "'" : file_ + ": /materials/" + name, choices_.back()));
+        *desc, file_kind ? where + ": " + file_kind + " material '" + name + "'" : file_ + ": /materials/" + name,
+        choices_.back()));
     return std::uint32_t(plan_.materials.size() - 1);
   }
 
@@ -593,12 +600,13 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
     MeshPlan mesh = plan_mesh(object, mesh_key(object));
     if (!object.material.empty()) {
       // An explicit material overrides the MTL: every triangle of the object uses it.
-      mesh.material = planner.material(object.material, where + "/material", false);
+      mesh.material = planner.material(object.material, where + "/material", nullptr);
       plan.materials[mesh.material].objects.push_back(i);
       if (object.obj_mesh) mesh.mtl_materials.assign(object.obj_mesh->materials.size(), mesh.material);
     } else {
       for (const std::string& name : object.mtl_materials) {
-        mesh.mtl_materials.push_back(planner.material(name, object.mesh.file.string() + " (" + where + "/mesh/file)", true));
+        mesh.mtl_materials.push_back(planner.material(name, object.mesh.file.string() + " (" + where + "/mesh/file)",
+                                                      object.mesh.kind == MeshKind::Gltf ? "glTF" : "MTL"));
         plan.materials[mesh.mtl_materials.back()].objects.push_back(i);
       }
       if (mesh.mtl_materials.empty()) throw Error(where + "/material", "required (the mesh has no MTL materials)");
@@ -699,10 +707,11 @@ std::string FramePlan::describe() const {
       << mib(m.bytes);
     if (m.vertex_weights >= 0) s << ", per-vertex weights of " << materials[std::size_t(m.vertex_weights)].name;
     if (!m.mtl_materials.empty() && (m.mtl_materials.size() > 1 || m.mtl_materials[0] != m.material)) {
-      s << ", MTL materials:";
+      s << (m.kind.starts_with("gltf") ? ", glTF materials:" : ", MTL materials:");
       for (std::uint32_t mat : m.mtl_materials) s << " " << materials[mat].name;
     }
     s << "\n";
+    for (const std::string& note : m.notes) s << "    warning: " << note << "\n";
   }
   s << "aovs:";
   if (aovs.empty()) s << " none";
@@ -758,7 +767,7 @@ nlohmann::json FramePlan::to_json() const {
     for (std::uint32_t mat : m.mtl_materials) mtl.push_back(materials[mat].name);
     j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
                            {"bytes", m.bytes}, {"material", materials.empty() ? "" : materials[m.material].name},
-                           {"mtl_materials", mtl}});
+                           {"mtl_materials", mtl}, {"warnings", m.notes}});
   }
   j["items"] = items();
   j["aovs"] = nlohmann::json::array();

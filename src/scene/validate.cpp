@@ -531,13 +531,14 @@ std::vector<MaterialDesc> read_materials(const Value& value) {
 MeshDesc read_mesh(const Value& value) {
   value.expect_type(json::value_t::object, "an object");
   const auto type = value.member("type");
-  if (!type) value.fail("missing key 'type' (plane, box, sphere, grid or obj)");
+  if (!type) value.fail("missing key 'type' (plane, box, sphere, grid, obj or gltf)");
   MeshDesc mesh;
   mesh.kind = type->choice<MeshKind>({{"plane", MeshKind::Plane},
                                       {"box", MeshKind::Box},
                                       {"sphere", MeshKind::Sphere},
                                       {"grid", MeshKind::Grid},
-                                      {"obj", MeshKind::Obj}});
+                                      {"obj", MeshKind::Obj},
+                                      {"gltf", MeshKind::Gltf}});
   const Object object = [&] {
     switch (mesh.kind) {
       case MeshKind::Plane:
@@ -550,11 +551,28 @@ MeshDesc read_mesh(const Value& value) {
         return Object(value, {"type", "size", "resolution", "height_map", "height", "uv_scale"});
       case MeshKind::Obj:
         break;
+      case MeshKind::Gltf:
+        return Object(value, {"type", "file", "scene", "node"});
     }
     return Object(value, {"type", "file"});
   }();
-  if (mesh.kind == MeshKind::Obj) {
+  if (mesh.kind == MeshKind::Obj || mesh.kind == MeshKind::Gltf) {
     mesh.file = object.required("file").existing_file();
+    const auto pick = [](const Value& v) {
+      GltfPick p;
+      if (v.json().is_number_integer() || v.json().is_number_unsigned()) {
+        p.index = static_cast<int>(v.integer(0, 1 << 30));
+      } else {
+        p.name = v.string();
+        v.require(!p.name.empty(), "a name must not be empty (or give an index)");
+      }
+      return p;
+    };
+    if (auto v = object.find("scene")) mesh.gltf_scene = pick(*v);
+    if (auto v = object.find("node")) {
+      mesh.gltf_node = pick(*v);
+      v->require(!mesh.gltf_scene.given(), "give 'scene' or 'node', not both");
+    }
     return mesh;
   }
   if (auto v = object.find("size")) {
@@ -585,7 +603,7 @@ TransformDesc read_transform(const Value& value) {
 }
 
 ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<MaterialDesc>& materials) {
-  const Object object(value, {"name", "mesh", "material", "transform", "mtl"});
+  const Object object(value, {"name", "mesh", "material", "transform", "mtl", "materials"});
   ObjectDesc result;
   result.name = "object " + std::to_string(index);
   if (auto v = object.find("name")) {
@@ -604,8 +622,8 @@ ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<
           (names.empty() ? "; no materials are defined" : suggestion(result.material, names, "defined materials are")));
     }
   } else {
-    value.require(result.mesh.kind == MeshKind::Obj,
-                  "missing key 'material' (only obj meshes may leave it out to use their own MTL materials)");
+    value.require(result.mesh.kind == MeshKind::Obj || result.mesh.kind == MeshKind::Gltf,
+                  "missing key 'material' (only obj and gltf meshes may leave it out to use their own materials)");
   }
   if (auto v = object.find("transform")) result.transform = read_transform(*v);
   if (auto v = object.find("mtl")) {
@@ -614,10 +632,51 @@ ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<
                "only an obj mesh without 'material' has MTL materials to override");
     v->expect_type(json::value_t::object, "an object mapping MTL material names to overrides");
   }
+  if (auto v = object.find("materials")) {
+    // Checked by read_gltf_override once the asset is read and its material names are known.
+    v->require(result.mesh.kind == MeshKind::Gltf && result.material.empty(),
+               "only a gltf mesh without 'material' has glTF materials to override");
+    v->expect_type(json::value_t::object, "an object mapping glTF material names to overrides");
+  }
   return result;
 }
 
 }  // namespace
+
+namespace {
+
+// The keys an override of an MTL or a glTF material shares, applied after the kind's own keys; `no_height` is
+// the message when a displacement technique is asked of a material without a height.
+void read_material_override(const Object& object, MaterialDesc& material, const std::string& no_height) {
+  LayerDesc& layer = material.layers.front();
+  if (auto v = object.find("normal_convention"))
+    layer.normal_convention = v->choice<NormalConvention>({{"gl", NormalConvention::GL}, {"dx", NormalConvention::DX}});
+  if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
+  if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
+  if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
+  if (auto v = object.find("technique")) read_technique(*v, material.technique);
+  if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);
+  if (auto v = object.find("lighting")) read_lighting(*v, material.lighting);
+  if (auto v = object.find("shadow")) material.shadow = read_shadow(*v);
+  if (auto v = object.find("ao")) material.ao = read_ao(*v);
+  if (material.technique.kind != TechniqueKind::Normal && layer.height.source == TextureSource::None)
+    member_or_self(object, "technique").fail(no_height);
+  check_visibility_needs_displacement(object, material);
+}
+
+}  // namespace
+
+void read_gltf_override(const Value& value, MaterialDesc& material) {
+  const Object object(value, {"technique", "sampling", "lighting", "shadow", "ao", "height", "normal_strength",
+                              "normal_convention", "height_scale", "height_offset"});
+  LayerDesc& layer = material.layers.front();
+  if (auto v = object.find("height")) {
+    layer.height = read_texture(*v, Slot::Height);
+    if (layer.normal.source == TextureSource::None) layer.normal.source = TextureSource::FromHeight;  // a normalTexture wins
+  }
+  read_material_override(object, material,
+                         "a displacement technique needs a height: give this glTF material one with 'height'");
+}
 
 void read_mtl_override(const Value& value, MaterialDesc& material, const std::filesystem::path& bump) {
   const Object object(value, {"technique", "sampling", "lighting", "shadow", "ao", "bump", "normal_strength",
@@ -634,21 +693,9 @@ void read_mtl_override(const Value& value, MaterialDesc& material, const std::fi
       }
     }
   }
-  if (auto v = object.find("normal_convention"))
-    layer.normal_convention = v->choice<NormalConvention>({{"gl", NormalConvention::GL}, {"dx", NormalConvention::DX}});
-  if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
-  if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
-  if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
-  if (auto v = object.find("technique")) read_technique(*v, material.technique);
-  if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);
-  if (auto v = object.find("lighting")) read_lighting(*v, material.lighting);
-  if (auto v = object.find("shadow")) material.shadow = read_shadow(*v);
-  if (auto v = object.find("ao")) material.ao = read_ao(*v);
-  if (material.technique.kind != TechniqueKind::Normal && layer.height.source == TextureSource::None)
-    member_or_self(object, "technique")
-        .fail("a displacement technique needs a height: this MTL material has no disp map, and no bump map read as "
-              "a height");
-  check_visibility_needs_displacement(object, material);
+  read_material_override(object, material,
+                         "a displacement technique needs a height: this MTL material has no disp map, and no bump map "
+                         "read as a height");
 }
 
 SceneDesc validate_scene(const json& document, const Context& context) {

@@ -13,4 +13,9 @@ SceneDesc validate_scene(const nlohmann::json& document, const Context& context)
 // that MTL material (mesh/obj.cpp); `bump` is its bump map file, empty if it has none.
 void read_mtl_override(const Value& value, MaterialDesc& material, const std::filesystem::path& bump);
 
+// One entry of a glTF object's `materials` block (value: /objects/N/materials/NAME) applied over `material`, the
+// mapping of that glTF material (mesh/gltf.cpp): the keys of an MTL override but `bump`, and `height`, a TEX
+// of the height forms (relative to the scene) that displacement techniques march.
+void read_gltf_override(const Value& value, MaterialDesc& material);
+
 }  // namespace qdmr::scene_detail

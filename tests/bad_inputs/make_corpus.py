@@ -434,6 +434,87 @@ shutil.copy(os.path.join(FILES, "images/good.png"), os.path.join(FILES, "obj/tex
 put("obj/textured.mtl", "newmtl a\nmap_Kd textured.png\n")
 put("obj/textured.obj", "mtllib textured.mtl\n" + tri + "vt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n")
 
+# --- glTF 2.0 assets (mesh/gltf.cpp): each a copy of tests/gltf/assets/quad_embedded.gltf (buffer and image as
+# data: URIs, so each file stands alone) or quad.glb with one element broken; rendered on their own ----------------
+GLTF_ASSETS = os.path.join(os.path.dirname(HERE), "gltf", "assets")
+with open(os.path.join(GLTF_ASSETS, "quad_embedded.gltf")) as f:
+    gltf_quad = json.load(f)
+with open(os.path.join(GLTF_ASSETS, "quad.glb"), "rb") as f:
+    glb_quad = f.read()
+put("gltf/secret.bin", b"\0" * 140)
+
+def gltf_case(name, edit, message):
+    doc = json.loads(json.dumps(gltf_quad))
+    edit(doc)
+    put("gltf/%s.gltf" % name, json.dumps(doc, sort_keys=True))
+    case("gltf_" + name, ["render", "{in}/gltf/%s.gltf" % name, "-o", "{out}/image.png"], message)
+
+def prim(d):
+    return d["meshes"][0]["primitives"][0]
+
+def set_(obj, key, value):
+    obj[key] = value
+
+gltf_cases = [
+    ("points", lambda d: set_(prim(d), "mode", 0), "/meshes/0/primitives/0/mode: points cannot be drawn"),
+    ("lines", lambda d: set_(prim(d), "mode", 1), "/meshes/0/primitives/0/mode: lines cannot be drawn"),
+    ("line_strip", lambda d: set_(prim(d), "mode", 3), "lines cannot be drawn"),
+    ("morph_targets", lambda d: set_(prim(d), "targets", [{"POSITION": 0}]), "/meshes/0/primitives/0/targets: morph targets cannot be drawn"),
+    ("skin", lambda d: (set_(d["nodes"][0], "skin", 0), set_(d, "skins", [{"joints": [0], "inverseBindMatrices": 0}])),
+     "/nodes/0/skin: skinned meshes cannot be drawn"),
+    ("required_draco", lambda d: (set_(d, "extensionsRequired", ["KHR_draco_mesh_compression"]), set_(d, "extensionsUsed", ["KHR_draco_mesh_compression"])),
+     "/extensionsRequired/0: the asset requires KHR_draco_mesh_compression, which qdmr does not read"),
+    ("sparse", lambda d: set_(d["accessors"][0], "sparse", {"count": 1, "indices": {"bufferView": 0, "componentType": 5123}, "values": {"bufferView": 0}}),
+     "/accessors/0/sparse: sparse accessors are not supported"),
+    ("accessor_past_view", lambda d: set_(d["accessors"][0], "count", 5), "/accessors/0/count: 5 elements of 12 bytes"),
+    ("accessor_offset_past_view", lambda d: set_(d["accessors"][0], "byteOffset", 40), "/accessors/0/count"),
+    ("huge_count", lambda d: set_(d["accessors"][0], "count", 4294967295), "/accessors/0/count: 4294967295 elements"),
+    ("view_past_buffer", lambda d: set_(d["bufferViews"][0], "byteLength", 4000), "/bufferViews/0: bytes 0 + 4000 run past the end of buffer 0"),
+    ("overlapping_stride", lambda d: set_(d["bufferViews"][0], "byteStride", 8), "/bufferViews/0/byteStride: 8 is less than an element (12 bytes): the elements overlap"),
+    ("count_mismatch", lambda d: set_(d["accessors"][1], "count", 3), "/meshes/0/primitives/0/attributes/TEXCOORD_0: 3 elements, but POSITION has 4"),
+    ("accessor_missing", lambda d: set_(prim(d)["attributes"], "NORMAL", 42), "/meshes/0/primitives/0/attributes/NORMAL: accessor 42 does not exist"),
+    ("index_past_vertices", lambda d: [set_(d["accessors"][k], "count", 2) for k in range(3)], "past the primitive's 2 vertices"),
+    ("node_cycle", lambda d: set_(d, "nodes", [{"mesh": 0}, {"children": [2]}, {"children": [1]}]), "the node graph has a cycle"),
+    ("node_self_child", lambda d: set_(d["nodes"][0], "children", [0]), "the node graph has a cycle"),
+    ("uri_parent", lambda d: set_(d["buffers"][0], "uri", "../gltf/secret.bin"), "/buffers/0/uri: the URI '../gltf/secret.bin' leaves the asset's folder"),
+    ("uri_parent_encoded", lambda d: set_(d["buffers"][0], "uri", "%2E%2E/gltf/secret.bin"), "leaves the asset's folder"),
+    ("uri_absolute", lambda d: set_(d["buffers"][0], "uri", "/etc/passwd"), "/buffers/0/uri: the URI '/etc/passwd' is an absolute path"),
+    ("uri_http", lambda d: set_(d["images"][0], "uri", "http://127.0.0.1:9/a.png"), "/images/0/uri: the URI 'http://127.0.0.1:9/a.png' names a scheme"),
+    ("uri_file_scheme", lambda d: set_(d["images"][0], "uri", "file:///etc/passwd"), "names a scheme"),
+    ("embedded_image_not_png", lambda d: set_(d["images"][0], "uri", "data:image/png;base64,AAAAAAAA"), "/images/0: an embedded image must be PNG or JPEG"),
+    ("no_position", lambda d: prim(d)["attributes"].pop("POSITION"), "/meshes/0/primitives/0/attributes: no POSITION"),
+]
+for name, edit, message in gltf_cases:
+    gltf_case(name, edit, message)
+put("gltf/not_json.gltf", '{"asset": {"version": "2.0"},')
+case("gltf_not_json", ["render", "{in}/gltf/not_json.gltf", "-o", "{out}/image.png"], "parse error")
+put("gltf/deep.gltf", "[" * 100000 + "]" * 100000)
+case("gltf_deep_nesting", ["render", "{in}/gltf/deep.gltf", "-o", "{out}/image.png"], "nesting deeper than 64 levels")
+
+def glb_edit(name, at, value, message):
+    data = bytearray(glb_quad)
+    struct.pack_into("<I", data, at, value)
+    put("gltf/%s.glb" % name, bytes(data))
+    case("gltf_" + name, ["render", "{in}/gltf/%s.glb" % name, "-o", "{out}/image.png"], message)
+
+json_length = struct.unpack_from("<I", glb_quad, 12)[0]
+glb_edit("glb_header_length_lies", 8, len(glb_quad) + 4, ".glb header: length %d but the file has %d bytes" % (len(glb_quad) + 4, len(glb_quad)))
+glb_edit("glb_json_chunk_past_end", 12, 0x7FFFFFF0, ".glb chunk 0: length 2147483632 runs past the end of the file")
+glb_edit("glb_bin_chunk_past_end", 20 + json_length, len(glb_quad), ".glb chunk 1: length %d runs past the end of the file" % len(glb_quad))
+glb_edit("glb_version_1", 4, 1, ".glb header: version 1")
+put("gltf/glb_truncated.glb", glb_quad[:len(glb_quad) // 2])
+case("gltf_glb_truncated", ["render", "{in}/gltf/glb_truncated.glb", "-o", "{out}/image.png"], ".glb header: length")
+# In a scene: an override of a glTF material the asset lacks, a displacement technique without a height, a node
+# the asset lacks.
+shutil.copy(os.path.join(GLTF_ASSETS, "quad.glb"), os.path.join(FILES, "gltf/quad.glb"))
+case("gltf_unknown_material", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"chekcer": {}}}'),
+     "/objects/0/materials/chekcer: unknown glTF material 'chekcer'; did you mean 'checker'?")
+case("gltf_displaced_without_height", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"technique": {"name": "qdm"}}}}'),
+     "a displacement technique needs a height: give this glTF material one with 'height'")
+case("gltf_unknown_node", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb", "node": "qaud"}}'),
+     "the asset has no node named 'qaud'; did you mean 'quad'?")
+case("gltf_plan_points", ["plan", "{in}/gltf/points.gltf"], "points cannot be drawn")
+
 with open(os.path.join(HERE, "cases.json"), "w") as f:
     json.dump({"comment": "Written by make_corpus.py; checked by tests/cli/bad_inputs_corpus_test.cpp.",
                "generated": generated, "cases": cases},

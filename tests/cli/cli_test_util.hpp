@@ -141,4 +141,12 @@ inline std::string first_difference(const FloatImage& a, const FloatImage& b) {
   return s.str();
 }
 
+// Whether a --stats file lists a texture of `purpose` ("albedo", "height", ...) whose `where` contains where_part
+// (e.g. "'quads/displaced'": the material it belongs to).
+inline bool stats_have_texture(const nlohmann::json& stats, const std::string& where_part, const std::string& purpose) {
+  for (const auto& t : stats["textures"])
+    if (t["purpose"] == purpose && t["where"].get<std::string>().find(where_part) != std::string::npos) return true;
+  return false;
+}
+
 }  // namespace qdmr::test

@@ -33,12 +33,6 @@ std::string variant_of(const nlohmann::json& stats, const std::string& material)
   return "(not drawn)";
 }
 
-bool has_texture(const nlohmann::json& stats, const std::string& where_part, const std::string& purpose) {
-  for (const auto& t : stats["textures"])
-    if (t["purpose"] == purpose && t["where"].get<std::string>().find(where_part) != std::string::npos) return true;
-  return false;
-}
-
 TEST(CliObjMtl, DispRendersDisplacedAndEachMapKindGetsItsProgram) {
   TempDir dir;
   write_mtl_assets(dir.path());
@@ -46,12 +40,12 @@ TEST(CliObjMtl, DispRendersDisplacedAndEachMapKindGetsItsProgram) {
   ASSERT_FALSE(stats.is_null());
   EXPECT_GT(stats["iterations"]["max"].get<double>(), 0.0);
   EXPECT_EQ(variant_of(stats, "quads/displaced"), "displacement:pom");
-  EXPECT_TRUE(has_texture(stats, "'quads/displaced'", "height")) << stats["textures"].dump(1);
-  EXPECT_TRUE(has_texture(stats, "'quads/displaced'", "albedo"));
+  EXPECT_TRUE(stats_have_texture(stats, "'quads/displaced'", "height")) << stats["textures"].dump(1);
+  EXPECT_TRUE(stats_have_texture(stats, "'quads/displaced'", "albedo"));
   EXPECT_EQ(variant_of(stats, "quads/bumped"), "normal_mapping");
-  EXPECT_TRUE(has_texture(stats, "'quads/bumped'", "normal"));  // derived from the bump height
+  EXPECT_TRUE(stats_have_texture(stats, "'quads/bumped'", "normal"));  // derived from the bump height
   EXPECT_EQ(variant_of(stats, "quads/normal_mapped"), "normal_mapping");
-  EXPECT_TRUE(has_texture(stats, "'quads/normal_mapped'", "normal"));
+  EXPECT_TRUE(stats_have_texture(stats, "'quads/normal_mapped'", "normal"));
   EXPECT_EQ(variant_of(stats, "quads/plain"), "normal_mapping");
 }
 

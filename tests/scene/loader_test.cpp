@@ -197,9 +197,9 @@ TEST(SceneLoader, KeysDependOnTheMeshType) {
   EXPECT_EQ(load_error(document), "scene.json: /objects/0/mesh: unknown key 'segmnets'; did you mean 'segments'?");
   document["objects"][0]["mesh"] = {{"type", "cube"}};
   EXPECT_EQ(load_error(document),
-            "scene.json: /objects/0/mesh/type: unknown value 'cube'; expected one of: plane, box, sphere, grid, obj");
+            "scene.json: /objects/0/mesh/type: unknown value 'cube'; expected one of: plane, box, sphere, grid, obj, gltf");
   document["objects"][0]["mesh"] = json::object();
-  EXPECT_EQ(load_error(document), "scene.json: /objects/0/mesh: missing key 'type' (plane, box, sphere, grid or obj)");
+  EXPECT_EQ(load_error(document), "scene.json: /objects/0/mesh: missing key 'type' (plane, box, sphere, grid, obj or gltf)");
 }
 
 TEST(SceneLoader, WrongTypesNameTheExpectedType) {
@@ -320,8 +320,8 @@ TEST(SceneLoader, ObjectsReferenceExistingMaterials) {
             "scene.json: /objects/0/material: unknown material 'marble'; no materials are defined");
   document["objects"][0].erase("material");
   EXPECT_EQ(load_error(document),
-            "scene.json: /objects/0: missing key 'material' (only obj meshes may leave it out to use their own MTL "
-            "materials)");
+            "scene.json: /objects/0: missing key 'material' (only obj and gltf meshes may leave it out to use their "
+            "own materials)");
 }
 
 TEST(SceneLoader, HeightNormalDefaultsAndTextureForms) {

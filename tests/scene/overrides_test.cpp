@@ -96,7 +96,7 @@ TEST(SceneOverride, BadPointersAreErrorsNamingThePointer) {
 TEST(SceneOverride, OverriddenValuesAreValidated) {
   EXPECT_EQ(
       load_error(minimal_scene(), {{"/objects/0/mesh/type", "cylinder"}}),
-      "scene.json: /objects/0/mesh/type: unknown value 'cylinder'; expected one of: plane, box, sphere, grid, obj");
+      "scene.json: /objects/0/mesh/type: unknown value 'cylinder'; expected one of: plane, box, sphere, grid, obj, gltf");
   EXPECT_EQ(load_error(minimal_scene(), {{"/objects/0/materal", "rock"}}),
             "scene.json: /objects/0: unknown key 'materal'; did you mean 'material'?");
 }

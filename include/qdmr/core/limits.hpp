@@ -26,6 +26,8 @@ inline constexpr std::uint64_t kMaxTriangles = 1ull << 28;
 inline constexpr std::uint64_t kMaxSceneFileBytes = 16ull << 20;  // JSON scenes are a few KiB
 inline constexpr std::uint64_t kMaxObjFileBytes = 1ull << 30;     // ~30 M triangles of text
 inline constexpr std::uint64_t kMaxMtlFileBytes = 16ull << 20;
+// A .gltf or .glb file, and each external buffer (.bin) it names: tinygltf sizes buffers with 32-bit counts.
+inline constexpr std::uint64_t kMaxGltfFileBytes = 1ull << 30;
 inline constexpr std::uint64_t kMaxManifestFileBytes = 64ull << 20;  // check manifests: thousands of checks
 inline constexpr std::uint64_t kMaxImageFileBytes = 4ull << 30;  // a 16384^2 RGBA float image, uncompressed
 inline constexpr int kMaxJsonDepth = 64;                          // nesting of arrays/objects in scenes and --set

@@ -1,7 +1,7 @@
 #pragma once
 // The load stage: a scene file in, a validated SceneDesc out, with --set overrides applied first. Everything the
-// scene refers to is resolved here: paths made absolute, and OBJ meshes read with their MTL materials, which
-// join the scene's materials (named "<object>/<mtl material>"), so the plan sees every material of the frame.
+// scene refers to is resolved here: paths made absolute, and OBJ and glTF meshes read with their materials, which
+// join the scene's materials (named "<object>/<material>"), so the plan sees every material of the frame.
 #include <filesystem>
 #include <vector>
 
@@ -12,7 +12,8 @@
 
 namespace qdmr {
 
-// Reads, overrides, validates, resolves OBJ meshes. Throws qdmr::Error("FILE: /pointer", "what is wrong [; did
+// Reads, overrides, validates, resolves OBJ and glTF meshes. A .gltf or .glb file is rendered on its own: one
+// object drawing the asset's default scene, the default lights, its first camera or one framing it. Throws qdmr::Error("FILE: /pointer", "what is wrong [; did
 // you mean 'x'?]").
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides = {});
 

@@ -20,9 +20,11 @@ struct MeshData {
   std::vector<glm::vec2> uvs;
   std::vector<glm::vec4> blend_weights;  // per vertex, layers 0..3; filled for blended materials with per-vertex weights
   std::vector<std::uint32_t> indices;             // 3 per triangle, counter-clockwise front faces
-  std::vector<std::uint32_t> triangle_materials;  // obj only: per triangle, an index into `materials`; empty otherwise
-  std::vector<MaterialDesc> materials;            // obj only: materials from the MTL file (named "<mtl name>")
-  std::vector<std::filesystem::path> bump_maps;   // obj only: per entry of `materials`, its bump map (empty if none)
+  std::vector<std::uint32_t> triangle_materials;  // obj, gltf: per triangle, an index into `materials`; empty otherwise
+  std::vector<MaterialDesc> materials;            // obj, gltf: the file's materials (named as the file names them)
+  std::vector<std::filesystem::path> bump_maps;   // obj: per entry of `materials`, its bump map (empty if none)
+  std::vector<CameraDesc> cameras;                // gltf: the drawn nodes' perspective cameras, in qdmr's frame
+  std::vector<std::string> notes;                 // gltf: what was derived or ignored, for the plan's warnings
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return indices.size() / 3; }
@@ -35,7 +37,8 @@ struct MeshData {
 // uv_scale tiles the material without repeating the relief. OBJ: UVs are multiplied by uv_scale; MTL
 // map_Kd -> albedo, disp -> height with technique pom, else bump/map_Bump -> height for normals only,
 // norm -> normal map (else normals from the height), paths made absolute against the MTL file's folder; faces
-// without a material use an appended constant white "default" material.
+// without a material use an appended constant white "default" material. glTF: see mesh/gltf.cpp and
+// docs/scene-format.md ("glTF 2.0 assets").
 MeshData build_mesh(const MeshDesc& desc, const std::string& where);
 
 // Per-vertex tangent frames from positions, normals and UVs (accumulated per triangle, Gram-Schmidt

@@ -112,6 +112,7 @@ struct MeshPlan {
   std::uint32_t material = 0;                // frame material of its triangles (no MTL materials)
   std::vector<std::uint32_t> mtl_materials;  // obj with MTL materials: frame material per mesh-local material
   int vertex_weights = -1;   // per-vertex blend weights of this frame material are stored in the mesh, else -1
+  std::vector<std::string> notes;  // gltf: what was derived or ignored (MeshData::notes), printed as warnings
 };
 
 // The private memory the image library (OpenImageIO and the ~260 libraries it brings) takes once a process has

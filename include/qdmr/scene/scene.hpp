@@ -17,7 +17,7 @@
 
 namespace qdmr {
 
-struct MeshData;  // qdmr/mesh/mesh.hpp: an OBJ mesh, read when the scene is loaded
+struct MeshData;  // qdmr/mesh/mesh.hpp: an OBJ or glTF mesh, read when the scene is loaded
 
 struct OutputDesc {
   int width = 1920;
@@ -254,7 +254,14 @@ struct MaterialDesc {
   BlendDesc blend;          // used when there is more than one layer
 };
 
-enum class MeshKind { Plane, Box, Sphere, Grid, Obj };
+enum class MeshKind { Plane, Box, Sphere, Grid, Obj, Gltf };
+
+// glTF: which scene or node of the asset to draw, by index or by name (neither given: the default scene).
+struct GltfPick {
+  int index = -1;    // >= 0: by index
+  std::string name;  // non-empty: by name
+  bool given() const { return index >= 0 || !name.empty(); }
+};
 
 struct MeshDesc {
   MeshKind kind = MeshKind::Plane;
@@ -264,7 +271,9 @@ struct MeshDesc {
   int resolution = 64;          // grid: quads per side
   TextureDesc height_map;       // grid: optional height map displacing vertices along +z
   float height = 0.0f;          // grid: z extent of the height map (scene units)
-  std::filesystem::path file;   // obj: absolute path
+  std::filesystem::path file;   // obj, gltf: absolute path
+  GltfPick gltf_scene;          // gltf: the scene drawn (default: the asset's default scene, else its first)
+  GltfPick gltf_node;           // gltf: only this node and its children, placed by the node's own transform chain
 };
 
 struct TransformDesc {
@@ -276,10 +285,10 @@ struct TransformDesc {
 struct ObjectDesc {
   std::string name;
   MeshDesc mesh;
-  std::string material;  // a key of SceneDesc::materials; may be empty for obj meshes (their MTL materials are used)
+  std::string material;  // a key of SceneDesc::materials; may be empty for obj and gltf meshes (their own materials)
   TransformDesc transform;
-  // obj, filled by load_scene: the mesh as read, and for an object without `material`, the scene material of each
-  // of the mesh's MTL materials (MeshData::triangle_materials indexes this list).
+  // obj and gltf, filled by load_scene: the mesh as read, and for an object without `material`, the scene material
+  // of each of the mesh's own (MTL or glTF) materials (MeshData::triangle_materials indexes this list).
   std::shared_ptr<const MeshData> obj_mesh;
   std::vector<std::string> mtl_materials;
 };

@@ -1,0 +1,878 @@
+// glTF 2.0 (.gltf and .glb) through tinygltf, behind qdmr's own checks: the container and every URI are checked
+// before tinygltf parses (mesh/gltf_files.hpp), tinygltf reads only files inside the asset's folder through the
+// callbacks here, decodes no image (qdmr's readers do, from the file or from the embedded bytes stored in the
+// cache folder), and every accessor, buffer view and index is checked here before it is read.
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
+
+#include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
+#include "mesh/builders.hpp"
+#include "mesh/gltf_files.hpp"
+#include "qdmr/bake/cone_map.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/core/limits.hpp"
+#include "qdmr/texture/image.hpp"
+#include "scene/reader.hpp"
+#include "core/sha1.hpp"
+
+namespace qdmr::mesh_detail {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The extensions qdmr reads; an asset that requires any other is refused.
+const std::set<std::string> kSupportedExtensions = {"KHR_texture_transform", "KHR_materials_emissive_strength"};
+
+// glTF is +Y up, qdmr +Z up: a quarter turn about X, (x, y, z) -> (x, -z, y), as Blender imports glTF. Its entries
+// are exactly 0 and +-1, so a vertex is moved without rounding.
+const glm::dmat4 kZUp(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);
+
+// What the file callbacks and the image callback share with the loader.
+struct Reading {
+  fs::path folder;                       // the asset's folder, lexically normal and absolute
+  std::string where;                     // for messages
+  std::set<fs::path> image_files;        // external images: checked, never read by tinygltf
+  std::string error;                     // the first qdmr error raised inside a callback
+  const tinygltf::Model* model = nullptr;
+  std::vector<std::string> embedded;     // per image: its bytes when stored in the asset (data: URI or buffer view)
+};
+
+bool inside(const Reading& r, const fs::path& file) {
+  const fs::path normal = file.lexically_normal();
+  const auto [a, b] = std::mismatch(r.folder.begin(), r.folder.end(), normal.begin(), normal.end());
+  return a == r.folder.end() && b != normal.end();
+}
+
+bool file_exists(const std::string& file, void* user) {
+  const auto& r = *static_cast<Reading*>(user);
+  return inside(r, file) && non_regular_reason(file).empty();
+}
+
+std::string expand_file_path(const std::string& file, void*) { return file; }  // never a shell expansion
+
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* user) {
+  auto& r = *static_cast<Reading*>(user);
+  try {
+    if (!inside(r, file)) throw Error(r.where, "refused to read " + shown_path(file) + ": outside the asset's folder");
+    const fs::path path = fs::path(file).lexically_normal();
+    if (r.image_files.count(path)) {
+      // Checked now, decoded later by qdmr's image readers: tinygltf gets one placeholder byte.
+      check_input_file(path, r.where, InputKind::Image);
+      out->assign(1, 0);
+      return true;
+    }
+    const std::string bytes = read_input_file(path, r.where, InputKind::GltfBuffer);
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const Error& e) {
+    if (r.error.empty()) r.error = e.what();
+    if (err) *err += e.what();
+    return false;
+  }
+}
+
+bool write_whole_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "qdmr writes no glTF files";
+  return false;
+}
+
+// tinygltf hands over the bytes of an embedded image (and one placeholder byte for an external one); the bytes
+// of a buffer view are handed over unchecked, so the view is checked here first.
+bool keep_image(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
+                const unsigned char* bytes, int size, void* user) {
+  auto& r = *static_cast<Reading*>(user);
+  const std::string at = r.where + ": /images/" + std::to_string(index);
+  if (!image->uri.empty()) return true;  // external: read from its file
+  if (image->bufferView >= 0) {
+    const auto& views = r.model->bufferViews;
+    const auto& buffers = r.model->buffers;
+    const std::string problem =
+        std::size_t(image->bufferView) >= views.size() ? "names buffer view " + std::to_string(image->bufferView) + ", which does not exist"
+        : std::size_t(views[std::size_t(image->bufferView)].buffer) >= buffers.size() ? "its buffer view names a buffer that does not exist"
+        : views[std::size_t(image->bufferView)].byteOffset > buffers[std::size_t(views[std::size_t(image->bufferView)].buffer)].data.size() ||
+                  views[std::size_t(image->bufferView)].byteLength >
+                      buffers[std::size_t(views[std::size_t(image->bufferView)].buffer)].data.size() -
+                          views[std::size_t(image->bufferView)].byteOffset
+              ? "its buffer view runs past the end of its buffer"
+              : "";
+    if (!problem.empty()) {
+      if (r.error.empty()) r.error = at + ": " + problem;
+      if (err) *err += problem;
+      return false;
+    }
+  }
+  if (size <= 0) {
+    if (r.error.empty()) r.error = at + ": the image is empty";
+    return false;
+  }
+  if (std::size_t(index) >= r.embedded.size()) r.embedded.resize(std::size_t(index) + 1);
+  r.embedded[std::size_t(index)].assign(reinterpret_cast<const char*>(bytes), std::size_t(size));
+  return true;
+}
+
+// The file an embedded image is read from: its bytes stored once in the cache folder under their SHA-1 (the
+// same bytes, the same file: plans, keys and caches see a stable path).
+fs::path store_embedded_image(const std::string& bytes, const std::string& where) {
+  const bool png = bytes.size() >= 8 && std::memcmp(bytes.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
+  const bool jpeg = bytes.size() >= 3 && std::memcmp(bytes.data(), "\xff\xd8\xff", 3) == 0;
+  if (!png && !jpeg) throw Error(where, "an embedded image must be PNG or JPEG (glTF's image formats)");
+  const fs::path file = default_cache_dir() / ("gltf-image-" + sha1_hex(bytes.data(), bytes.size()) + (png ? ".png" : ".jpg"));
+  std::error_code ec;
+  if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == bytes.size()) {
+    std::ifstream in(file, std::ios::binary);
+    std::string stored(bytes.size(), '\0');
+    if (in.read(stored.data(), std::streamsize(stored.size())) && stored == bytes) return file;
+  }
+  fs::create_directories(file.parent_path(), ec);
+  write_atomically(file, "embedded glTF image", [&](const fs::path& temporary) -> std::string {
+    std::ofstream out(temporary, std::ios::binary);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+    return out.flush() ? "" : "write failed";
+  });
+  return file;
+}
+
+// One accessor's elements, checked against its buffer view and buffer.
+struct Elements {
+  const unsigned char* first = nullptr;
+  std::size_t count = 0, stride = 0;
+  int components = 0, component_type = 0;
+  bool normalized = false;
+};
+
+class Asset {
+public:
+  Asset(const tinygltf::Model& model, std::string where) : model_(model), where_(std::move(where)) {}
+
+  [[noreturn]] void fail(const std::string& pointer, const std::string& what) const {
+    throw Error(where_ + ": " + pointer, what);
+  }
+
+  Elements elements(int index, const std::string& pointer, std::initializer_list<int> types,
+                    std::initializer_list<int> component_types) const {
+    if (index < 0 || std::size_t(index) >= model_.accessors.size())
+      fail(pointer, "accessor " + std::to_string(index) + " does not exist");
+    const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
+    const std::string at = "/accessors/" + std::to_string(index);
+    if (a.sparse.isSparse) fail(at + "/sparse", "sparse accessors are not supported");
+    if (std::find(types.begin(), types.end(), a.type) == types.end())
+      fail(at + "/type", "this attribute cannot be of this type");
+    if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end())
+      fail(at + "/componentType", std::to_string(a.componentType) + " is not a component type this attribute may have");
+    if (a.bufferView < 0) fail(at, "has no bufferView (an accessor of zeros is not supported)");
+    if (std::size_t(a.bufferView) >= model_.bufferViews.size())
+      fail(at + "/bufferView", "buffer view " + std::to_string(a.bufferView) + " does not exist");
+    const tinygltf::BufferView& view = model_.bufferViews[std::size_t(a.bufferView)];
+    const std::string view_at = "/bufferViews/" + std::to_string(a.bufferView);
+    if (view.buffer < 0 || std::size_t(view.buffer) >= model_.buffers.size())
+      fail(view_at + "/buffer", "buffer " + std::to_string(view.buffer) + " does not exist");
+    const std::size_t buffer_size = model_.buffers[std::size_t(view.buffer)].data.size();
+    if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
+      fail(view_at, "bytes " + std::to_string(view.byteOffset) + " + " + std::to_string(view.byteLength) +
+                        " run past the end of buffer " + std::to_string(view.buffer) + " (" + std::to_string(buffer_size) +
+                        " bytes)");
+    Elements e;
+    e.components = tinygltf::GetNumComponentsInType(std::uint32_t(a.type));
+    const int size = tinygltf::GetComponentSizeInBytes(std::uint32_t(a.componentType));
+    const std::size_t element = std::size_t(e.components) * std::size_t(size);
+    e.stride = view.byteStride ? view.byteStride : element;
+    if (e.stride < element)
+      fail(view_at + "/byteStride", std::to_string(e.stride) + " is less than an element (" + std::to_string(element) +
+                                        " bytes): the elements overlap");
+    if (a.count == 0) fail(at + "/count", "must be at least 1");
+    if (a.byteOffset > view.byteLength || a.count > view.byteLength ||
+        (a.count - 1) * e.stride + element > view.byteLength - a.byteOffset || e.stride > view.byteLength)
+      fail(at + "/count", std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes every " +
+                              std::to_string(e.stride) + " from byte " + std::to_string(a.byteOffset) +
+                              " do not fit buffer view " + std::to_string(a.bufferView) + " (" +
+                              std::to_string(view.byteLength) + " bytes)");
+    e.first = model_.buffers[std::size_t(view.buffer)].data.data() + view.byteOffset + a.byteOffset;
+    e.count = a.count;
+    e.component_type = a.componentType;
+    e.normalized = a.normalized;
+    return e;
+  }
+
+  // Every component as float (float, or a normalised unsigned byte or short); `what` names the attribute.
+  std::vector<float> floats(int index, const std::string& pointer, int type, bool normalized_ok) const {
+    const Elements e = normalized_ok
+                           ? elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT})
+                           : elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    if (e.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT && !e.normalized)
+      fail("/accessors/" + std::to_string(index) + "/normalized", "integer texture coordinates must be normalized");
+    std::vector<float> out(e.count * std::size_t(e.components));
+    for (std::size_t i = 0; i < e.count; ++i) {
+      const unsigned char* p = e.first + i * e.stride;
+      for (int c = 0; c < e.components; ++c) {
+        float v = 0.0f;
+        if (e.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+          std::memcpy(&v, p + 4 * c, 4);
+          if (!std::isfinite(v))
+            fail("/accessors/" + std::to_string(index), "element " + std::to_string(i) + " is not finite");
+        } else if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+          v = float(p[c]) / 255.0f;
+        } else {
+          std::uint16_t s = 0;
+          std::memcpy(&s, p + 2 * c, 2);
+          v = float(s) / 65535.0f;
+        }
+        out[i * std::size_t(e.components) + std::size_t(c)] = v;
+      }
+    }
+    return out;
+  }
+
+  std::vector<std::uint32_t> indices(int index, const std::string& pointer, std::size_t vertices) const {
+    const Elements e = elements(index, pointer, {TINYGLTF_TYPE_SCALAR},
+                                {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+    std::vector<std::uint32_t> out(e.count);
+    for (std::size_t i = 0; i < e.count; ++i) {
+      const unsigned char* p = e.first + i * e.stride;
+      std::uint32_t v = 0;
+      if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+        v = p[0];
+      } else if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+        std::uint16_t s = 0;
+        std::memcpy(&s, p, 2);
+        v = s;
+      } else {
+        std::memcpy(&v, p, 4);
+      }
+      if (v >= vertices)
+        fail("/accessors/" + std::to_string(index), "index " + std::to_string(i) + " is " + std::to_string(v) +
+                                                        ", past the primitive's " + std::to_string(vertices) + " vertices");
+      out[i] = v;
+    }
+    return out;
+  }
+
+private:
+  const tinygltf::Model& model_;
+  std::string where_;
+};
+
+glm::dmat4 local_matrix(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    glm::dmat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[std::size_t(c * 4 + r)];
+    return m;
+  }
+  glm::dmat4 m(1.0);
+  if (node.translation.size() == 3) m = glm::translate(m, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4)
+    m = m * glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+  if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+  return m;
+}
+
+struct TextureChoice {
+  const tinygltf::TextureInfo* base = nullptr;  // the texture whose UV set and transform the material uses
+  int tex_coord = 0;
+  glm::dvec2 offset{0.0}, scale{1.0};
+  double rotation = 0.0;
+};
+
+double number_or(const tinygltf::Value& object, const char* key, double fallback) {
+  if (!object.IsObject() || !object.Has(key)) return fallback;
+  const tinygltf::Value& v = object.Get(key);
+  return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+// The transform (KHR_texture_transform) and UV set of one textureInfo.
+TextureChoice choice_of(int index, int tex_coord, const tinygltf::ExtensionMap& extensions) {
+  TextureChoice c;
+  c.tex_coord = index >= 0 ? tex_coord : 0;
+  if (const auto it = extensions.find("KHR_texture_transform"); it != extensions.end()) {
+    const tinygltf::Value& t = it->second;
+    if (t.Has("offset") && t.Get("offset").IsArray() && t.Get("offset").ArrayLen() == 2)
+      c.offset = {t.Get("offset").Get(0).GetNumberAsDouble(), t.Get("offset").Get(1).GetNumberAsDouble()};
+    if (t.Has("scale") && t.Get("scale").IsArray() && t.Get("scale").ArrayLen() == 2)
+      c.scale = {t.Get("scale").Get(0).GetNumberAsDouble(), t.Get("scale").Get(1).GetNumberAsDouble()};
+    c.rotation = number_or(t, "rotation", 0.0);
+    if (t.Has("texCoord") && t.Get("texCoord").IsInt()) c.tex_coord = t.Get("texCoord").GetNumberAsInt();
+  }
+  return c;
+}
+
+bool same_choice(const TextureChoice& a, const TextureChoice& b) {
+  return a.tex_coord == b.tex_coord && a.offset == b.offset && a.scale == b.scale && a.rotation == b.rotation;
+}
+
+Filter filter_of(int min_filter) {
+  switch (min_filter) {
+    case TINYGLTF_TEXTURE_FILTER_NEAREST: return Filter::Point;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR: return Filter::Bilinear;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST: return Filter::PointMipPoint;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR: return Filter::PointMipLinear;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST: return Filter::LinearMipPoint;
+    default: return Filter::Trilinear;
+  }
+}
+
+AddressMode address_of(int wrap) {
+  switch (wrap) {
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return AddressMode::Clamp;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return AddressMode::Mirror;
+    default: return AddressMode::Wrap;
+  }
+}
+
+// Turns the asset into one MeshData: every primitive of the drawn nodes, in qdmr's frame.
+class Builder {
+public:
+  Builder(const tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where)
+      : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, where_) {}
+
+  MeshData build(const MeshDesc& desc) {
+    check_nodes();
+    const std::vector<int> roots = drawn_roots(desc);
+    for (std::size_t m = 0; m < model_.materials.size(); ++m) materials_.push_back(convert_material(int(m)));
+    for (const int root : roots) visit(root, parent_world(root));
+    if (mesh_.indices.empty()) throw Error(where_, "no triangles to draw in " + shown_path(file_));
+    mesh_.materials = materials_;
+    if (default_material_ >= 0) {
+      MaterialDesc m = default_gltf_material();
+      m.name = unique("default");
+      mesh_.materials.push_back(m);
+    }
+    mesh_.bump_maps.assign(mesh_.materials.size(), fs::path());
+    for (const auto& [what, n] : notes_) mesh_.notes.push_back(n > 1 ? what + " (" + std::to_string(n) + " times)" : what);
+    return std::move(mesh_);
+  }
+
+private:
+  void note(const std::string& what) {
+    for (auto& [w, n] : notes_)
+      if (w == what) {
+        ++n;
+        return;
+      }
+    notes_.emplace_back(what, 1);
+  }
+
+  // Every child index exists, no node has two parents, and the graph has no cycle.
+  void check_nodes() {
+    parent_.assign(model_.nodes.size(), -1);
+    for (std::size_t n = 0; n < model_.nodes.size(); ++n)
+      for (std::size_t k = 0; k < model_.nodes[n].children.size(); ++k) {
+        const int child = model_.nodes[n].children[k];
+        const std::string at = "/nodes/" + std::to_string(n) + "/children/" + std::to_string(k);
+        if (child < 0 || std::size_t(child) >= model_.nodes.size())
+          asset_.fail(at, "node " + std::to_string(child) + " does not exist");
+        if (parent_[std::size_t(child)] >= 0)
+          asset_.fail(at, "node " + std::to_string(child) + " has two parents (nodes " +
+                              std::to_string(parent_[std::size_t(child)]) + " and " + std::to_string(n) + ")");
+        parent_[std::size_t(child)] = int(n);
+      }
+    // With one parent each, a cycle is a chain of parents that comes back to where it started.
+    std::vector<int> state(model_.nodes.size(), 0);  // 0 unknown, 1 on the current walk, 2 reaches a root
+    for (std::size_t n = 0; n < model_.nodes.size(); ++n) {
+      std::vector<std::size_t> walk;
+      std::size_t at = n;
+      while (state[at] == 0 && parent_[at] >= 0) {
+        state[at] = 1;
+        walk.push_back(at);
+        at = std::size_t(parent_[at]);
+      }
+      if (state[at] == 1) asset_.fail("/nodes/" + std::to_string(at) + "/children", "the node graph has a cycle through node " + std::to_string(at));
+      state[at] = 2;
+      for (std::size_t w : walk) state[w] = 2;
+    }
+  }
+
+  std::vector<int> drawn_roots(const MeshDesc& desc) {
+    const auto pick = [&](const GltfPick& p, std::size_t count, auto name_of, const char* what) -> int {
+      if (p.index >= 0) {
+        if (std::size_t(p.index) >= count)
+          throw Error(where_, std::string("the asset has no ") + what + " " + std::to_string(p.index) + " (it has " +
+                                  std::to_string(count) + ")");
+        return p.index;
+      }
+      std::vector<std::string> names;
+      for (std::size_t i = 0; i < count; ++i) {
+        if (name_of(i) == p.name) return int(i);
+        if (!name_of(i).empty()) names.push_back(name_of(i));
+      }
+      throw Error(where_, std::string("the asset has no ") + what + " named '" + scene_detail::shorten(p.name) + "'" +
+                              scene_detail::suggestion(p.name, names, std::string("its ") + what + "s are"));
+    };
+    if (desc.gltf_node.given())
+      return {pick(desc.gltf_node, model_.nodes.size(), [&](std::size_t i) { return model_.nodes[i].name; }, "node")};
+    int scene = -1;
+    if (desc.gltf_scene.given())
+      scene = pick(desc.gltf_scene, model_.scenes.size(), [&](std::size_t i) { return model_.scenes[i].name; }, "scene");
+    else if (model_.defaultScene >= 0 && std::size_t(model_.defaultScene) < model_.scenes.size())
+      scene = model_.defaultScene;
+    else if (model_.defaultScene >= 0)
+      asset_.fail("/scene", "scene " + std::to_string(model_.defaultScene) + " does not exist");
+    else if (!model_.scenes.empty())
+      scene = 0;
+    std::vector<int> roots;
+    if (scene < 0) {  // no scene: every node without a parent
+      for (std::size_t n = 0; n < model_.nodes.size(); ++n)
+        if (parent_[n] < 0) roots.push_back(int(n));
+      return roots;
+    }
+    const auto& nodes = model_.scenes[std::size_t(scene)].nodes;
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const std::string at = "/scenes/" + std::to_string(scene) + "/nodes/" + std::to_string(k);
+      if (nodes[k] < 0 || std::size_t(nodes[k]) >= model_.nodes.size())
+        asset_.fail(at, "node " + std::to_string(nodes[k]) + " does not exist");
+      if (parent_[std::size_t(nodes[k])] >= 0) asset_.fail(at, "node " + std::to_string(nodes[k]) + " is not a root node");
+      if (std::find(roots.begin(), roots.end(), nodes[k]) != roots.end())
+        asset_.fail(at, "node " + std::to_string(nodes[k]) + " is listed twice");
+      roots.push_back(nodes[k]);
+    }
+    return roots;
+  }
+
+  glm::dmat4 parent_world(int node) const {
+    glm::dmat4 m = kZUp;
+    std::vector<int> chain;
+    for (int p = parent_[std::size_t(node)]; p >= 0; p = parent_[std::size_t(p)]) chain.push_back(p);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) m = m * local_matrix(model_.nodes[std::size_t(*it)]);
+    return m;
+  }
+
+  void visit(int root, const glm::dmat4& parent) {
+    std::vector<std::pair<int, glm::dmat4>> stack{{root, parent}};
+    while (!stack.empty()) {
+      const auto [n, above] = stack.back();
+      stack.pop_back();
+      const tinygltf::Node& node = model_.nodes[std::size_t(n)];
+      const std::string at = "/nodes/" + std::to_string(n);
+      if (node.matrix.size() != 0 && node.matrix.size() != 16) asset_.fail(at + "/matrix", "must have 16 numbers");
+      const glm::dmat4 world = above * local_matrix(node);
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+          if (!std::isfinite(world[c][r])) asset_.fail(at, "its transform is not finite");
+      if (node.mesh >= 0) {
+        if (std::size_t(node.mesh) >= model_.meshes.size()) asset_.fail(at + "/mesh", "mesh " + std::to_string(node.mesh) + " does not exist");
+        if (node.skin >= 0) asset_.fail(at + "/skin", "skinned meshes cannot be drawn (qdmr draws rigid meshes)");
+        add_mesh(node.mesh, world);
+      }
+      if (node.camera >= 0) add_camera(node.camera, world, at);
+      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, world);
+    }
+  }
+
+  void add_camera(int index, const glm::dmat4& world, const std::string& at) {
+    if (std::size_t(index) >= model_.cameras.size()) asset_.fail(at + "/camera", "camera " + std::to_string(index) + " does not exist");
+    const tinygltf::Camera& c = model_.cameras[std::size_t(index)];
+    if (c.type != "perspective") {
+      note("camera " + std::to_string(index) + " (" + c.type + ") ignored: only perspective cameras are read");
+      return;
+    }
+    const std::string cat = "/cameras/" + std::to_string(index) + "/perspective";
+    const double fov = c.perspective.yfov * 180.0 / 3.14159265358979323846;
+    if (!(fov > 0.0 && fov < 180.0)) asset_.fail(cat + "/yfov", "must be between 0 and pi radians");
+    if (!(c.perspective.znear > 0.0)) asset_.fail(cat + "/znear", "must be positive");
+    if (c.perspective.zfar != 0.0 && !(c.perspective.zfar > c.perspective.znear)) asset_.fail(cat + "/zfar", "must exceed znear");
+    CameraDesc camera;
+    const glm::dvec3 position(world * glm::dvec4(0, 0, 0, 1));
+    const glm::dvec3 forward = glm::normalize(glm::dvec3(world * glm::dvec4(0, 0, -1, 0)));
+    const glm::dvec3 up = glm::normalize(glm::dvec3(world * glm::dvec4(0, 1, 0, 0)));
+    if (!std::isfinite(forward.x + forward.y + forward.z + up.x + up.y + up.z) || glm::length(glm::cross(forward, up)) < 1e-6)
+      asset_.fail(at, "the camera's transform has no view direction");
+    camera.position = glm::vec3(position);
+    camera.target = glm::vec3(position + forward);
+    camera.up = glm::vec3(up);
+    camera.fov_y_deg = float(fov);
+    camera.near = float(c.perspective.znear);
+    camera.far = c.perspective.zfar > 0.0 ? float(c.perspective.zfar) : std::max(1000.0f, camera.near * 1e4f);
+    mesh_.cameras.push_back(camera);
+  }
+
+  int material_slot(int material, const std::string& at) {
+    if (material < 0) {
+      if (default_material_ < 0) default_material_ = int(materials_.size());
+      return default_material_;
+    }
+    if (std::size_t(material) >= model_.materials.size()) asset_.fail(at + "/material", "material " + std::to_string(material) + " does not exist");
+    return material;
+  }
+
+  void add_mesh(int index, const glm::dmat4& world) {
+    const tinygltf::Mesh& gltf_mesh = model_.meshes[std::size_t(index)];
+    const glm::dmat3 linear(world);
+    const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+    const bool mirrored = glm::determinant(linear) < 0.0;
+    for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& prim = gltf_mesh.primitives[p];
+      const std::string at = "/meshes/" + std::to_string(index) + "/primitives/" + std::to_string(p);
+      if (prim.mode == TINYGLTF_MODE_POINTS) asset_.fail(at + "/mode", "points cannot be drawn (qdmr draws triangles)");
+      if (prim.mode >= TINYGLTF_MODE_LINE && prim.mode <= TINYGLTF_MODE_LINE_STRIP)
+        asset_.fail(at + "/mode", "lines cannot be drawn (qdmr draws triangles)");
+      if (prim.mode < 0 || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN) asset_.fail(at + "/mode", "unknown mode " + std::to_string(prim.mode));
+      if (!prim.targets.empty()) asset_.fail(at + "/targets", "morph targets cannot be drawn");
+      const auto attribute = [&](const std::string& name) {
+        const auto it = prim.attributes.find(name);
+        return it == prim.attributes.end() ? -1 : it->second;
+      };
+      const int position_accessor = attribute("POSITION");
+      if (position_accessor < 0) asset_.fail(at + "/attributes", "no POSITION");
+      const std::vector<float> positions = asset_.floats(position_accessor, at + "/attributes/POSITION", TINYGLTF_TYPE_VEC3, false);
+      const std::size_t count = positions.size() / 3;
+      const auto same_count = [&](const std::vector<float>& values, int components, const char* name) {
+        if (values.size() / std::size_t(components) != count)
+          asset_.fail(at + "/attributes/" + name, std::to_string(values.size() / std::size_t(components)) +
+                                                     " elements, but POSITION has " + std::to_string(count));
+      };
+      const int slot = material_slot(prim.material, at);
+      const TextureChoice& uv_choice = slot < int(uv_choices_.size()) ? uv_choices_[std::size_t(slot)] : TextureChoice{};
+      std::vector<float> normals, tangents, uvs;
+      if (const int a = attribute("NORMAL"); a >= 0) {
+        normals = asset_.floats(a, at + "/attributes/NORMAL", TINYGLTF_TYPE_VEC3, false);
+        same_count(normals, 3, "NORMAL");
+        if (const int t = attribute("TANGENT"); t >= 0) {
+          tangents = asset_.floats(t, at + "/attributes/TANGENT", TINYGLTF_TYPE_VEC4, false);
+          same_count(tangents, 4, "TANGENT");
+        }
+      } else {
+        note("flat normals generated (a primitive has no NORMAL)");
+      }
+      const std::string uv_name = "TEXCOORD_" + std::to_string(uv_choice.tex_coord);
+      if (const int a = attribute(uv_name); a >= 0) {
+        uvs = asset_.floats(a, at + "/attributes/" + uv_name, TINYGLTF_TYPE_VEC2, true);
+        same_count(uvs, 2, uv_name.c_str());
+      } else if (uv_choice.base) {
+        asset_.fail(at + "/attributes", "no " + uv_name + ", which the material's textures use");
+      }
+      for (const auto& [name, accessor] : prim.attributes)
+        if (name.starts_with("JOINTS_") || name.starts_with("WEIGHTS_")) note("skinning attributes ignored");
+
+      std::vector<std::uint32_t> corners;
+      if (prim.indices >= 0) {
+        corners = asset_.indices(prim.indices, at + "/indices", count);
+      } else {
+        corners.resize(count);
+        for (std::size_t i = 0; i < count; ++i) corners[i] = std::uint32_t(i);
+      }
+      const std::vector<std::uint32_t> triangles = triangle_list(corners, prim.mode, at);
+      check_triangle_count(mesh_.indices.size() / 3 + triangles.size() / 3, where_);
+      append(positions, normals, tangents, uvs, uv_choice, triangles, world, normal_matrix, mirrored, std::uint32_t(slot));
+    }
+  }
+
+  std::vector<std::uint32_t> triangle_list(const std::vector<std::uint32_t>& c, int mode, const std::string& at) {
+    std::vector<std::uint32_t> out;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (c.size() % 3 != 0) asset_.fail(at, std::to_string(c.size()) + " corners are not whole triangles");
+      return c;
+    }
+    if (c.size() < 3) asset_.fail(at, "a strip or fan needs at least 3 corners");
+    out.reserve((c.size() - 2) * 3);
+    for (std::size_t i = 2; i < c.size(); ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+        out.insert(out.end(), {c[0], c[i - 1], c[i]});
+      } else if (i % 2 == 0) {
+        out.insert(out.end(), {c[i - 2], c[i - 1], c[i]});
+      } else {
+        out.insert(out.end(), {c[i - 1], c[i - 2], c[i]});
+      }
+    }
+    return out;
+  }
+
+  void append(const std::vector<float>& positions, const std::vector<float>& normals, const std::vector<float>& tangents,
+              const std::vector<float>& uvs, const TextureChoice& uv_choice, const std::vector<std::uint32_t>& triangles,
+              const glm::dmat4& world, const glm::dmat3& normal_matrix, bool mirrored, std::uint32_t material) {
+    // Without normals each triangle gets its own corners, flat-shaded (glTF 2.0, "Meshes").
+    const bool flat = normals.empty();
+    MeshData part;
+    const std::size_t count = positions.size() / 3;
+    const auto vertex = [&](std::size_t v) {
+      part.positions.emplace_back(world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0));
+      glm::dvec2 uv(0.0);
+      if (!uvs.empty()) uv = glm::dvec2(uvs[2 * v], uvs[2 * v + 1]);
+      uv *= uv_choice.scale;
+      if (uv_choice.rotation != 0.0) {
+        const double c = std::cos(uv_choice.rotation), s = std::sin(uv_choice.rotation);
+        uv = glm::dvec2(c * uv.x - s * uv.y, s * uv.x + c * uv.y);
+      }
+      uv += uv_choice.offset;
+      part.uvs.emplace_back(float(uv.x), float(1.0 - uv.y));  // glTF's v runs down the image, qdmr's up
+      if (flat) return;
+      glm::dvec3 n = normal_matrix * glm::dvec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+      const double len = glm::length(n);
+      part.normals.emplace_back(len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1));
+      if (tangents.empty()) return;
+      const glm::dvec3 t = glm::dmat3(world) * glm::dvec3(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2]);
+      const double tl = glm::length(t);
+      const float w = (tangents[4 * v + 3] < 0.0f) != mirrored ? -1.0f : 1.0f;
+      part.tangents.emplace_back(tl > 0.0 && std::isfinite(tl) ? glm::vec3(t / tl) : any_orthogonal(part.normals.back()), w);
+    };
+    if (flat) {
+      for (std::size_t k = 0; k < triangles.size(); ++k) {
+        vertex(triangles[k]);
+        part.indices.push_back(std::uint32_t(k));
+      }
+      for (std::size_t k = 0; k < triangles.size(); k += 3) {
+        const glm::dvec3 a(part.positions[k]), b(part.positions[k + 1]), c(part.positions[k + 2]);
+        const glm::dvec3 face = glm::cross(b - a, c - a);
+        const double len = glm::length(face);
+        const glm::vec3 n = len > 0.0 && std::isfinite(len) ? glm::vec3(face / len) : glm::vec3(0, 0, 1);
+        part.normals.insert(part.normals.end(), {n, n, n});
+      }
+    } else {
+      for (std::size_t v = 0; v < count; ++v) vertex(v);
+      part.indices = triangles;
+    }
+    if (part.tangents.size() != part.positions.size()) {
+      part.tangents.clear();
+      compute_tangents(part);
+      if (has_textures_) note("tangents generated (a primitive has no TANGENT; not MikkTSpace: see docs/scene-format.md)");
+    }
+    const auto base = std::uint32_t(mesh_.positions.size());
+    mesh_.positions.insert(mesh_.positions.end(), part.positions.begin(), part.positions.end());
+    mesh_.normals.insert(mesh_.normals.end(), part.normals.begin(), part.normals.end());
+    mesh_.tangents.insert(mesh_.tangents.end(), part.tangents.begin(), part.tangents.end());
+    mesh_.uvs.insert(mesh_.uvs.end(), part.uvs.begin(), part.uvs.end());
+    for (const std::uint32_t i : part.indices) mesh_.indices.push_back(base + i);
+    mesh_.triangle_materials.insert(mesh_.triangle_materials.end(), part.indices.size() / 3, material);
+  }
+
+  std::string unique(std::string name) const {
+    const auto taken = [&](const std::string& n) {
+      return std::any_of(materials_.begin(), materials_.end(), [&](const MaterialDesc& m) { return m.name == n; });
+    };
+    while (taken(name)) name += "_";
+    return name;
+  }
+
+  static MaterialDesc default_gltf_material() {
+    // glTF's default material: white, metallic 1, roughness 1 (qdmr: Cook-Torrance, no diffuse, F0 of white).
+    MaterialDesc m;
+    LayerDesc layer;
+    layer.albedo.source = TextureSource::Constant;
+    layer.albedo.constant = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    m.layers = {layer};
+    m.lighting.model = LightingModel::CookTorrance;
+    m.lighting.specular = 1.0f;
+    m.lighting.roughness = 1.0f;
+    return m;
+  }
+
+  // The file of image `index` (an external file beside the asset, or the embedded bytes stored in the cache),
+  // checked by qdmr's image reader up to its header.
+  fs::path image_file(int texture, const std::string& at) {
+    if (texture < 0 || std::size_t(texture) >= model_.textures.size()) asset_.fail(at + "/index", "texture " + std::to_string(texture) + " does not exist");
+    const int source = model_.textures[std::size_t(texture)].source;
+    if (source < 0 || std::size_t(source) >= model_.images.size())
+      asset_.fail("/textures/" + std::to_string(texture) + "/source", "no image qdmr can read (an image of an extension is not read)");
+    if (const auto it = image_files_.find(source); it != image_files_.end()) return it->second;
+    const tinygltf::Image& image = model_.images[std::size_t(source)];
+    const std::string image_at = where_ + ": /images/" + std::to_string(source);
+    fs::path file;
+    if (!image.uri.empty()) {
+      file = (reading_.folder / *relative_uri(image.uri, image_at)).lexically_normal();
+    } else {
+      if (std::size_t(source) >= reading_.embedded.size() || reading_.embedded[std::size_t(source)].empty())
+        throw Error(image_at, "the image has no data");
+      file = store_embedded_image(reading_.embedded[std::size_t(source)], image_at);
+    }
+    static_cast<void>(read_image_header(file, image_at));
+    image_files_[source] = file;
+    return file;
+  }
+
+  TextureDesc texture(int index, const std::string& at, bool srgb) {
+    TextureDesc t;
+    t.source = TextureSource::File;
+    t.file = image_file(index, at);
+    t.srgb = srgb;
+    return t;
+  }
+
+  MaterialDesc convert_material(int index) {
+    const tinygltf::Material& g = model_.materials[std::size_t(index)];
+    const std::string at = "/materials/" + std::to_string(index);
+    const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+    MaterialDesc m = default_gltf_material();
+    m.name = unique(g.name.empty() ? "material " + std::to_string(index) : g.name);
+    LayerDesc& layer = m.layers.front();
+    std::vector<double> color = pbr.baseColorFactor;
+    if (color.size() != 4) color = {1, 1, 1, 1};
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!(color[k] >= 0.0 && color[k] <= 1.0)) asset_.fail(at + "/pbrMetallicRoughness/baseColorFactor", "components must be in [0, 1]");
+    const double metallic = pbr.metallicFactor, roughness = pbr.roughnessFactor;
+    if (!(metallic >= 0.0 && metallic <= 1.0)) asset_.fail(at + "/pbrMetallicRoughness/metallicFactor", "must be in [0, 1]");
+    if (!(roughness >= 0.0 && roughness <= 1.0)) asset_.fail(at + "/pbrMetallicRoughness/roughnessFactor", "must be in [0, 1]");
+
+    // The UV set and transform: the base colour texture's, else the normal texture's.
+    TextureChoice choice;
+    std::vector<std::pair<std::string, TextureChoice>> used;
+    const auto consider = [&](const char* name, int tex, int coord, const tinygltf::ExtensionMap& ext) {
+      if (tex < 0) return;
+      used.emplace_back(name, choice_of(tex, coord, ext));
+    };
+    consider("baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions);
+    consider("normalTexture", g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions);
+    if (!used.empty()) {
+      has_textures_ = true;
+      choice = used.front().second;
+      choice.base = &pbr.baseColorTexture;
+      for (const auto& [name, c] : used)
+        if (!same_choice(c, choice))
+          note("material '" + m.name + "': " + name + " uses another UV set or transform than " + used.front().first +
+               "; qdmr samples a material's textures alike, with " + used.front().first + "'s");
+    }
+    uv_choices_.resize(std::size_t(index) + 1);
+    uv_choices_[std::size_t(index)] = choice;
+
+    const double f0 = 0.04 + (0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2] - 0.04) * metallic;
+    m.lighting.roughness = float(std::clamp(roughness, 0.02, 1.0));
+    m.lighting.specular = float(f0);
+    if (pbr.baseColorTexture.index >= 0) {
+      layer.albedo = texture(pbr.baseColorTexture.index, at + "/pbrMetallicRoughness/baseColorTexture", true);
+      if (color != std::vector<double>{1, 1, 1, 1})
+        note("material '" + m.name + "': baseColorFactor not applied over its baseColorTexture");
+      if (metallic > 0.0) note("material '" + m.name + "': metallic surfaces with a baseColorTexture keep their diffuse colour");
+      const int sampler = model_.textures[std::size_t(pbr.baseColorTexture.index)].sampler;
+      if (sampler >= 0) {
+        if (std::size_t(sampler) >= model_.samplers.size())
+          asset_.fail("/textures/" + std::to_string(pbr.baseColorTexture.index) + "/sampler", "sampler " + std::to_string(sampler) + " does not exist");
+        const tinygltf::Sampler& s = model_.samplers[std::size_t(sampler)];
+        m.sampling.filter = filter_of(s.minFilter);
+        m.sampling.address = address_of(s.wrapS);
+        if (s.wrapS != s.wrapT) note("material '" + m.name + "': wrapT differs from wrapS; qdmr addresses both axes with wrapS");
+      }
+    } else {
+      layer.albedo.constant = glm::vec4(float(color[0] * (1.0 - metallic)), float(color[1] * (1.0 - metallic)),
+                                        float(color[2] * (1.0 - metallic)), float(color[3]));
+    }
+    if (g.normalTexture.index >= 0) {
+      layer.normal = texture(g.normalTexture.index, at + "/normalTexture", false);
+      if (!std::isfinite(g.normalTexture.scale)) asset_.fail(at + "/normalTexture/scale", "must be finite");
+      layer.normal_strength = float(std::max(0.0, g.normalTexture.scale));
+    }
+    if (pbr.metallicRoughnessTexture.index >= 0) {
+      static_cast<void>(image_file(pbr.metallicRoughnessTexture.index, at + "/pbrMetallicRoughness/metallicRoughnessTexture"));
+      note("material '" + m.name + "': metallicRoughnessTexture not applied (its factors are)");
+    }
+    if (g.occlusionTexture.index >= 0) {
+      static_cast<void>(image_file(g.occlusionTexture.index, at + "/occlusionTexture"));
+      note("material '" + m.name + "': occlusionTexture not applied (qdmr's ambient occlusion is the material's ao block)");
+    }
+    double emissive_strength = 1.0;
+    if (const auto it = g.extensions.find("KHR_materials_emissive_strength"); it != g.extensions.end())
+      emissive_strength = number_or(it->second, "emissiveStrength", 1.0);
+    const bool emits = g.emissiveTexture.index >= 0 ||
+                       (g.emissiveFactor.size() == 3 && emissive_strength > 0.0 &&
+                        (g.emissiveFactor[0] > 0.0 || g.emissiveFactor[1] > 0.0 || g.emissiveFactor[2] > 0.0));
+    if (emits) note("material '" + m.name + "': emission not drawn (qdmr has no emissive term)");
+    if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) note("material '" + m.name + "': alphaMode " + g.alphaMode + " drawn opaque");
+    return m;
+  }
+
+  const tinygltf::Model& model_;
+  const Reading& reading_;
+  fs::path file_;
+  std::string where_;
+  Asset asset_;
+  std::vector<int> parent_;
+  std::vector<MaterialDesc> materials_;
+  std::vector<TextureChoice> uv_choices_;
+  std::map<int, fs::path> image_files_;
+  int default_material_ = -1;
+  bool has_textures_ = false;
+  std::vector<std::pair<std::string, int>> notes_;
+  MeshData mesh_;
+};
+
+// What the document says before tinygltf reads it: the URIs it names (checked), the extensions it requires
+// (refused unless qdmr reads them), and what qdmr ignores (the plan's notes).
+std::vector<std::string> prescan(const std::string& json_text, Reading& reading) {
+  nlohmann::json doc;
+  try {
+    doc = scene_detail::parse_json_bounded(json_text);
+  } catch (const Error& e) {
+    throw Error(reading.where, e.what());
+  } catch (const nlohmann::json::exception& e) {
+    const std::string what = e.what();
+    const auto start = what.find("parse error");
+    throw Error(reading.where, start != std::string::npos ? what.substr(start) : what);
+  }
+  if (!doc.is_object()) throw Error(reading.where, "a glTF document is a JSON object");
+  std::vector<std::string> notes;
+  for (const char* kind : {"buffers", "images"}) {
+    const auto it = doc.find(kind);
+    if (it == doc.end() || !it->is_array()) continue;
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& item = (*it)[i];
+      if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+      const auto path = relative_uri(item["uri"].get_ref<const std::string&>(),
+                                     reading.where + ": /" + kind + "/" + std::to_string(i) + "/uri");
+      if (path && std::string(kind) == "images") reading.image_files.insert((reading.folder / *path).lexically_normal());
+    }
+  }
+  if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
+    for (std::size_t i = 0; i < it->size(); ++i)
+      if ((*it)[i].is_string() && !kSupportedExtensions.count((*it)[i].get<std::string>()))
+        throw Error(reading.where + ": /extensionsRequired/" + std::to_string(i),
+                    "the asset requires " + scene_detail::shorten((*it)[i].get<std::string>()) + ", which qdmr does not read");
+  if (const auto it = doc.find("extensionsUsed"); it != doc.end() && it->is_array())
+    for (const auto& e : *it)
+      if (e.is_string() && !kSupportedExtensions.count(e.get<std::string>()))
+        notes.push_back("extension " + scene_detail::shorten(e.get<std::string>()) + " ignored");
+  if (const auto it = doc.find("animations"); it != doc.end() && it->is_array() && !it->empty())
+    notes.push_back(std::to_string(it->size()) + " animation" + (it->size() > 1 ? "s" : "") + " ignored (drawn at rest)");
+  return notes;
+}
+
+}  // namespace
+
+MeshData load_gltf(const MeshDesc& desc, const std::string& where) {
+  const fs::path file = fs::absolute(desc.file).lexically_normal();
+  const std::string bytes = read_input_file(file, where, InputKind::Gltf);
+  Reading reading;
+  reading.folder = file.parent_path();
+  reading.where = where.empty() ? shown_path(file) : where + ": " + shown_path(file);
+  const bool binary = looks_like_glb(bytes);
+  const std::string json_text = binary ? std::string(glb_json_chunk(bytes, reading.where)) : bytes;
+  std::vector<std::string> notes = prescan(json_text, reading);
+
+  tinygltf::Model model;
+  reading.model = &model;
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({&file_exists, &expand_file_path, &read_whole_file, &write_whole_file, &reading});
+  loader.SetImageLoader(&keep_image, &reading);
+  std::string err, warn;
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                              unsigned(bytes.size()), reading.folder.string())
+                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), reading.folder.string());
+  } catch (const std::exception& e) {
+    throw Error(reading.where, std::string("tinygltf: ") + e.what());
+  }
+  if (!reading.error.empty()) throw Error(reading.error);
+  if (!ok || !err.empty()) {
+    std::string first = err.substr(0, err.find('\n'));
+    if (first.empty()) first = "tinygltf could not read the asset";
+    throw Error(reading.where, first);
+  }
+  MeshData mesh = Builder(model, reading, file, reading.where).build(desc);
+  notes.insert(notes.end(), mesh.notes.begin(), mesh.notes.end());
+  mesh.notes = std::move(notes);
+  return mesh;
+}
+
+}  // namespace qdmr::mesh_detail

@@ -1,0 +1,235 @@
+// glTF 2.0 assets through mesh_detail::load_gltf: what is read (the generated assets of tests/gltf/assets, see
+// tests/gltf/make_assets.py) and what is refused, each refusal naming the file and the element at fault.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+#include "mesh/builders.hpp"
+#include "mesh/gltf_files.hpp"
+#include "qdmr/core/error.hpp"
+#include "support/test_support.hpp"
+
+namespace qdmr {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path asset(const std::string& name) { return test::source_dir() / "tests/gltf/assets" / name; }
+
+MeshData load(const fs::path& file, GltfPick scene = {}, GltfPick node = {}) {
+  MeshDesc desc;
+  desc.kind = MeshKind::Gltf;
+  desc.file = file;
+  desc.gltf_scene = scene;
+  desc.gltf_node = node;
+  return mesh_detail::load_gltf(desc, "scene.json: /objects/0/mesh/file");
+}
+
+std::string load_error(const fs::path& file) {
+  try {
+    load(file);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// The quad of quad.gltf, as tests/gltf/make_assets.py writes it: glTF positions (x, 0, -y) land on qdmr's
+// (x, y, 0) exactly (the +Y-up to +Z-up turn has entries 0 and +-1), UVs (u, 1 - v) on (u, v).
+TEST(Gltf, TheQuadLandsOnQdmrsAxes) {
+  const MeshData m = load(asset("quad.gltf"));
+  ASSERT_EQ(m.vertex_count(), 4u);
+  ASSERT_EQ(m.triangle_count(), 2u);
+  EXPECT_EQ(m.positions[0], glm::vec3(-1, -1, 0));
+  EXPECT_EQ(m.positions[2], glm::vec3(1, 1, 0));
+  EXPECT_EQ(m.uvs[0], glm::vec2(0, 0));
+  EXPECT_EQ(m.uvs[2], glm::vec2(1, 1));
+  EXPECT_EQ(m.normals[0], glm::vec3(0, 0, 1));
+  EXPECT_EQ(m.tangents[0], glm::vec4(1, 0, 0, 1));  // generated: +u is +x, +v is +y
+  ASSERT_EQ(m.materials.size(), 1u);
+  const MaterialDesc& material = m.materials[0];
+  EXPECT_EQ(material.name, "checker");
+  EXPECT_EQ(material.layers[0].albedo.source, TextureSource::File);
+  EXPECT_EQ(material.layers[0].albedo.file, fs::absolute(asset("checker.png")).lexically_normal());
+  EXPECT_EQ(material.lighting.model, LightingModel::CookTorrance);
+  EXPECT_FLOAT_EQ(material.lighting.roughness, 0.6f);
+  EXPECT_FLOAT_EQ(material.lighting.specular, 0.04f);  // a dielectric's F0 (metallicFactor 0)
+  EXPECT_EQ(material.technique.kind, TechniqueKind::Normal);
+  EXPECT_EQ(m.triangle_materials, std::vector<std::uint32_t>({0, 0}));
+}
+
+// The same asset with its buffer and image embedded (data: URIs), and as one .glb (BIN chunk, image in a buffer
+// view): the same mesh, and an albedo file with the same bytes as checker.png.
+TEST(Gltf, EmbeddedExternalAndBinaryAreTheSameAsset) {
+  const MeshData external = load(asset("quad.gltf"));
+  for (const char* name : {"quad_embedded.gltf", "quad.glb"}) {
+    const MeshData m = load(asset(name));
+    EXPECT_EQ(m.positions, external.positions) << name;
+    EXPECT_EQ(m.normals, external.normals) << name;
+    EXPECT_EQ(m.tangents, external.tangents) << name;
+    EXPECT_EQ(m.uvs, external.uvs) << name;
+    EXPECT_EQ(m.indices, external.indices) << name;
+    const fs::path albedo = m.materials.at(0).layers[0].albedo.file;
+    EXPECT_NE(albedo, external.materials[0].layers[0].albedo.file) << name << ": stored in the cache folder";
+    EXPECT_EQ(test::read_file(albedo), test::read_file(asset("checker.png"))) << name;
+  }
+}
+
+// Node hierarchy: root (translate (0, 0.5, 0), a quarter turn about +Y, scale 0.5) with children by TRS and by
+// matrix, a grandchild, and a camera node. Expected corners are worked out by hand in glTF space, then turned
+// +Z up ((x, y, z) -> (x, -z, y)).
+TEST(Gltf, NodeHierarchyPlacesEveryMesh) {
+  const MeshData m = load(asset("hierarchy.gltf"));
+  ASSERT_EQ(m.triangle_count(), 6u);
+  // Tolerance: the quaternion's sqrt(0.5) components round in double; 1e-6 is far below any wrong transform.
+  const auto near = [](glm::vec3 a, glm::vec3 b) { return glm::length(a - b) < 1e-6f; };
+  // "left": corner (-1, 0, 1) + (-2.5, 0, 0) = (-3.5, 0, 1); scale 0.5: (-1.75, 0, 0.5); a quarter turn about Y
+  // maps (x, y, z) to (z, y, -x): (0.5, 0, 1.75); + (0, 0.5, 0): (0.5, 0.5, 1.75); +Z up: (0.5, -1.75, 0.5).
+  EXPECT_TRUE(near(m.positions[0], glm::vec3(0.5f, -1.75f, 0.5f))) << m.positions[0].x << " " << m.positions[0].y << " " << m.positions[0].z;
+  // Its normal (0, 1, 0) stays +Y in glTF: +Z in qdmr.
+  EXPECT_TRUE(near(m.normals[0], glm::vec3(0, 0, 1)));
+  // Every material was read, by name.
+  ASSERT_EQ(m.materials.size(), 3u);
+  EXPECT_EQ(m.materials[1].name, "green");
+  EXPECT_FLOAT_EQ(m.materials[1].layers[0].albedo.constant.g, 0.7f);
+  // The camera node: at glTF (0, 6, 6) looking down 45 degrees towards -Z; qdmr (0, -6, 6) looking towards +Y.
+  ASSERT_EQ(m.cameras.size(), 1u);
+  EXPECT_TRUE(near(m.cameras[0].position, glm::vec3(0, -6, 6)));
+  const glm::vec3 view = glm::normalize(m.cameras[0].target - m.cameras[0].position);
+  EXPECT_TRUE(near(view, glm::normalize(glm::vec3(0, 1, -1))));
+  EXPECT_NEAR(m.cameras[0].fov_y_deg, 0.8 * 180 / 3.14159265358979, 1e-4);  // float degrees of 0.8 rad
+  // One node and its subtree, by name: "left" and its grandchild "lifted".
+  EXPECT_EQ(load(asset("hierarchy.gltf"), {}, {-1, "left"}).triangle_count(), 4u);
+  EXPECT_EQ(load(asset("hierarchy.gltf"), {}, {2, ""}).triangle_count(), 2u);
+}
+
+// 8-, 16- and 32-bit indices and none; the last primitive has no normals: flat ones, per triangle.
+TEST(Gltf, EveryIndexTypeAndFlatNormals) {
+  const MeshData m = load(asset("indices.gltf"));
+  EXPECT_EQ(m.triangle_count(), 8u);
+  EXPECT_EQ(m.vertex_count(), 4u * 3 + 6u);
+  EXPECT_EQ(m.triangle_materials, std::vector<std::uint32_t>({0, 0, 1, 1, 2, 2, 3, 3}));
+  for (std::size_t i = 0; i < m.indices.size(); ++i) {
+    // The three indexed quads index the same corners, offset by their vertices; x by their offsets.
+    const std::size_t quad = i / 6;
+    EXPECT_NEAR(m.positions[m.indices[i]].x, -4.5f + 3.0f * float(quad), 1.0f + 1e-6f);
+  }
+  EXPECT_EQ(m.normals[12], glm::vec3(0, 0, 1));  // flat: the face normal
+  EXPECT_FALSE(m.notes.empty());
+}
+
+TEST(Gltf, SparseAccessorsAreRefused) {
+  EXPECT_NE(load_error(asset("sparse.gltf")).find("/accessors/0/sparse: sparse accessors are not supported"),
+            std::string::npos)
+      << load_error(asset("sparse.gltf"));
+}
+
+// A copy of quad.gltf (with its buffer and image) edited by `edit`, loaded: the error message.
+std::string edited_error(const std::function<void(nlohmann::json&)>& edit) {
+  test::TempDir dir;
+  fs::create_directories(dir / "asset");
+  fs::copy_file(asset("quad.bin"), dir / "asset/quad.bin");
+  fs::copy_file(asset("checker.png"), dir / "asset/checker.png");
+  nlohmann::json doc = nlohmann::json::parse(test::read_file(asset("quad.gltf")));
+  edit(doc);
+  test::write_file(dir / "asset/quad.gltf", doc.dump());
+  test::write_file(dir / "secret.bin", std::string(140, 'x'));
+  const std::string error = load_error(dir / "asset/quad.gltf");
+  const std::string prefix = "scene.json: /objects/0/mesh/file: " + (dir / "asset/quad.gltf").string() + ": ";
+  return error.rfind(prefix, 0) == 0 ? error.substr(prefix.size()) : error;
+}
+
+TEST(Gltf, EachBadElementIsNamed) {
+  using J = nlohmann::json;
+  const auto has = [](const std::string& error, const std::string& part) {
+    return error.find(part) != std::string::npos ? testing::AssertionSuccess()
+                                                 : testing::AssertionFailure() << "'" << error << "' lacks '" << part << "'";
+  };
+  // URIs that leave the folder or name a scheme: refused before anything is opened.
+  EXPECT_TRUE(has(edited_error([](J& d) { d["buffers"][0]["uri"] = "../secret.bin"; }), "/buffers/0/uri: the URI '../secret.bin' leaves the asset's folder"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["buffers"][0]["uri"] = "%2e%2e/secret.bin"; }), "leaves the asset's folder"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["buffers"][0]["uri"] = "/etc/passwd"; }), "is an absolute path"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "https://example.com/a.png"; }), "/images/0/uri: the URI 'https://example.com/a.png' names a scheme"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "file:checker.png"; }), "names a scheme"));
+  // What qdmr cannot draw.
+  EXPECT_TRUE(has(edited_error([](J& d) { d["meshes"][0]["primitives"][0]["mode"] = 0; }), "/meshes/0/primitives/0/mode: points cannot be drawn"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["meshes"][0]["primitives"][0]["mode"] = 1; }), "lines cannot be drawn"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["meshes"][0]["primitives"][0]["targets"] = J::array({{{"POSITION", 0}}}); }), "/meshes/0/primitives/0/targets: morph targets"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["nodes"][0]["skin"] = 0; d["skins"] = J::array({{{"joints", {0}}, {"inverseBindMatrices", 0}}}); }), "/nodes/0/skin: skinned meshes cannot be drawn"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["extensionsRequired"] = {"KHR_draco_mesh_compression"}; d["extensionsUsed"] = d["extensionsRequired"]; }),
+                  "/extensionsRequired/0: the asset requires KHR_draco_mesh_compression, which qdmr does not read"));
+  // Accessors and views that lie.
+  EXPECT_TRUE(has(edited_error([](J& d) { d["accessors"][0]["count"] = 5; }), "/accessors/0/count: 5 elements of 12 bytes"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["accessors"][0]["count"] = 4000000000u; }), "/accessors/0/count"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["accessors"][1]["bufferView"] = 9; }), "/accessors/1/bufferView: buffer view 9 does not exist"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["bufferViews"][0]["byteLength"] = 4000; }), "/bufferViews/0: bytes 0 + 4000 run past the end of buffer 0"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["bufferViews"][0]["byteStride"] = 8; }), "/bufferViews/0/byteStride: 8 is less than an element (12 bytes)"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["accessors"][0]["componentType"] = 5123; }), "/accessors/0/componentType"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["accessors"][1]["count"] = 3; }), "/meshes/0/primitives/0/attributes/TEXCOORD_0: 3 elements, but POSITION has 4"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["buffers"][0]["byteLength"] = 1000; }), "quad.bin"));
+  // Indices past the vertices, and a node graph with a cycle.
+  EXPECT_TRUE(has(edited_error([](J& d) {
+                    const int accessor = d["meshes"][0]["primitives"][0]["indices"];
+                    d["accessors"][accessor]["count"] = 3;
+                    d["accessors"][0]["count"] = 2;
+                    d["accessors"][1]["count"] = 2;
+                    d["accessors"][2]["count"] = 2;
+                  }),
+                  "/accessors/3: index 2 is 2, past the primitive's 2 vertices"));
+  EXPECT_TRUE(has(edited_error([](J& d) {
+                    d["nodes"] = J::array({{{"mesh", 0}}, {{"children", {2}}}, {{"children", {1}}}});
+                  }),
+                  "the node graph has a cycle"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["nodes"][0]["children"] = {0}; }), "cycle"));
+  EXPECT_TRUE(has(edited_error([](J& d) { d["nodes"][0]["children"] = {7}; }), "/nodes/0/children/0: node 7 does not exist"));
+  // An image that is not one.
+  EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "quad.bin"; }), "quad.bin"));
+}
+
+std::string glb_error(std::string bytes) {
+  try {
+    static_cast<void>(mesh_detail::glb_json_chunk(bytes, "a.glb"));
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+void put32(std::string& s, std::size_t at, std::uint32_t v) { std::memcpy(s.data() + at, &v, 4); }
+
+TEST(Gltf, GlbChunkLengthsThatLieAreRefused) {
+  const std::string good = test::read_file(asset("quad.glb"));
+  EXPECT_EQ(glb_error(good), "no error");
+  std::string s = good;
+  put32(s, 8, std::uint32_t(good.size() + 4));
+  EXPECT_NE(glb_error(s).find(".glb header: length"), std::string::npos) << glb_error(s);
+  s = good;
+  put32(s, 12, 0x7ffffff0u);
+  EXPECT_NE(glb_error(s).find(".glb chunk 0: length 2147483632 runs past the end of the file"), std::string::npos) << glb_error(s);
+  s = good;
+  std::uint32_t json_length = 0;
+  std::memcpy(&json_length, good.data() + 12, 4);
+  put32(s, 20 + json_length, std::uint32_t(good.size()));
+  EXPECT_NE(glb_error(s).find(".glb chunk 1: length"), std::string::npos) << glb_error(s);
+  s = good;
+  put32(s, 4, 1);
+  EXPECT_NE(glb_error(s).find("version 1"), std::string::npos);
+  EXPECT_NE(glb_error(good.substr(0, 16)).find("needs a 12-byte header and a chunk"), std::string::npos);
+}
+
+TEST(Gltf, UrisStayInTheFolder) {
+  EXPECT_EQ(*mesh_detail::relative_uri("textures/a%20b.png", "w"), fs::path("textures/a b.png"));
+  EXPECT_FALSE(mesh_detail::relative_uri("data:image/png;base64,AAAA", "w"));
+  for (const char* bad : {"../a.png", "a/../../b.png", "/abs.png", "http://x/y.png", "C:/x.png", "a\\b.png", "%00.png",
+                          "%2", "", "ftp:x"})
+    EXPECT_THROW(mesh_detail::relative_uri(bad, "w"), Error) << bad;
+}
+
+}  // namespace
+}  // namespace qdmr
