@@ -20,6 +20,8 @@ def cli():
 
 
 def run_cli(cli, *args, cwd=None):
-    done = subprocess.run([cli, *args], capture_output=True, text=True, cwd=cwd)
+    # Not the ASan runtime preloaded for a sanitized module (tests/CMakeLists.txt): a sanitized qdmr has its own.
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    done = subprocess.run([cli, *args], capture_output=True, text=True, cwd=cwd, env=env)
     assert done.returncode == 0, done.stderr
     return done.stdout
