@@ -15,6 +15,7 @@
 #include <glm/geometric.hpp>
 
 #include "mesh/builders.hpp"
+#include "mesh/triangulate.hpp"
 #include "io/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
@@ -54,7 +55,10 @@ void for_each_line(const std::string& text, Visit visit) {
 // tinyobjloader reads positions through face indices unchecked while triangulating, and only warns about
 // indices out of range: check every face index first. Positive indices may point forward (to the file's
 // total); negative ones count back from the vertices read so far.
-void check_face_indices(const std::string& text, const std::string& where) {
+// Returns the number of corners of every face, in file order (tinyobjloader keeps a face's count in an unsigned
+// char: 1000 corners come out as 232).
+std::vector<std::size_t> check_face_indices(const std::string& text, const std::string& where) {
+  std::vector<std::size_t> face_corners;
   static constexpr const char* kNames[3] = {"position", "texture coordinate", "normal"};
   std::array<long long, 3> total{}, seen{};
   for_each_line(text, [&](std::size_t, std::string_view line) {
@@ -71,9 +75,7 @@ void check_face_indices(const std::string& text, const std::string& where) {
     std::istringstream tokens{std::string(line.substr(1))};
     long long corners = 0;
     for (std::string token; tokens >> token;) {
-      // tinyobjloader ear-clips polygons in quadratic time: a face line of a megabyte would take minutes.
-      if (++corners > limits::kMaxFaceVertices)
-        fail("a face has more than " + std::to_string(limits::kMaxFaceVertices) + " vertices");
+      ++corners;
       std::size_t part_start = 0;
       for (int k = 0; k < 3 && part_start <= token.size(); ++k) {
         std::size_t part_end = std::min(token.find('/', part_start), token.size());
@@ -96,7 +98,9 @@ void check_face_indices(const std::string& text, const std::string& where) {
     if (corners < 3)
       fail("a face needs at least 3 vertices, this one has " + std::to_string(corners) +
            " (use 'l' for lines)");
+    face_corners.push_back(std::size_t(corners));
   });
+  return face_corners;
 }
 
 // tinyobjloader reads "nan", "inf" and other words as 0 without a warning: check every number of the v, vt
@@ -246,12 +250,71 @@ std::string unique_name(const std::vector<MaterialDesc>& materials, std::string 
   return name;
 }
 
+struct FaceTriangles {
+  std::vector<std::uint32_t> corners;  // 3 per triangle: indices into the shape's mesh.indices
+  std::vector<std::uint32_t> faces;    // per triangle: its face
+  std::size_t degenerate_faces = 0;    // faces of 4 or more corners without area, dropped
+};
+
+// The shape's faces as triangles. Triangles stay as they are (a degenerate one too: the rasterizer culls it);
+// quads are split along their shorter diagonal, as tinyobjloader split them (the same float arithmetic, so
+// meshes keep their triangles); larger faces are ear-clipped (mesh/triangulate.hpp). Faces of 4 or more corners
+// with no area are dropped and counted.
+// `corners_of`: the true corner count of each face of the file, from `next` on (check_face_indices), advanced past
+// this shape's faces.
+FaceTriangles triangulate_faces(const tinyobj::mesh_t& mesh, const tinyobj::attrib_t& attrib, const std::string& where,
+                                const std::vector<std::size_t>& corners_of, std::size_t& next) {
+  FaceTriangles out;
+  const auto position = [&](std::size_t corner) {
+    const float* p = &attrib.vertices[3 * std::size_t(mesh.indices[corner].vertex_index)];
+    return glm::vec3(p[0], p[1], p[2]);
+  };
+  std::vector<glm::dvec3> polygon;
+  std::size_t first = 0;
+  for (std::size_t f = 0; f < mesh.num_face_vertices.size(); first += corners_of[next++], ++f) {
+    if (next >= corners_of.size() || corners_of[next] % 256 != mesh.num_face_vertices[f] ||
+        first + corners_of[next] > mesh.indices.size())
+      throw Error(where, "the faces tinyobjloader read differ from the file's face lines");
+    const std::size_t count = corners_of[next];
+    const auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+      out.corners.insert(out.corners.end(), {std::uint32_t(first) + a, std::uint32_t(first) + b, std::uint32_t(first) + c});
+      out.faces.push_back(std::uint32_t(f));
+    };
+    if (count < 3) continue;  // check_face_indices refused these already
+    if (count == 3) {
+      add(0, 1, 2);
+      continue;
+    }
+    polygon.resize(count);
+    for (std::size_t k = 0; k < count; ++k) polygon[k] = glm::dvec3(position(first + k));
+    const PolygonTriangles split = triangulate_polygon(polygon, where);
+    if (split.degenerate) {
+      ++out.degenerate_faces;
+      continue;
+    }
+    if (count == 4) {
+      const glm::vec3 e02 = position(first + 2) - position(first), e13 = position(first + 3) - position(first + 1);
+      const float d02 = e02.x * e02.x + e02.y * e02.y + e02.z * e02.z, d13 = e13.x * e13.x + e13.y * e13.y + e13.z * e13.z;
+      if (d02 < d13) {
+        add(0, 1, 2);
+        add(0, 2, 3);
+      } else {
+        add(0, 1, 3);
+        add(1, 2, 3);
+      }
+      continue;
+    }
+    for (std::size_t t = 0; t < split.corners.size(); t += 3) add(split.corners[t], split.corners[t + 1], split.corners[t + 2]);
+  }
+  return out;
+}
+
 }  // namespace
 
 MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
   const std::string text = read_input_file(file, where, InputKind::Obj);
-  check_face_indices(text, where);
+  const std::vector<std::size_t> face_corners = check_face_indices(text, where);
   check_vertex_numbers(text, where);
 
   tinyobj::attrib_t attrib;
@@ -260,7 +323,9 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   std::string warn, err;
   MtlReader reader(file.parent_path(), where);
   std::istringstream stream(text);
-  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &mtls, &warn, &err, &stream, &reader, true, false);
+  // Faces as they are (triangulate = false): tinyobjloader's own ear clipping misreads concave faces and takes
+  // quadratic time and more; quads and larger faces are split below.
+  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &mtls, &warn, &err, &stream, &reader, false, false);
   if (!reader.error().empty()) throw Error(reader.error());
   if (!ok || !err.empty()) {
     while (!err.empty() && std::isspace(static_cast<unsigned char>(err.back()))) err.pop_back();
@@ -275,12 +340,22 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   check_finite<3>(attrib.normals, "normal", where);
   check_finite<2>(attrib.texcoords, "texture coordinate", where);
 
-  std::size_t corners = 0;
-  for (const auto& shape : shapes) corners += shape.mesh.indices.size();
+  // Every face as triangles (corner indices into shape.mesh.indices), per shape.
+  std::vector<FaceTriangles> triangles;
+  std::size_t corners = 0, degenerate = 0;
+  std::size_t next_face = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    triangles.push_back(triangulate_faces(shape.mesh, attrib, where, face_corners, next_face));
+    corners += triangles.back().corners.size();
+    degenerate += triangles.back().degenerate_faces;
+  }
   check_triangle_count(corners / 3, where);
-  if (corners == 0) throw Error(where, "no faces in " + file.string());
+  if (corners == 0)
+    throw Error(where, degenerate ? "every face of " + file.string() + " is degenerate (no area)"
+                                  : "no faces in " + file.string());
 
   MeshData m;
+  m.degenerate_faces = degenerate;
   for (std::size_t i = 0; i < mtls.size(); ++i) {
     m.materials.push_back(convert_material(mtls[i], reader.folder_of(i)));
     m.bump_maps.push_back(mtls[i].bump_texname.empty() ? fs::path()
@@ -304,20 +379,17 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   std::vector<bool> needs_normal;  // per vertex: no usable normal in the file
   m.indices.reserve(corners);
   m.triangle_materials.reserve(corners / 3);
-  for (const auto& shape : shapes) {
-    std::size_t corner = 0;
-    for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
-      const std::size_t count = shape.mesh.num_face_vertices[f];
-      if (count != 3) {  // triangulation leaves none; lines and points are not faces
-        corner += count;
-        continue;
-      }
+  for (std::size_t s = 0; s < shapes.size(); ++s) {
+    const tinyobj::shape_t& shape = shapes[s];
+    const std::vector<std::uint32_t>& corner_of = triangles[s].corners;
+    for (std::size_t t = 0; t < corner_of.size(); t += 3) {
+      const std::size_t f = triangles[s].faces[t / 3];
       const int material = f < shape.mesh.material_ids.size() ? shape.mesh.material_ids[f] : -1;
       const bool known = material >= 0 && std::size_t(material) < mtls.size();
       uses_default = uses_default || !known;
       m.triangle_materials.push_back(known ? std::uint32_t(material) : default_material);
-      for (std::size_t k = 0; k < 3; ++k, ++corner) {
-        const tinyobj::index_t& idx = shape.mesh.indices[corner];
+      for (std::size_t k = 0; k < 3; ++k) {
+        const tinyobj::index_t& idx = shape.mesh.indices[corner_of[t + k]];
         if (idx.vertex_index < 0 || idx.vertex_index >= positions || idx.texcoord_index >= uvs ||
             idx.normal_index >= normals)
           throw Error(where, "face index out of range in " + file.string());

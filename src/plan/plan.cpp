@@ -208,6 +208,7 @@ MeshPlan plan_mesh(const ObjectDesc& object, const std::string& mesh_key) {
       m.vertices = object.obj_mesh ? object.obj_mesh->vertex_count() : 0;
       m.triangles = object.obj_mesh ? object.obj_mesh->triangle_count() : 0;
       if (object.obj_mesh) m.notes = object.obj_mesh->notes;
+      m.degenerate_faces = object.obj_mesh ? object.obj_mesh->degenerate_faces : 0;
       break;
   }
   // position, normal, tangent, uv per vertex; three indices and a material id per triangle
@@ -705,6 +706,7 @@ std::string FramePlan::describe() const {
   for (const MeshPlan& m : meshes) {
     s << "  " << m.object << ": " << m.kind << ", " << m.vertices << " vertices, " << m.triangles << " triangles, "
       << mib(m.bytes);
+    if (m.degenerate_faces > 0) s << ", " << m.degenerate_faces << " degenerate faces dropped";
     if (m.vertex_weights >= 0) s << ", per-vertex weights of " << materials[std::size_t(m.vertex_weights)].name;
     if (!m.mtl_materials.empty() && (m.mtl_materials.size() > 1 || m.mtl_materials[0] != m.material)) {
       s << (m.kind.starts_with("gltf") ? ", glTF materials:" : ", MTL materials:");
@@ -766,7 +768,8 @@ nlohmann::json FramePlan::to_json() const {
     nlohmann::json mtl = nlohmann::json::array();
     for (std::uint32_t mat : m.mtl_materials) mtl.push_back(materials[mat].name);
     j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
-                           {"bytes", m.bytes}, {"material", materials.empty() ? "" : materials[m.material].name},
+                           {"degenerate_faces", m.degenerate_faces}, {"bytes", m.bytes},
+                           {"material", materials.empty() ? "" : materials[m.material].name},
                            {"mtl_materials", mtl}, {"warnings", m.notes}});
   }
   j["items"] = items();

@@ -270,9 +270,10 @@ objs = [
     ("face_index_word.obj", tri + "f a b c\n", "line 4: cannot read the face index 'a'"),
     ("face_index_float.obj", tri + "f 1.5 2 3\n", "cannot read the face index '1.5'"),
     ("face_too_many_slashes.obj", tri + "f 1/1/1/1 2 3\n", "line 4:"),
-    ("face_too_many_vertices.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf " + " ".join(["1", "2", "3"] * 100) + "\n",
-     "line 4: a face has more than 256 vertices"),
-    ("face_one_megabyte_line.obj", put_big("obj/face_one_megabyte_line.obj", (tri + "f", 1), (" 1 2 3", 180000), ("\n", 1)) and None, "a face has more than 256 vertices"),
+    ("face_one_megabyte_line.obj", put_big("obj/face_one_megabyte_line.obj", (tri + "f", 1), (" 1 2 3", 180000), ("\n", 1)) and None,
+     "a concave face of 540000 corners (23171 of them concave) is too complex to triangulate"),
+    ("ngon_collinear_only.obj", "".join("v %d %d 0\n" % (i, 2 * i) for i in range(6)) + "f 1 2 3 4 5 6\n",
+     "obj/ngon_collinear_only.obj is degenerate (no area)"),
     ("vertex_nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component 'nan' is not a finite number"),
     ("vertex_inf.obj", "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component 'inf'"),
     ("vertex_minus_inf.obj", "v 0 0 0\nv 0 -inf 0\nv 0 1 0\nf 1 2 3\n", "line 2: position component '-inf'"),
@@ -298,6 +299,29 @@ for name, _, message in objs:
     if message is None:
         continue
     case("obj_" + name.replace(".", "_"), render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/%s"}}' % name), message)
+# N-gons qdmr accepts (`qdmr plan` says what they became; nothing is written): a convex 1000-gon, a concave
+# 100-gon (a star), a self-intersecting one (a pentagram: each corner joined to the second next) and a collinear
+# one beside a triangle, dropped and counted.
+import math
+def ngon(points):
+    return "".join("v %.9f %.9f 0\n" % p for p in points) + "f " + " ".join(str(i + 1) for i in range(len(points))) + "\n"
+ngons = [
+    ("ngon_convex_1000.obj", ngon([(math.cos(2 * math.pi * i / 1000), math.sin(2 * math.pi * i / 1000)) for i in range(1000)]),
+     "1000 vertices, 998 triangles"),
+    ("ngon_concave_100.obj", ngon([((1.0 if i % 2 == 0 else 0.35) * math.cos(2 * math.pi * i / 100),
+                                    (1.0 if i % 2 == 0 else 0.35) * math.sin(2 * math.pi * i / 100)) for i in range(100)]),
+     "100 vertices, 98 triangles"),
+    ("face_300_corners_on_3_points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf " + " ".join(["1", "2", "3"] * 100) + "\n",
+     "3 vertices, 298 triangles"),  # a triangle wound 100 times: it crosses itself, n - 2 triangles
+    ("ngon_self_intersecting.obj", ngon([(math.cos(2 * math.pi * (2 * i % 5) / 5), math.sin(2 * math.pi * (2 * i % 5) / 5)) for i in range(5)]),
+     "5 vertices, 3 triangles"),
+    ("ngon_collinear.obj", tri + "".join("v %d %d 1\n" % (i, 2 * i) for i in range(6)) + "f 1 2 3\nf 4 5 6 7 8 9\n",
+     "3 vertices, 1 triangles, 0.00 MiB, 1 degenerate faces dropped"),
+]
+for name, text, message in ngons:
+    put("obj/" + name, text)
+    case("obj_" + name.replace(".", "_"), ["plan", "{in}/base.json", "--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/%s"}}' % name],
+         message, code=0)
 case("obj_binary_garbage_obj", render("--set", '/objects/0={"mesh": {"type": "obj", "file": "obj/binary_garbage.obj"}}'), "obj/binary_garbage.obj")
 
 # --- scene files -------------------------------------------------------------------------------------

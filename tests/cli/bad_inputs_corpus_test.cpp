@@ -168,6 +168,14 @@ TEST(BadInputs, Corpus) {
     EXPECT_EQ(result.exit_code, c.at("exit").get<int>());
     const std::vector<std::string> lines = lines_of(result.output);
     ASSERT_FALSE(lines.empty());
+    if (c.at("exit").get<int>() == 0) {  // accepted (a `qdmr plan` of an odd but valid input): what it printed
+      EXPECT_EQ(result.output.find("qdmr: error"), std::string::npos);
+      EXPECT_NE(result.output.find(fragment), std::string::npos) << "expected: " << fragment;
+      EXPECT_TRUE(fs::is_empty(out)) << "something was written to the output folder";
+      EXPECT_EQ(snapshot(in, false), before) << "an input changed or a file appeared next to the inputs";
+      if (testing::Test::HasFailure() && !std::getenv("QDMR_CORPUS_ALL")) break;
+      continue;
+    }
     // libpng prints "libpng error: ..." itself before qdmr's line (OIIO 2.4 keeps its default handler), once
     // per attempt to decode, as two writes: the message, then its newline. Two textures made from one file are
     // decoded at once, so two messages may interleave as "msg msg \n \n" (an empty line, seen in CI): any other

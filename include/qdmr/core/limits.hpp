@@ -31,6 +31,5 @@ inline constexpr std::uint64_t kMaxGltfFileBytes = 1ull << 30;
 inline constexpr std::uint64_t kMaxManifestFileBytes = 64ull << 20;  // check manifests: thousands of checks
 inline constexpr std::uint64_t kMaxImageFileBytes = 4ull << 30;  // a 16384^2 RGBA float image, uncompressed
 inline constexpr int kMaxJsonDepth = 64;                          // nesting of arrays/objects in scenes and --set
-inline constexpr int kMaxFaceVertices = 256;                      // corners of one OBJ face (polygons are ear-clipped)
 
 }  // namespace qdmr::limits

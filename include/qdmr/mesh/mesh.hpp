@@ -25,6 +25,7 @@ struct MeshData {
   std::vector<std::filesystem::path> bump_maps;   // obj: per entry of `materials`, its bump map (empty if none)
   std::vector<CameraDesc> cameras;                // gltf: the drawn nodes' perspective cameras, in qdmr's frame
   std::vector<std::string> notes;                 // gltf: what was derived or ignored, for the plan's warnings
+  std::size_t degenerate_faces = 0;               // obj: faces of 4 or more corners without area, dropped
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return indices.size() / 3; }
@@ -33,6 +34,8 @@ struct MeshData {
 // Builds a primitive or loads an OBJ (with MTL through tinyobjloader). `where` names the scene field for
 // messages ("scene.json: /objects/2/mesh"). Throws qdmr::Error on unreadable files, NaN/infinite data,
 // out-of-range indices. Degenerate triangles are kept (the rasterizer culls them) but their tangents are ignored.
+// OBJ faces of any number of corners are triangulated (concave ones by ear clipping); larger faces without area
+// are dropped and counted in degenerate_faces.
 // Grid: the height map spans the whole grid once (sampled at the vertex UV divided by uv_scale), so
 // uv_scale tiles the material without repeating the relief. OBJ: UVs are multiplied by uv_scale; MTL
 // map_Kd -> albedo, disp -> height with technique pom, else bump/map_Bump -> height for normals only,

@@ -109,6 +109,7 @@ struct MeshPlan {
   std::string kind;
   std::string key;           // content key (with the vertex weights it carries)
   std::uint64_t vertices = 0, triangles = 0, bytes = 0;
+  std::uint64_t degenerate_faces = 0;        // obj: faces without area, dropped (mesh.hpp)
   std::uint32_t material = 0;                // frame material of its triangles (no MTL materials)
   std::vector<std::uint32_t> mtl_materials;  // obj with MTL materials: frame material per mesh-local material
   int vertex_weights = -1;   // per-vertex blend weights of this frame material are stored in the mesh, else -1
