@@ -3,11 +3,14 @@
 Runs as `python3 path/to/qdmr_report RESULTS -o REPORT` (qdmr's `report` command does this). Exit status 0 on
 success, 2 for bad input (one line naming the file and the problem), 1 for anything unexpected. The report is
 built in a temporary folder beside REPORT and renamed into place: an interrupted run leaves the previous report
-or none, never half of one. It never writes into the results folder itself.
+or none, never half of one (a killed run's temporary folder is removed by the next run; Ctrl-C or SIGTERM removes
+it at once and exits 130). It never writes into the results folder itself.
 """
 import argparse
+import errno
 import os
 import shutil
+import signal
 import sys
 import tempfile
 
@@ -35,12 +38,32 @@ def check_output(results, output):
             raise BadResults(f"{output}: a folder with other files in it (not a qdmr report): choose another -o")
 
 
+def remove_stale_staging(parent):
+    """Removes the temporary folders (".report-PID-...", ".report-old-PID-...") of report runs that were killed:
+    those whose process is gone. A folder of a running report is left alone."""
+    for name in os.listdir(parent):
+        if not name.startswith(".report-"):
+            continue
+        pid = name[len(".report-"):].removeprefix("old-").split("-")[0]
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid), 0)
+            continue  # running (or another user's): not ours to remove
+        except ProcessLookupError:
+            pass
+        except (PermissionError, OverflowError):
+            continue
+        shutil.rmtree(os.path.join(parent, name), ignore_errors=True)
+
+
 def write_report(study, output, worst, crop):
     from qdmr_report.page import Page  # matplotlib loads here, after the inputs are checked
 
     parent = os.path.dirname(os.path.abspath(output))
     os.makedirs(parent, exist_ok=True)
-    staging = tempfile.mkdtemp(prefix=".report-", dir=parent)
+    remove_stale_staging(parent)
+    staging = tempfile.mkdtemp(prefix=f".report-{os.getpid()}-", dir=parent)
     try:
         page = Page(study, staging, worst_count=worst, crop_size=crop).render()
         with open(os.path.join(staging, "index.html"), "w", encoding="utf-8") as f:
@@ -49,7 +72,7 @@ def write_report(study, output, worst, crop):
             f.write("written by qdmr report; the next report into this folder replaces it\n")
         os.chmod(staging, 0o755)
         if os.path.exists(output):  # a previous report: swap, then delete the old one
-            old = tempfile.mkdtemp(prefix=".report-old-", dir=parent)
+            old = tempfile.mkdtemp(prefix=f".report-old-{os.getpid()}-", dir=parent)
             os.rename(output, os.path.join(old, "report"))
             os.rename(staging, output)
             shutil.rmtree(old, ignore_errors=True)
@@ -58,6 +81,10 @@ def write_report(study, output, worst, crop):
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
+
+
+def stop(signum, frame):
+    raise KeyboardInterrupt
 
 
 def main(argv=None):
@@ -71,6 +98,7 @@ def main(argv=None):
     parser.add_argument("--partial", action="store_true",
                         help="report an unfinished study or a single shard instead of refusing it")
     args = parser.parse_args(argv)
+    signal.signal(signal.SIGTERM, stop)  # like Ctrl-C: the staging folder is removed on the way out
     results = args.results.rstrip("/") or "/"
     output = args.output or results + "-report"
     try:
@@ -89,8 +117,13 @@ def main(argv=None):
               "scripts/setup installs them)", file=sys.stderr)
         return 2
     except OSError as e:
-        print(f"qdmr report: {e.filename or output}: {e.strerror}", file=sys.stderr)
+        # A full or read-only file system is the report folder's; anything else names the file it happened to.
+        where = output if e.errno in (errno.ENOSPC, errno.EROFS, errno.EDQUOT) else e.filename or output
+        print(f"qdmr report: {where}: {e.strerror}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("qdmr report: interrupted (SIGINT or SIGTERM): no report written", file=sys.stderr)
+        return 130
     print(os.path.join(output, "index.html"))
     return 0
 

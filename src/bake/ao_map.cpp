@@ -14,6 +14,7 @@
 #include "bake/content_hash.hpp"
 #include "bake/float_cache.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "bake/ao_pattern.hpp"
 
 namespace qdmr {
@@ -125,11 +126,14 @@ Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& de
   const std::optional<MaxPyramid> pyramid = desc.coarse ? std::optional<MaxPyramid>(field) : std::nullopt;
   const ao::Taps taps = ao::make_taps(desc, field.width, field.height);
   Image map(size.width, size.height, 1);
+  ProgressStep step("AO map " + std::to_string(size.width) + "x" + std::to_string(size.height), size.height);
   tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& rows) {
+    step.advance();  // stops here when asked to (Ctrl-C)
     for (int j = rows.begin(); j < rows.end(); ++j)
       for (int i = 0; i < size.width; ++i)
         map.at(i, j, 0) = float(texel_ao(field, pyramid ? &*pyramid : nullptr, depth_scale, desc, taps, i, j, (i + 0.5) / size.width,
                                          (j + 0.5) / size.height));
+    step.advance(rows.size());
   });
   return map;
 }

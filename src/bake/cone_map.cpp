@@ -13,6 +13,7 @@
 #include <string>
 
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 
 namespace qdmr {
 namespace {
@@ -333,11 +334,16 @@ ConeMap bake_cone_map(const HeightField& field, ConeKind kind) {
   const std::vector<Level> levels = build_hierarchy(g);
   ConeMap map = empty_map(g, kind);
   const Baker baker{g, levels};
+  ProgressStep step(std::string(cone_kind_name(kind)) + " cone map " + std::to_string(g.out_width) + "x" +
+                        std::to_string(g.out_height),
+                    g.out_height);
   tbb::parallel_for(tbb::blocked_range<int>(0, g.out_height, 2), [&](const tbb::blocked_range<int>& rows) {
+    step.advance();  // stops here when asked to (Ctrl-C): within two rows
     for (int j = rows.begin(); j < rows.end(); ++j)
       for (int i = 0; i < g.out_width; ++i)
         map.ratio[std::size_t(j) * std::size_t(g.out_width) + std::size_t(i)] =
             round_toward_zero(baker.bake_texel(i, j));
+    step.advance(rows.size());
   });
   return map;
 }

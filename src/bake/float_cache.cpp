@@ -7,6 +7,7 @@
 #include "bake/content_hash.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_file.hpp"
+#include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/core/error.hpp"
 
 namespace qdmr {
@@ -51,10 +52,13 @@ bool read_float_cache(const std::filesystem::path& file, const FloatCacheId& id,
   if (payload_hash(values) != header.payload_hash) return false;
   for (float v : values)
     if (!(v >= lo && v <= hi)) return false;
+  touch_bake_cache_entry(file);  // recently used: evicted last
   return true;
 }
 
 void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, std::span<const float> values) {
+  const std::uint64_t limit = bake_cache_limit_bytes();
+  if (sizeof(Header) + values.size_bytes() > limit) return;  // larger than the whole cache may be
   std::error_code ec;
   std::filesystem::create_directories(file.parent_path(), ec);
   if (ec) return;
@@ -74,7 +78,9 @@ void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id
       return out.flush() ? "" : "write failed";
     });
   } catch (const Error&) {
+    return;
   }
+  trim_bake_cache(file.parent_path(), limit, file);
 }
 
 }  // namespace qdmr

@@ -1,8 +1,9 @@
 #pragma once
 // The on-disk format of the bake caches (cone maps, AO maps): a fixed 40-byte header in host byte order (the cache
 // is local) and width x height floats. A file is used only if its size, magic, version, tag, size, key and payload
-// checksum all match and every value lies in [lo, hi]; writing goes through a temporary file and a rename, and a
-// cache that cannot be written is skipped (it only costs a rebake next time).
+// checksum all match and every value lies in [lo, hi] (a hit marks the file as used); writing goes through a
+// temporary file and a rename, then evicts the least recently used entries past the cache's limit
+// (qdmr/bake/bake_cache.hpp); a cache that cannot be written is skipped (it only costs a rebake next time).
 #include <array>
 #include <cstdint>
 #include <filesystem>

@@ -108,8 +108,7 @@ void DiffFolder::add_comparison(const std::string& output, const Frame& frame, s
                                 const Image& rendered, const Image& golden, const std::filesystem::path& golden_file) {
   const std::string ext = lower_extension(golden_file);
   write_output(frame, aov, folder_ / (output + ".rendered" + ext));
-  std::filesystem::copy_file(golden_file, folder_ / (output + ".golden" + ext),
-                             std::filesystem::copy_options::overwrite_existing);
+  copy_file_atomically(golden_file, folder_ / (output + ".golden" + ext));
   if (ext != ".png") {
     write_output(frame, aov, folder_ / (output + ".rendered.png"));
     if (ext == ".exr")

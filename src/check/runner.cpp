@@ -12,9 +12,11 @@
 
 #include "check/diff_folder.hpp"
 #include "io/atomic_file.hpp"
+#include "io/os_error.hpp"
 #include "qdmr/check/canonical_hash.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/render/render.hpp"
@@ -98,7 +100,13 @@ public:
     } catch (const std::bad_alloc&) {
       result.status = CheckStatus::Error;
       result.lines.push_back("out of memory");
-    } catch (const std::exception& e) {  // e.g. a file system error writing the diff folder
+    } catch (const Interrupted&) {  // Ctrl-C during a bake: run_checks stops and says so
+      result.status = CheckStatus::Error;
+      result.lines.push_back("interrupted");
+    } catch (const std::filesystem::filesystem_error& e) {  // e.g. a full disk under the diff folder
+      result.status = CheckStatus::Error;
+      result.lines.push_back(os_error_line(e));
+    } catch (const std::exception& e) {
       result.status = CheckStatus::Error;
       result.lines.push_back(e.what());
     }
@@ -301,7 +309,7 @@ CheckRun run_checks(const Manifest& manifest, const CheckOptions& options) {
   std::size_t done = 0;
   const auto work = [&] {
     CheckJob job(manifest, options, jobs == 1 && options.threads == 0 ? 0 : threads);
-    for (std::size_t k; (k = next.fetch_add(1)) < total;) {
+    for (std::size_t k; !stop_requested() && (k = next.fetch_add(1)) < total;) {
       const std::size_t index = order[k];
       std::map<std::string, std::string> hashes;
       CheckResult result = job.run(manifest.checks[index], &hashes);
@@ -318,6 +326,7 @@ CheckRun run_checks(const Manifest& manifest, const CheckOptions& options) {
     for (int j = 0; j < jobs; ++j) workers.emplace_back(work);
     for (std::thread& w : workers) w.join();
   }
+  throw_if_stop_requested();  // Ctrl-C: the goldens written so far are whole; the manifest is left as it was
   if (options.update) run.manifest_rewritten = rewrite_manifest(manifest, new_hashes);
   run.seconds = seconds_since(start);
   return run;

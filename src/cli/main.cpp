@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -16,13 +17,18 @@
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
+#include "cli/interrupt.hpp"
+#include "io/os_error.hpp"
 #include "cli/report.hpp"
+#include "cli/step_progress.hpp"
 #include "cli/study.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output_check.hpp"
+#include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
@@ -33,6 +39,8 @@
 namespace {
 
 constexpr int kExitBadInput = 2;
+
+qdmr::cli::StepProgress steps(::isatty(STDERR_FILENO));  // long preparation steps (qdmr/core/progress.hpp)
 
 struct SceneArgs {
   std::string scene;
@@ -156,8 +164,10 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   }
   qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
+  frame.stats.prepare_steps = steps.finished_steps();
   qdmr::check_outputs(outputs);  // and now also the MTL files, the maps they name and the caches read
 
+  qdmr::throw_if_stop_requested();  // Ctrl-C while drawing: nothing is written
   // Every output written to a temporary first, then all renamed: all of them or none.
   qdmr::OutputBatch batch;
   start = Clock::now();
@@ -166,6 +176,7 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file, write);
   frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (!render.stats.empty()) qdmr::write_stats(frame.stats, render.stats);
+  qdmr::throw_if_stop_requested();  // and while writing: the batch removes its temporaries
   batch.commit();
   const qdmr::RenderStats& s = frame.stats;
   std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
@@ -264,9 +275,43 @@ int run_bake_cone(const ConeArgs& args) {
   }
   const double bake_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   field = {};  // and the field before the write
+  qdmr::throw_if_stop_requested();
   qdmr::write_cone_map_exr(map, out);
   std::printf("%s: %dx%d %s cone map, %.1f ms\n", args.output.c_str(), map.width, map.height,
               qdmr::cone_kind_name(kind), bake_ms);
+  return 0;
+}
+
+std::string mib_text(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(1 << 20));
+  return text;
+}
+
+// qdmr cache: where the bake cache is, its limit, and what it holds (most recently used first).
+int run_cache(bool clear) {
+  const std::filesystem::path folder = qdmr::default_cache_dir();
+  if (clear) {
+    const auto [count, bytes] = qdmr::clear_bake_cache(folder);
+    std::printf("%s: removed %zu entries, %s\n", folder.c_str(), count, mib_text(bytes).c_str());
+    return 0;
+  }
+  const std::uint64_t limit = qdmr::bake_cache_limit_bytes();
+  std::printf("bake cache: %s\n  (QDMR_CACHE_DIR, else $XDG_CACHE_HOME/qdmr, else ~/.cache/qdmr)\n", folder.c_str());
+  std::printf("limit: %s (%s; least recently used entries are removed past it)\n", mib_text(limit).c_str(),
+              qdmr::kBakeCacheLimitVariable);
+  const std::vector<qdmr::BakeCacheEntry> entries = qdmr::bake_cache_entries(folder);
+  std::uint64_t total = 0;
+  for (const qdmr::BakeCacheEntry& e : entries) total += e.bytes;
+  std::printf("%zu entries, %s\n", entries.size(), mib_text(total).c_str());
+  for (auto e = entries.rbegin(); e != entries.rend(); ++e) {
+    const std::time_t used = std::chrono::system_clock::to_time_t(std::chrono::file_clock::to_sys(e->last_used));
+    std::tm local{};
+    ::localtime_r(&used, &local);
+    char when[32];
+    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M", &local);
+    std::printf("  %s  %10s  %-24s  used %s\n", e->file.filename().c_str(), mib_text(e->bytes).c_str(), e->kind.c_str(), when);
+  }
   return 0;
 }
 
@@ -414,6 +459,11 @@ int main(int argc, char** argv) {
   report_cmd->add_option("--crop", report.crop, "Crop size in pixels (8 to 1024, default 96)");
   report_cmd->add_flag("--partial", report.partial, "Report an unfinished study or one shard instead of refusing it");
 
+  CLI::App* cache_cmd = app.add_subcommand(
+      "cache", "Show the bake cache of cone and AO maps: where it is, its size limit, what it holds (docs/scene-format.md)");
+  CLI::App* cache_clear_cmd = cache_cmd->add_subcommand("clear", "Remove every entry of the bake cache");
+  cache_cmd->require_subcommand(0, 1);
+
   // Errors of the command line are one line, like every other error; `qdmr` alone prints the usage.
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
     return std::string("qdmr: error: ") + e.what() + " (see qdmr --help)\n";
@@ -428,6 +478,8 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }
+  qdmr::cli::stop_on_signals();
+  qdmr::set_progress_sink(&steps);  // on the terminal only (logs and CI stay quiet), and for --stats
   try {
     if (render_cmd->parsed()) return run_render(render_scene, render);
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);
@@ -442,8 +494,15 @@ int main(int argc, char** argv) {
     }
     if (diff_cmd->parsed()) return qdmr::cli::run_diff(diff);
     if (report_cmd->parsed()) return qdmr::cli::run_report(report);
+    if (cache_cmd->parsed()) return run_cache(cache_clear_cmd->parsed());
+  } catch (const qdmr::Interrupted&) {
+    std::fprintf(stderr, "qdmr: interrupted (SIGINT or SIGTERM): stopped, nothing half-written\n");
+    return qdmr::cli::kExitInterrupted;
   } catch (const qdmr::Error& e) {
     std::fprintf(stderr, "qdmr: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::fprintf(stderr, "qdmr: error: %s\n", qdmr::os_error_line(e).c_str());
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "qdmr: error: out of memory (try a smaller --width/--height or textures)\n");

@@ -1,25 +1,22 @@
 #include "cli/study.hpp"
 
+#include "cli/interrupt.hpp"
 #include "cli/report.hpp"
 
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/study/spec.hpp"
 #include "qdmr/study/study.hpp"
 
 namespace qdmr::cli {
 namespace {
-
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted = true; }
 
 StudyShard parse_shard(const std::string& text) {
   StudyShard shard;
@@ -83,16 +80,14 @@ int run_study(const StudyArgs& args) {
     }
     std::fflush(stderr);
   };
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
-  options.stop_requested = [] { return interrupted.load(); };
+  options.stop_requested = [] { return qdmr::stop_requested(); };  // main's stop_on_signals
   const StudyRun run = qdmr::run_study(spec, args.output, options);
   std::printf("%s: %zu configurations (%zu rendered now, %zu kept from before; assets prepared %zu times) in %.1f s; "
               "results.csv, results.json, pareto.csv\n",
               args.output.c_str(), run.total, run.rendered, run.resumed, run.asset_builds, run.seconds);
   if (run.stopped) {
     std::fprintf(stderr, "study: interrupted; the results so far are valid, continue with --resume\n");
-    return 130;
+    return kExitInterrupted;
   }
   if (args.report) {
     ReportArgs report;

@@ -3,7 +3,12 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cctype>
 #include <filesystem>
 #include <map>
@@ -159,6 +164,31 @@ bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_st
 
 void close(Reader* reader) { delete reader; }
 
+// `bytes` into the existing file `path` (truncated), every write() and the close() checked: a full disk is an
+// error with its reason, never a short file.
+bool write_bytes(const std::string& path, const std::vector<unsigned char>& bytes, std::string& error) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) {
+    error = std::strerror(errno);
+    return false;
+  }
+  for (std::size_t done = 0; done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      error = n < 0 ? std::strerror(errno) : "short write";
+      ::close(fd);
+      return false;
+    }
+    done += std::size_t(n);
+  }
+  if (::close(fd) != 0) {
+    error = std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
 bool write(const std::string& path, const WriteSpec& spec, const void* data, std::string& error) {
   OIIO::ImageSpec s(spec.width, spec.height, spec.channels, type_desc(spec.type));
   if (!spec.channel_names.empty()) s.channelnames = spec.channel_names;
@@ -169,10 +199,19 @@ bool write(const std::string& path, const WriteSpec& spec, const void* data, std
     error = OIIO::geterror();
     return false;
   }
-  if (output->open(path, s) && output->write_image(type_desc(spec.type), data) && output->close()) return true;
-  error = output->geterror();
-  if (error.empty()) error = "unknown error";
-  return false;
+  // OpenEXR files are encoded into memory and the bytes go to the file here: OpenEXR's buffered stream loses a
+  // failed final flush (a full disk gave a 0-byte "written" file). The TIFF and PNG writers report a full disk
+  // themselves (and TIFF through a memory proxy wrote unreadable files).
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput memory(encoded);
+  const bool in_memory = std::string_view(output->format_name()) == "openexr" && output->supports("ioproxy") &&
+                         output->set_ioproxy(&memory);
+  if (!(output->open(path, s) && output->write_image(type_desc(spec.type), data) && output->close())) {
+    error = output->geterror();
+    if (error.empty()) error = "unknown error";
+    return false;
+  }
+  return !in_memory || write_bytes(path, encoded, error);
 }
 
 void color_map(const float* values, int width, int height, const char* map, float* rgb) {

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -116,6 +117,19 @@ LockedTemporary create_temporary(const std::filesystem::path& file, const std::s
   throw Error(file.string(), "cannot write " + what + ": no temporary file could be created and locked");
 }
 
+// An image library's message ("File output failed") with the OS reason behind it where it has none: the errno
+// of the failed write when it says why, else a full file system when statvfs finds no space left.
+std::string with_os_reason(const std::string& message, int error, const std::filesystem::path& folder) {
+  const auto with = [&](int reason) {
+    const std::string text = std::strerror(reason);
+    return message.find(text) != std::string::npos ? message : message + " (" + text + ")";
+  };
+  if (error == ENOSPC || error == EDQUOT || error == EFBIG || error == EIO || error == EROFS) return with(error);
+  struct statvfs space{};
+  if (::statvfs(folder.c_str(), &space) == 0 && space.f_bavail == 0) return with(ENOSPC);
+  return message;
+}
+
 thread_local OutputBatch* current_batch = nullptr;
 
 }  // namespace
@@ -149,11 +163,13 @@ void write_atomically(const std::filesystem::path& file, const std::string& what
   remove_stale_temporaries(file);
   const LockedTemporary temporary = create_temporary(file, what);
   std::string message;
+  errno = 0;
   try {
     message = write(temporary.path);
   } catch (const std::exception& e) {
     message = e.what();
   }
+  if (!message.empty()) message = with_os_reason(message, errno, folder);
   std::error_code ec;
   if (message.empty() && current_batch) {
     current_batch->pending_.push_back({temporary.path, file, temporary.fd});
@@ -198,9 +214,19 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
 
 void write_text_file(const std::filesystem::path& file, const std::string& text) {
   write_atomically(file, "file", [&](const std::filesystem::path& temporary) -> std::string {
+    errno = 0;
     std::ofstream out(temporary, std::ios::binary);
     out << text;
-    return out.flush() ? "" : "write failed";
+    if (out.flush()) return "";
+    return errno ? std::strerror(errno) : "write failed";  // the OS reason (a full disk) where the stream has it
+  });
+}
+
+void copy_file_atomically(const std::filesystem::path& from, const std::filesystem::path& file) {
+  write_atomically(file, "copy of " + from.string(), [&](const std::filesystem::path& temporary) -> std::string {
+    std::error_code ec;
+    std::filesystem::copy_file(from, temporary, std::filesystem::copy_options::overwrite_existing, ec);
+    return ec ? ec.message() : "";
   });
 }
 

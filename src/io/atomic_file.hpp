@@ -29,6 +29,9 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
 
 void write_text_file(const std::filesystem::path& file, const std::string& text);
 
+// A copy of `from` at `file`, written like every other output (whole or not at all).
+void copy_file_atomically(const std::filesystem::path& from, const std::filesystem::path& file);
+
 // While an OutputBatch lives, write_atomically on this thread writes the temporary but defers the rename:
 // commit() renames every file (after all of them were written), the destructor removes the temporaries of an
 // uncommitted batch. A job with several outputs thus writes all or none of them.

@@ -8,6 +8,7 @@
 
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/twin_texels.hpp"
@@ -178,6 +179,8 @@ private:
                 assets_.texture_stats[i] = it->second.second;
                 return;
               }
+              const ProgressStep step("texture " + std::to_string(request.width) + "x" + std::to_string(request.height) +
+                                      " (" + request.where + ")");  // a line on a terminal when it takes seconds
               assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
               record("texture " + request.key);
             }));
@@ -192,6 +195,7 @@ private:
     }
     const MaterialPlan& m = plan_.materials[std::size_t(d.material)];
     const MaterialDesc& desc = m.desc;
+    const ProgressStep step(std::string(derived_kind_name(d.kind)) + " of " + m.name);  // (and Ctrl-C stops here)
     const auto input = [&](std::size_t k) -> const DerivedAsset& { return assets_.derived[std::size_t(d.inputs.at(k))]; };
     const auto mip = [](Image image, TexelFormat format, MipReduce reduce) {
       return std::make_shared<const Texture>(make_mip_texture(image, format, false, reduce));

@@ -1,10 +1,13 @@
 // Runs a study: see qdmr/study/study.hpp.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -13,9 +16,11 @@
 #include <thread>
 
 #include "io/atomic_file.hpp"
+#include "io/folder_lock.hpp"
 #include "qdmr/check/canonical_hash.hpp"
 #include "qdmr/check/compare.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
@@ -271,14 +276,36 @@ nlohmann::ordered_json make_header(const StudySpec& spec, std::size_t configurat
 }
 
 // Appends one line with one write(): a killed process leaves whole lines (and a crash of the machine at most one
-// torn last line, which --resume drops). No fsync: it would cost more than drawing a small configuration.
+// torn last line, which --resume drops). A write that fails part way (a full disk) is cut off again, so the file
+// keeps whole lines. No fsync: it would cost more than drawing a small configuration. Only the holder of the
+// folder's lock appends.
 void append_line(const std::filesystem::path& file, const std::string& line) {
   const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(file.string(), "cannot open for appending");
+  if (fd < 0) throw Error(file.string(), std::string("cannot open for appending: ") + std::strerror(errno));
+  struct stat before{};
+  const bool sized = ::fstat(fd, &before) == 0;
   const std::string text = line + "\n";
   const ssize_t written = ::write(fd, text.data(), text.size());
+  const int error = errno;
+  if (written != ssize_t(text.size()) && written > 0 && sized) static_cast<void>(::ftruncate(fd, before.st_size));
   ::close(fd);
-  if (written != ssize_t(text.size())) throw Error(file.string(), "short write (disk full?)");
+  if (written != ssize_t(text.size()))
+    throw Error(file.string(), std::string("cannot append a row: ") +
+                                   (written < 0 ? std::strerror(error) : "short write (disk full?)"));
+}
+
+// The rows an earlier run left in `file` (none when it does not exist: a run killed before its first row), with a
+// torn last line (a killed write) cut off the file, so that appending continues after the last whole row.
+std::vector<StudyRow> rows_to_resume(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) return {};
+  std::uint64_t valid = 0;
+  std::vector<StudyRow> rows = read_study_rows(file, &valid);
+  if (std::filesystem::file_size(file, ec) != valid || ec) {
+    std::filesystem::resize_file(file, valid, ec);
+    if (ec) throw Error(file.string(), "cannot cut its half-written last row: " + ec.message());
+  }
+  return rows;
 }
 
 // The configurations in the order that re-prepares least: grouped by what their plan builds (the items of the
@@ -345,7 +372,10 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
                                               measurers[0]->renderer().threads(), isa_name(measurers[0]->renderer().isa()));
   header["machine"]["jobs"] = jobs;
 
-  std::filesystem::create_directories(out);
+  std::error_code made;
+  const bool created = std::filesystem::create_directories(out, made);
+  if (made) throw Error(out.string(), "cannot create the results folder: " + made.message());
+  const FolderLock lock_folder(out, "study", created);  // two runs on one folder would interleave their rows
   const std::filesystem::path rows_file = out / "rows.jsonl", header_file = out / "study.json";
   std::vector<StudyRow> rows;
   if (std::filesystem::exists(rows_file) || std::filesystem::exists(header_file)) {
@@ -362,9 +392,7 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
                                     spec.hash + "): --resume continues the same spec only");
     if (old["shard"] != header["shard"])
       throw Error(out.string(), "holds shard " + old["shard"].dump() + ", not " + header["shard"].dump());
-    std::uint64_t valid = 0;
-    rows = read_study_rows(rows_file, &valid);
-    std::filesystem::resize_file(rows_file, valid);  // drop a torn last line
+    rows = rows_to_resume(rows_file);
   }
   write_text_file(header_file, header.dump(2) + "\n");
   const bool keep = !spec.keep.empty();
@@ -436,6 +464,10 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
           write_study_results(results_header(), rows, out);
           last_write = Clock::now();
         }
+      } catch (const Interrupted&) {  // a long bake stopped by Ctrl-C: the rows so far are the result
+        const std::lock_guard<std::mutex> guard(lock);
+        run.stopped = true;
+        return;
       } catch (...) {
         const std::lock_guard<std::mutex> guard(lock);
         if (!failure) failure = std::current_exception();
@@ -504,7 +536,10 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
   for (int p : present) missing += p == 0 ? 1 : 0;
   if (missing) throw Error("study merge", std::to_string(missing) + " configuration(s) have no row: resume the unfinished shards first");
   header["shard"] = {1, 1};
-  std::filesystem::create_directories(out);
+  std::error_code made;
+  const bool created = std::filesystem::create_directories(out, made);
+  if (made) throw Error(out.string(), "cannot create the merged folder: " + made.message());
+  const FolderLock lock_folder(out, "study merge", created);
   write_text_file(out / "study.json", header.dump(2) + "\n");
   std::sort(rows.begin(), rows.end(),
             [](const StudyRow& a, const StudyRow& b) { return a["index"].get<std::size_t>() < b["index"].get<std::size_t>(); });
@@ -521,7 +556,7 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
       const std::filesystem::path target = out / "images" / entry.path().filename();
       std::filesystem::remove(target, error);
       std::filesystem::create_hard_link(entry.path(), target, error);
-      if (error) std::filesystem::copy_file(entry.path(), target);
+      if (error) copy_file_atomically(entry.path(), target);
     }
   }
   header["run"] = {{"wall_seconds", wall_seconds}, {"shards", count}, {"longest_shard_seconds", longest_shard}};

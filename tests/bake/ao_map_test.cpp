@@ -2,6 +2,8 @@
 // independence and the content-hash cache.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -123,14 +125,19 @@ TEST(AoMap, CacheMissThenHitThenCorruptFilesAreRebuilt) {
   const std::string good = read_file(file);
   EXPECT_EQ(good.size(), 40 + 16 * 12 * sizeof(float));  // header + values
 
-  // A hit leaves the file alone (a rebuild would replace it: new modification time).
+  // A hit leaves the file alone (a rebuild would replace it: another inode) and marks it as used (its
+  // modification time: the cache evicts the least recently used, qdmr/bake/bake_cache.hpp).
   const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(24);
   fs::last_write_time(file, old_time);
+  struct stat before{}, after{};
+  ASSERT_EQ(::stat(file.c_str(), &before), 0);
   const Image hit = load_or_bake_ao_map(f, 0.05, d, dir / "cache");
   EXPECT_EQ(hit.texels, expected.texels);
   EXPECT_EQ(hit.width, 16);
   EXPECT_EQ(hit.height, 12);
-  EXPECT_EQ(fs::last_write_time(file), old_time);
+  ASSERT_EQ(::stat(file.c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino);
+  EXPECT_GT(fs::last_write_time(file), old_time);
 
   std::string payload_flip = good;
   payload_flip[good.size() - 3] ^= 0x40;

@@ -4,6 +4,8 @@
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+
+#include <sys/stat.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -432,11 +434,16 @@ TEST(ConeMapCache, MissThenHitThenCorruptFilesAreRebuilt) {
   const std::string good = read_file(file);
   EXPECT_EQ(good.size(), 40 + 16 * 12 * sizeof(float));  // header + ratios
 
-  // A hit leaves the file alone (a rebuild would replace it: new modification time).
+  // A hit leaves the file alone (a rebuild would replace it: another inode) and marks it as used (its
+  // modification time: the cache evicts the least recently used, qdmr/bake/bake_cache.hpp).
   const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(24);
   fs::last_write_time(file, old_time);
+  struct stat before{}, after{};
+  ASSERT_EQ(::stat(file.c_str(), &before), 0);
   EXPECT_EQ(load_or_bake_cone_map(f, ConeKind::Relaxed, dir.path() / "cache").ratio, expected.ratio);
-  EXPECT_EQ(fs::last_write_time(file), old_time);
+  ASSERT_EQ(::stat(file.c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino);
+  EXPECT_GT(fs::last_write_time(file), old_time);
 
   std::string payload_flip = good;
   payload_flip[good.size() - 3] ^= 0x40;

@@ -2,12 +2,15 @@
 // after a kill equal to an uninterrupted run, merge refusing missing or foreign shards, folders never mixed.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -122,6 +125,82 @@ TEST(StudyCommand, ResumeAfterAKillGivesTheRowsOfAnUninterruptedRun) {
   const CommandResult other = study(dir, {"-o", (dir / "cut").string(), "--resume"});
   EXPECT_EQ(other.exit_code, 2);
   EXPECT_NE(other.output.find("holds results of another spec"), std::string::npos) << other.output;
+}
+
+// Every state a kill can leave a folder in, made by hand from a finished run's files: nothing yet, the header
+// only (killed before the first row: the state of issue #57), an empty rows file, half a first row, whole rows
+// and half a row, a header temporary of a dead process. --resume finishes each with the rows of the
+// uninterrupted run; a half row is cut, never kept.
+TEST(StudyCommand, ResumeFinishesEveryStateAKillCanLeave) {
+  TempDir dir;
+  write_spec(dir);
+  ASSERT_EQ(study(dir, {"-o", (dir / "full").string()}).exit_code, 0);
+  const std::string header = read_file(dir / "full" / "study.json");
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(dir / "full" / "rows.jsonl");
+    for (std::string line; std::getline(in, line);) lines.push_back(line + "\n");
+  }
+  ASSERT_EQ(lines.size(), 6u);
+  const std::string half = lines[2].substr(0, lines[2].size() / 2);
+  struct State {
+    const char* name;
+    bool header;
+    std::optional<std::string> rows;  // absent: no rows.jsonl
+    std::size_t kept;                 // rows the resumed run keeps
+  };
+  const State states[] = {{"empty_folder", false, std::nullopt, 0},
+                          {"header_only", true, std::nullopt, 0},
+                          {"empty_rows", true, "", 0},
+                          {"half_first_row", true, half, 0},
+                          {"rows_and_half_row", true, lines[0] + lines[1] + half, 2}};
+  for (const State& state : states) {
+    SCOPED_TRACE(state.name);
+    const fs::path folder = dir / state.name;
+    fs::create_directories(folder);
+    if (state.header) write_file(folder / "study.json", header);
+    if (state.rows) write_file(folder / "rows.jsonl", *state.rows);
+    const CommandResult resumed = study(dir, {"-o", folder.string(), "--resume"});
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+    EXPECT_NE(resumed.output.find(std::to_string(state.kept) + " kept from before"), std::string::npos) << resumed.output;
+    EXPECT_EQ(deterministic_rows(folder), deterministic_rows(dir / "full"));
+  }
+  // A header temporary of a process that is gone (killed while writing study.json the first time): the run
+  // starts afresh, without --resume too, and removes it.
+  const fs::path folder = dir / "header_temporary";
+  fs::create_directories(folder);
+  write_file(folder / ".study.json.tmp2147483647-0.json", header.substr(0, 10));
+  const CommandResult fresh = study(dir, {"-o", folder.string()});
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.output;
+  EXPECT_EQ(deterministic_rows(folder), deterministic_rows(dir / "full"));
+  EXPECT_FALSE(fs::exists(folder / ".study.json.tmp2147483647-0.json"));
+}
+
+// A second study on a folder that a running one writes (two shards given the same -o, a requeued job racing its
+// zombie) is refused with one line naming the folder and the holder, and writes nothing. Here the test itself
+// holds the folder's lock as a running study would (faults.injection races two real studies); once released, the
+// folder is a study's like any other.
+TEST(StudyCommand, ASecondRunOnTheSameFolderIsRefused) {
+  TempDir dir;
+  write_spec(dir);
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  const int fd = ::open((out / ".qdmr-lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  const std::string pid = std::to_string(::getpid()) + "\n";
+  ASSERT_EQ(::write(fd, pid.data(), pid.size()), ssize_t(pid.size()));
+  const CommandResult second = study(dir, {"-o", out.string()});
+  EXPECT_EQ(second.exit_code, 2) << second.output;
+  EXPECT_NE(second.output.find(out.string() + ": is in use by another qdmr study (process " + std::to_string(::getpid()) +
+                               "): wait until it ends, or choose another -o"),
+            std::string::npos) << second.output;
+  EXPECT_FALSE(fs::exists(out / "study.json"));
+  EXPECT_FALSE(fs::exists(out / "rows.jsonl"));
+  ::close(fd);  // the lock goes with its holder
+  const CommandResult after = study(dir, {"-o", out.string()});
+  ASSERT_EQ(after.exit_code, 0) << after.output;
+  EXPECT_EQ(deterministic_rows(out).size(), 6u);
 }
 
 TEST(StudyCommand, MergeRefusesMissingDuplicateAndForeignShards) {

@@ -38,6 +38,13 @@ struct TextureCacheStats {
   std::uint64_t footprint_bytes = 0;  // the textures' memory in this layout (padding and 3D slices included)
 };
 
+// A long preparation step (a cone or AO bake) and its wall time: filled by the command from its progress sink
+// (qdmr/core/progress.hpp), one line each in `--stats`.
+struct PrepareStep {
+  std::string name;
+  double ms = 0;
+};
+
 struct RenderStats {
   // Milliseconds per stage; load and write are filled in by whoever loads and writes. prepare_ms is 0 for a
   // frame that re-used everything.
@@ -57,6 +64,7 @@ struct RenderStats {
   std::string simd_arch;  // the draw kernel's ISA: "sse4.2", "avx2"
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
   std::uint64_t items_built = 0, items_reused = 0;  // prepare: plan items built, and taken from the previous frame
+  std::vector<PrepareStep> prepare_steps;
   std::vector<TextureStat> textures;
   std::vector<MaterialStat> materials;
   TextureCacheStats texture_cache;

@@ -1,0 +1,47 @@
+#pragma once
+// What the command does with long steps' progress (qdmr/core/progress.hpp): on a terminal, a line for the newest
+// step that has run for a second ("relaxed cone map 4096x4096  37% (12 s)", refreshed five times a second by a
+// thread of its own, then the step's time when it ends); always, the finished steps for `render --stats`
+// (RenderStats::prepare_steps).
+#include <chrono>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "qdmr/core/progress.hpp"
+#include "qdmr/core/stats.hpp"
+
+namespace qdmr::cli {
+
+class StepProgress final : public ProgressSink {
+public:
+  explicit StepProgress(bool terminal) : terminal_(terminal) {}
+  ~StepProgress() override;
+  void started(const void* step, const std::string& name) override;
+  void advanced(const void* step, const std::string& name, double fraction, double seconds) override;
+  void finished(const void* step, const std::string& name, double seconds) override;
+  std::vector<PrepareStep> finished_steps();
+
+private:
+  using Clock = std::chrono::steady_clock;
+  struct Running {
+    std::string name;
+    Clock::time_point start;
+    double fraction = -1;  // unknown
+  };
+  void tick();  // the terminal line's thread
+
+  bool terminal_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool ending_ = false;
+  std::thread ticker_;
+  std::map<const void*, Running> running_;
+  const void* shown_ = nullptr;  // the step on the terminal line now
+  std::vector<PrepareStep> finished_;
+};
+
+}  // namespace qdmr::cli
