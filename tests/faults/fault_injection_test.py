@@ -278,9 +278,12 @@ def test_the_bake_cache_stays_within_its_limit_and_rebuilds_a_damaged_entry(work
     for cells in (3, 4, 5, 6):  # four cone maps of 256 KiB and a 40-byte header: three fit in 1 MiB
         out = os.path.join(work, f"cone-{cells}.png")
         before = set(os.listdir(cache)) if os.path.isdir(cache) else set()
-        r = run(["render", cone_scene(work, cells), "--width", "96", "--height", "54", "-o", out], env=limited)
+        stats = os.path.join(work, f"cone-{cells}.stats.json")
+        r = run(["render", cone_scene(work, cells), "--width", "96", "--height", "54", "-o", out, "--stats", stats], env=limited)
         assert r.returncode == 0, r.stderr
         images[cells] = open(out, "rb").read()
+        steps = json.load(open(stats))["prepare"]["steps"]  # a line per preparation step, the bake among them
+        assert any(s["name"] == "relaxed cone map 256x256" and s["ms"] > 0 for s in steps), steps
         added = sorted(set(os.listdir(cache)) - before)
         assert len(added) == 1 and added[0].startswith("cone-relaxed-"), added
         entries.append(added[0])
