@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""What qdmr costs from Python (docs/performance.md, "qdmr from Python"), against the command doing the same:
+
+  - draw: `Renderer.draw()` timed around the call (the frame's arrays included) against `qdmr bench`'s median warm
+    draw of the same scene, size, threads and ISA, at 480x270 and 1920x1080 (target <= 1.05x);
+  - study: `qdmr.study.run` in process against `qdmr study` (a process), wall time of the 100-configuration study
+    of bench/study_overhead.py (target <= 1.1x);
+  - dask: a shipped study (studies/filtering.json: 54 configurations) on a Dask LocalCluster of 2 single-thread
+    worker processes against one process with 1 thread, wall time (target <= 0.6x); the cluster's start is timed
+    apart.
+
+Run it on a quiet machine (the load average is printed), with Debian's python3 and the build's package:
+  PYTHONPATH=build/release/python /usr/bin/python3 bench/python_costs.py [-n 3] [-B build/release] [--only draw]
+"""
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_util  # noqa: E402
+
+import qdmr  # noqa: E402
+
+PLANE = os.path.join(bench_util.ROOT, "scenes", "plane.json")
+STUDY_100 = {
+    "scene": PLANE, "width": 480, "height": 270, "frames": 3, "warmup": 1, "metrics": ["time", "iterations"],
+    "axes": [
+        {"name": "technique", "path": "/materials/bricks/technique/name", "values": ["normal", "pom", "relief", "qdm", "csm"]},
+        {"name": "elevation", "camera": "elevation", "range": {"from": 10, "to": 80, "steps": 10}},
+        {"name": "depth", "path": "/materials/bricks/technique/depth_scale", "values": [0.02, 0.05]},
+    ],
+}
+
+
+def load():
+    return f"{os.getloadavg()[0]:.2f}"
+
+
+def draw_costs(args, cli, width, height, frames=30, warmup=3):
+    """Median ms of draw() from Python and of `qdmr bench`'s draws, the same scene and settings."""
+    python, command = [], []
+    for _ in range(args.n):
+        renderer = qdmr.Renderer(threads=args.threads)
+        renderer.set_scene(qdmr.load_scene(PLANE, {"/output/width": width, "/output/height": height}))
+        times = []
+        for k in range(warmup + frames):
+            start = time.perf_counter()
+            frame = renderer.draw()
+            frame.color  # the array a caller gets
+            if k >= warmup:
+                times.append((time.perf_counter() - start) * 1000.0)
+        python.append(statistics.median(times))
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "b.json")
+            subprocess.run([cli, "bench", PLANE, "--frames", str(frames), "--warmup", str(warmup), "--threads",
+                            str(args.threads), "--isa", renderer.isa, "--width", str(width), "--height", str(height),
+                            "--json", out, "--image", os.path.join(tmp, "b.png")],
+                           check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            with open(out) as f:
+                command.append(json.load(f)["draw_ms"]["median"])
+    return python, command
+
+
+def study_costs(args, cli):
+    python, command = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        spec = os.path.join(tmp, "s.json")
+        with open(spec, "w") as f:
+            json.dump(STUDY_100, f)
+        for k in range(args.n):
+            start = time.perf_counter()
+            subprocess.run([cli, "study", spec, "-o", os.path.join(tmp, f"c{k}"), "--threads", str(args.threads)],
+                           check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            command.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            qdmr.study.run(spec, os.path.join(tmp, f"p{k}"), threads=args.threads)
+            python.append(time.perf_counter() - start)
+    return python, command
+
+
+def dask_costs(args):
+    from distributed import Client, LocalCluster
+    spec = os.path.join(bench_util.ROOT, "studies", "filtering.json")
+    one, spread, starts = [], [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(args.n):
+            start = time.perf_counter()
+            qdmr.study.run(spec, os.path.join(tmp, f"one{k}"), threads=1)
+            one.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+                    Client(cluster) as client:
+                client.run(lambda: __import__("qdmr").__version__)  # every worker started and qdmr imported
+                starts.append(time.perf_counter() - start)
+                start = time.perf_counter()
+                qdmr.study.run(spec, os.path.join(tmp, f"dask{k}"), client=client)
+                spread.append(time.perf_counter() - start)
+    return one, spread, starts
+
+
+def main():
+    parser = bench_util.arguments(__doc__.split("\n")[0])
+    parser.add_argument("--threads", type=int, default=2, help="threads of the draw and study cases (default 2)")
+    parser.add_argument("--only", choices=["draw", "study", "dask"], help="one case only")
+    args = parser.parse_args()
+    cli = os.path.join(args.B, "qdmr")
+    print(f"qdmr {qdmr.__version__} ({qdmr.__file__}), {os.cpu_count()} cores, load average {load()}")
+    if args.only in (None, "draw"):
+        for width, height in ((480, 270), (1920, 1080)):
+            python, command = draw_costs(args, cli, width, height)
+            ratios = [p / c for p, c in zip(python, command)]
+            print(f"draw {width}x{height}, {args.threads} threads: Python draw() {statistics.median(python):.3f} ms "
+                  f"({min(python):.3f} - {max(python):.3f}), qdmr bench {statistics.median(command):.3f} ms "
+                  f"({min(command):.3f} - {max(command):.3f}): ratio {statistics.median(ratios):.3f} "
+                  f"(target <= 1.05); load {load()}")
+    if args.only in (None, "study"):
+        python, command = study_costs(args, cli)
+        ratios = [p / c for p, c in zip(python, command)]
+        print(f"study, 100 configurations, {args.threads} threads: qdmr.study.run {statistics.median(python):.2f} s "
+              f"({min(python):.2f} - {max(python):.2f}), qdmr study {statistics.median(command):.2f} s "
+              f"({min(command):.2f} - {max(command):.2f}): ratio {statistics.median(ratios):.3f} (target <= 1.1); "
+              f"load {load()}")
+    if args.only in (None, "dask"):
+        one, spread, starts = dask_costs(args)
+        ratios = [s / o for s, o in zip(spread, one)]
+        print(f"dask, studies/filtering.json: one process (1 thread) {statistics.median(one):.2f} s "
+              f"({min(one):.2f} - {max(one):.2f}), LocalCluster 2 x 1 thread {statistics.median(spread):.2f} s "
+              f"({min(spread):.2f} - {max(spread):.2f}): ratio {statistics.median(ratios):.3f} (target <= 0.6); "
+              f"the cluster's start {statistics.median(starts):.2f} s apart, with it "
+              f"{statistics.median([(s + t) / o for s, t, o in zip(spread, starts, one)]):.3f}; load {load()}")
+
+
+if __name__ == "__main__":  # LocalCluster's worker processes import this module again
+    main()
