@@ -120,6 +120,27 @@ def test_study_killed_at_any_moment_resumes_to_the_rows_of_an_uninterrupted_run(
         assert temporaries(out) == [], f"killed after {moment:.3f} s"
 
 
+def test_study_merge_killed_at_any_moment_ends_as_an_uninterrupted_merge(work, study):
+    spec, reference, _ = study
+    shards = [os.path.join(work, f"shard-{i}") for i in (1, 2)]
+    for i, folder in enumerate(shards, 1):
+        assert run(["study", spec, "-o", folder, "--shard", f"{i}/2"]).returncode == 0
+    merge = lambda out: ["study", "merge", *shards, "-o", out]
+    start = time.monotonic()
+    assert run(merge(os.path.join(work, "merged-full"))).returncode == 0
+    seconds = time.monotonic() - start
+    without_lock = lambda folder: {k: v for k, v in tree(folder).items() if k != ".qdmr-lock"}  # it holds a PID
+    full = without_lock(os.path.join(work, "merged-full"))
+    for i, moment in enumerate(moments(seconds)):
+        out = os.path.join(work, f"merged-cut-{i}")
+        kill_after(merge(out), moment)
+        r = run(merge(out))
+        assert r.returncode == 0, f"killed after {moment:.3f} s: {r.stderr}"
+        assert without_lock(out) == full, f"killed after {moment:.3f} s"
+        assert deterministic_rows(out) == reference
+        assert temporaries(out) == []
+
+
 def check_manifest(folder):
     os.makedirs(folder, exist_ok=True)
     bits = int(re.search(r"bits version (\d+)", run(["--version"]).stdout).group(1))
