@@ -248,6 +248,19 @@ def test_ctrl_c_stops_a_study_at_the_next_configuration_and_a_bake_at_once(work,
     assert err.strip().splitlines()[-1].startswith("qdmr: interrupted")
     assert not os.path.exists(out) and temporaries(work) == []
 
+    # A render whose preparation bakes a 2048² cone map (no cache): SIGINT stops it before anything is written.
+    out = os.path.join(work, "stopped.png")
+    p = subprocess.Popen([QDMR, "render", cone_scene(work, 7, 2048), "--width", "96", "--height", "54", "-o", out],
+                         stderr=subprocess.PIPE, text=True, env=env(QDMR_CACHE_DIR=os.path.join(work, "no-cache")))
+    time.sleep(0.4)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    if p.returncode == 0:
+        pytest.skip("the render finished before the signal")
+    assert p.returncode == 130, err
+    assert err.strip().splitlines()[-1].startswith("qdmr: interrupted")
+    assert not os.path.exists(out) and temporaries(work) == []
+
 
 # --- two processes, one folder or file -------------------------------------------------------------------------
 
@@ -279,14 +292,14 @@ def test_concurrent_renders_to_one_path(work):
 
 # --- the bake cache --------------------------------------------------------------------------------------------
 
-def cone_scene(work, cells):
-    """The plane with relaxed cone stepping over 256² procedural bricks of `cells` rows: a cone map of 256 KiB."""
+def cone_scene(work, cells, size=256):
+    """The plane with relaxed cone stepping over size² procedural bricks of `cells` rows (256²: a 256 KiB map)."""
     scene = json.load(open(PLANE))
     layer = scene["materials"]["bricks"]["layers"][0]
-    layer["height"].update(size=256, cells=cells)
-    layer["albedo"]["size"] = 256
+    layer["height"].update(size=size, cells=cells)
+    layer["albedo"]["size"] = size
     scene["materials"]["bricks"]["technique"] = {"name": "rcsm", "depth_scale": 0.05}
-    path = os.path.join(work, f"cone-{cells}.json")
+    path = os.path.join(work, f"cone-{cells}-{size}.json")
     with open(path, "w") as f:
         json.dump(scene, f)
     return path
