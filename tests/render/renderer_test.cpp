@@ -1,6 +1,6 @@
 // The persistent renderer: frames equal the one-shot render bit for bit, drawing again changes nothing, a new
-// camera or output size re-prepares nothing, the variant each material runs is the one the plan names, and
-// memory does not grow over many frames.
+// camera or output size re-prepares nothing, the variant each material runs is the one the plan names,
+// memory does not grow over many frames, and a recycled frame's buffers are drawn into.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -34,6 +34,30 @@ TEST(Renderer, FramesEqualTheOneShotRenderAndRepeat) {
     ASSERT_EQ(frame.aovs.size(), 2u);
     for (std::size_t a = 0; a < 2; ++a) EXPECT_TRUE(same_bits(frame.aovs[a].pixels, one_shot.aovs[a].pixels));
   }
+}
+
+// A frame taken out and handed back (as the Python module does with frames nobody holds any more): the next draw
+// draws into its buffers, the same bits as before; a taken frame that is kept is not touched by later draws.
+TEST(Renderer, DrawsIntoARecycledFrame) {
+  const SceneDesc scene = small_scene("plane");
+  RenderOptions options;
+  options.aovs = {Aov::Depth};
+  Renderer renderer(options);
+  renderer.set_scene(scene);
+  renderer.draw();
+  Frame kept = renderer.take_frame();
+  const PixelBuffer kept_color = kept.color;
+  renderer.draw();  // into new buffers: `kept` stays as it was
+  EXPECT_TRUE(same_bits(kept.color, kept_color));
+  Frame spare = renderer.take_frame();
+  const float* spare_color = spare.color.data();
+  const float* spare_depth = spare.aovs.at(0).pixels.data();
+  renderer.recycle_frame(std::move(spare));
+  const Frame& frame = renderer.draw();
+  EXPECT_EQ(frame.color.data(), spare_color);
+  EXPECT_EQ(frame.aovs.at(0).pixels.data(), spare_depth);
+  EXPECT_TRUE(same_bits(frame.color, kept_color));
+  EXPECT_TRUE(same_bits(frame.aovs.at(0).pixels, kept.aovs.at(0).pixels));
 }
 
 TEST(Renderer, CameraAndSizeChangesRePrepareNothing) {
