@@ -565,13 +565,14 @@ private:
         corners.resize(count);
         for (std::size_t i = 0; i < count; ++i) corners[i] = std::uint32_t(i);
       }
-      const std::vector<std::uint32_t> triangles = triangle_list(corners, prim.mode, at);
+      std::vector<std::uint32_t> triangles = triangle_list(std::move(corners), prim.mode, at);
       check_triangle_count(mesh_.indices.size() / 3 + triangles.size() / 3, where_);
-      append(positions, normals, tangents, uvs, uv_choice, triangles, world, normal_matrix, mirrored, std::uint32_t(slot));
+      append(positions, normals, tangents, uvs, uv_choice, std::move(triangles), world, normal_matrix, mirrored,
+             std::uint32_t(slot));
     }
   }
 
-  std::vector<std::uint32_t> triangle_list(const std::vector<std::uint32_t>& c, int mode, const std::string& at) {
+  std::vector<std::uint32_t> triangle_list(std::vector<std::uint32_t> c, int mode, const std::string& at) {
     std::vector<std::uint32_t> out;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
       if (c.size() % 3 != 0) asset_.fail(at, std::to_string(c.size()) + " corners are not whole triangles");
@@ -592,7 +593,7 @@ private:
   }
 
   void append(const std::vector<float>& positions, const std::vector<float>& normals, const std::vector<float>& tangents,
-              const std::vector<float>& uvs, const TextureChoice& uv_choice, const std::vector<std::uint32_t>& triangles,
+              const std::vector<float>& uvs, const TextureChoice& uv_choice, std::vector<std::uint32_t> triangles,
               const glm::dmat4& world, const glm::dmat3& normal_matrix, bool mirrored, std::uint32_t material) {
     // Without normals each triangle gets its own corners, flat-shaded (glTF 2.0, "Meshes").
     const bool flat = normals.empty();
@@ -619,6 +620,11 @@ private:
       const float w = (tangents[4 * v + 3] < 0.0f) != mirrored ? -1.0f : 1.0f;
       part.tangents.emplace_back(tl > 0.0 && std::isfinite(tl) ? glm::vec3(t / tl) : any_orthogonal(part.normals.back()), w);
     };
+    const std::size_t vertices = flat ? triangles.size() : count;
+    part.positions.reserve(vertices);
+    part.normals.reserve(vertices);
+    part.uvs.reserve(vertices);
+    if (!tangents.empty()) part.tangents.reserve(vertices);
     if (flat) {
       for (std::size_t k = 0; k < triangles.size(); ++k) {
         vertex(triangles[k]);
@@ -633,12 +639,21 @@ private:
       }
     } else {
       for (std::size_t v = 0; v < count; ++v) vertex(v);
-      part.indices = triangles;
+      part.indices = std::move(triangles);
     }
     if (part.tangents.size() != part.positions.size()) {
       part.tangents.clear();
       compute_tangents(part);
       if (has_textures_) note("tangents generated (a primitive has no TANGENT; not MikkTSpace: see docs/scene-format.md)");
+    }
+    if (mesh_.positions.empty()) {  // the first primitive (often the only one): moved, not copied
+      mesh_.positions = std::move(part.positions);
+      mesh_.normals = std::move(part.normals);
+      mesh_.tangents = std::move(part.tangents);
+      mesh_.uvs = std::move(part.uvs);
+      mesh_.indices = std::move(part.indices);
+      mesh_.triangle_materials.assign(mesh_.indices.size() / 3, material);
+      return;
     }
     const auto base = std::uint32_t(mesh_.positions.size());
     mesh_.positions.insert(mesh_.positions.end(), part.positions.begin(), part.positions.end());
@@ -682,7 +697,10 @@ private:
     const std::string image_at = where_ + ": /images/" + std::to_string(source);
     fs::path file;
     if (!image.uri.empty()) {
-      file = (reading_.folder / *relative_uri(image.uri, image_at)).lexically_normal();
+      // tinygltf keeps the URI of an image it did not decode: a file, or a data: URI it could not read.
+      const auto relative = relative_uri(image.uri, image_at);
+      if (!relative) throw Error(image_at, "a data: URI that is not base64 data of a known media type");
+      file = (reading_.folder / *relative).lexically_normal();
     } else {
       if (std::size_t(source) >= reading_.embedded.size() || reading_.embedded[std::size_t(source)].empty())
         throw Error(image_at, "the image has no data");
@@ -841,13 +859,12 @@ std::vector<std::string> prescan(const std::string& json_text, Reading& reading)
 
 MeshData load_gltf(const MeshDesc& desc, const std::string& where) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
-  const std::string bytes = read_input_file(file, where, InputKind::Gltf);
+  std::string bytes = read_input_file(file, where, InputKind::Gltf);
   Reading reading;
   reading.folder = file.parent_path();
   reading.where = where.empty() ? shown_path(file) : where + ": " + shown_path(file);
   const bool binary = looks_like_glb(bytes);
-  const std::string json_text = binary ? std::string(glb_json_chunk(bytes, reading.where)) : bytes;
-  std::vector<std::string> notes = prescan(json_text, reading);
+  std::vector<std::string> notes = prescan(binary ? std::string(glb_json_chunk(bytes, reading.where)) : bytes, reading);
 
   tinygltf::Model model;
   reading.model = &model;
@@ -863,6 +880,7 @@ MeshData load_gltf(const MeshDesc& desc, const std::string& where) {
   } catch (const std::exception& e) {
     throw Error(reading.where, std::string("tinygltf: ") + e.what());
   }
+  std::string().swap(bytes);  // tinygltf holds its own copy of every buffer: the file is no longer needed
   if (!reading.error.empty()) throw Error(reading.error);
   if (!ok || !err.empty()) {
     std::string first = err.substr(0, err.find('\n'));

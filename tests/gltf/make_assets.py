@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the glTF test assets under tests/gltf/assets/ (and the glTF example and scene assets): small, exact,
-deterministic (no timestamps, zlib level 9). Re-run after editing and commit what it writes; tests check the files
-are what this script makes (tests/gltf/assets_test.py).
+deterministic (no timestamps, zlib level 9). Re-run after editing and commit what it writes (the goldens of
+tests/golden/gltf_assets.json and the expectations of tests/mesh/gltf_test.cpp are made from these files).
 
   quad.gltf + quad.bin + checker.png   a textured quad (external buffer and image), the same quad as quad.obj + quad.mtl
   quad_embedded.gltf                   the same asset with its buffer and image as data: URIs

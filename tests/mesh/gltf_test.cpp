@@ -2,6 +2,7 @@
 // tests/gltf/make_assets.py) and what is refused, each refusal naming the file and the element at fault.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -145,6 +146,58 @@ std::string edited_error(const std::function<void(nlohmann::json&)>& edit) {
   return error.rfind(prefix, 0) == 0 ? error.substr(prefix.size()) : error;
 }
 
+bool has_note(const MeshData& m, const std::string& part) {
+  return std::any_of(m.notes.begin(), m.notes.end(), [&](const std::string& n) { return n.find(part) != std::string::npos; });
+}
+
+// A copy of quad.gltf edited by `edit`, loaded.
+MeshData edited(const std::function<void(nlohmann::json&)>& edit) {
+  test::TempDir dir;
+  fs::copy_file(asset("quad.bin"), dir / "quad.bin");
+  fs::copy_file(asset("checker.png"), dir / "checker.png");
+  nlohmann::json doc = nlohmann::json::parse(test::read_file(asset("quad.gltf")));
+  edit(doc);
+  test::write_file(dir / "quad.gltf", doc.dump());
+  return load(dir / "quad.gltf");
+}
+
+TEST(Gltf, TextureTransformSamplerAndFactors) {
+  using J = nlohmann::json;
+  // KHR_texture_transform: uv' = offset + rotation(scale * uv) in glTF's UVs, then v flipped: glTF (0, 1) becomes
+  // (2 * 0 + 0.5, 2 * 1 + 0) = (0.5, 2), qdmr (0.5, 1 - 2).
+  const MeshData moved = edited([](J& d) {
+    d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+        {"KHR_texture_transform", {{"offset", {0.5, 0.0}}, {"scale", {2.0, 2.0}}}}};
+    d["extensionsUsed"] = {"KHR_texture_transform"};
+    d["extensionsRequired"] = {"KHR_texture_transform"};
+  });
+  EXPECT_EQ(moved.uvs[0], glm::vec2(0.5f, -1.0f));
+  EXPECT_EQ(moved.uvs[2], glm::vec2(2.5f, 1.0f));
+  // The base colour texture's sampler: NEAREST_MIPMAP_LINEAR, clamp; a wrapT unlike wrapS is a warning.
+  const MeshData sampled = edited([](J& d) {
+    d["samplers"] = J::array({{{"minFilter", 9986}, {"magFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33648}}});
+    d["textures"][0]["sampler"] = 0;
+  });
+  EXPECT_EQ(sampled.materials[0].sampling.filter, Filter::PointMipLinear);
+  EXPECT_EQ(sampled.materials[0].sampling.address, AddressMode::Clamp);
+  EXPECT_TRUE(has_note(sampled, "wrapT differs from wrapS"));
+  // Factors without a texture: albedo = baseColor x (1 - metallic), F0 from metallic, roughness clamped.
+  const MeshData metal = edited([](J& d) {
+    d["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {1.0, 0.5, 0.0, 1.0}}, {"metallicFactor", 0.5},
+                                                 {"roughnessFactor", 0.0}};
+    d["materials"][0]["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", 2.0}}}};
+    d["materials"][0]["emissiveFactor"] = {1.0, 1.0, 1.0};
+  });
+  const MaterialDesc& m = metal.materials[0];
+  EXPECT_EQ(m.layers[0].albedo.source, TextureSource::Constant);
+  EXPECT_FLOAT_EQ(m.layers[0].albedo.constant.r, 0.5f);
+  EXPECT_FLOAT_EQ(m.layers[0].albedo.constant.g, 0.25f);
+  EXPECT_FLOAT_EQ(m.lighting.roughness, 0.02f);
+  // F0 = 0.04 + (luminance - 0.04) * metallic, luminance = 0.2126 + 0.7152 * 0.5
+  EXPECT_NEAR(m.lighting.specular, 0.04 + (0.2126 + 0.7152 * 0.5 - 0.04) * 0.5, 1e-6);  // float of a double
+  EXPECT_TRUE(has_note(metal, "emission not drawn"));
+}
+
 TEST(Gltf, EachBadElementIsNamed) {
   using J = nlohmann::json;
   const auto has = [](const std::string& error, const std::string& part) {
@@ -188,6 +241,9 @@ TEST(Gltf, EachBadElementIsNamed) {
                   "the node graph has a cycle"));
   EXPECT_TRUE(has(edited_error([](J& d) { d["nodes"][0]["children"] = {0}; }), "cycle"));
   EXPECT_TRUE(has(edited_error([](J& d) { d["nodes"][0]["children"] = {7}; }), "/nodes/0/children/0: node 7 does not exist"));
+  // A data: URI tinygltf cannot decode stays a URI (found by fuzz_gltf: it was taken for a file name).
+  EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "data:image/png;base28,iVBO"; }),
+                  "/images/0: a data: URI that is not base64 data of a known media type"));
   // An image that is not one.
   EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "quad.bin"; }), "quad.bin"));
 }
