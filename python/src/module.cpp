@@ -213,6 +213,11 @@ Scene load_scene_arg(py::handle scene, py::handle overrides, py::handle base_dir
   return Scene{load_scene(path, sets)};
 }
 
+const Scene& scene_arg(py::handle value, const char* function) {
+  if (!py::isinstance<Scene>(value)) type_error(function, "scene", "a qdmr.Scene (from qdmr.load_scene)", value);
+  return value.cast<const Scene&>();
+}
+
 std::vector<Aov> aovs_arg(py::handle value, const char* function) {
   std::vector<Aov> aovs;
   if (value.is_none()) return aovs;
@@ -326,7 +331,8 @@ public:
     }
   }
 
-  void set_scene(const Scene& scene, py::handle aovs) {
+  void set_scene(py::handle scene_value, py::handle aovs) {
+    const Scene& scene = scene_arg(scene_value, "Renderer.set_scene");
     const std::vector<Aov> list = aovs.is_none() ? default_aovs_ : aovs_arg(aovs, "Renderer.set_scene");
     Busy busy(*this, "set_scene");
     py::gil_scoped_release release;
@@ -505,9 +511,9 @@ PYBIND11_MODULE(_qdmr, m) {
         "its OBJ meshes. Relative paths of a dict resolve against base_dir (default: the current folder).\n"
         "Raises SceneError naming the file and the field, InputError for a file that cannot be read.");
 
-  m.def("plan", [](const Scene& scene, py::handle aovs) {
+  m.def("plan", [](py::handle scene, py::handle aovs) {
     const qdmr::PlanOptions options{aovs_arg(aovs, "plan")};
-    return to_python(qdmr::plan_frame(scene.desc, options).to_json());
+    return to_python(qdmr::plan_frame(scene_arg(scene, "plan").desc, options).to_json());
   }, py::arg("scene"), py::arg("aovs") = py::none(),
         "plan(scene, aovs=None) -> dict\n\nWhat the scene requires (programs, textures, derived data, memory): "
         "`qdmr plan --json`.");

@@ -58,6 +58,8 @@ def test_argument_types_name_the_parameter(tmp_path):
         (lambda: qdmr.Renderer(isa=2), "isa"),
         (lambda: qdmr.Renderer(aovs="depth"), "aovs"),
         (lambda: qdmr.Renderer().set_scene(qdmr.load_scene(PLANE), aovs=[3]), "aovs"),
+        (lambda: qdmr.Renderer().set_scene(PLANE), "scene"),
+        (lambda: qdmr.plan({"output": {}}), "scene"),
         (lambda: qdmr.read_image(5), "path"),
         (lambda: qdmr.write_image("pixels", tmp_path / "x.exr"), "image"),
         (lambda: qdmr.write_image(numpy.zeros((2, 2), numpy.float32), 7), "path"),
