@@ -186,11 +186,14 @@ def test_report_killed_at_any_moment_ends_as_an_uninterrupted_run(work, study):
         assert temporaries(work) == [], f"killed after {moment:.3f} s"
 
 
-def height_map(path, size):
-    """A size x size 16-bit PGM of smooth bumps (deterministic)."""
+def height_map(path, size, terraces=0):
+    """A size x size 16-bit PGM of smooth bumps (deterministic), cut into flat terraces if asked (their flat tops
+    make a cone bake walk far: 1024² with 6 terraces takes about 2.4 s, the smooth map a tenth of that)."""
     import numpy as np
     y, x = np.mgrid[0:size, 0:size].astype(np.float64)
     v = 0.5 + 0.25 * np.sin(x * 0.11) * np.cos(y * 0.07) + 0.2 * np.sin((x + 2 * y) * 0.031)
+    if terraces:
+        v = np.floor(v * terraces) / terraces
     with open(path, "wb") as f:
         f.write(b"P5\n%d %d\n65535\n" % (size, size) + (v * 65535).astype(">u2").tobytes())
     return path
@@ -260,6 +263,33 @@ def test_ctrl_c_stops_a_study_at_the_next_configuration_and_a_bake_at_once(work,
     assert p.returncode == 130, err
     assert err.strip().splitlines()[-1].startswith("qdmr: interrupted")
     assert not os.path.exists(out) and temporaries(work) == []
+
+
+def test_a_long_bake_shows_its_progress_on_a_terminal_only(work):
+    """A bake over a second shows its line on a terminal (stderr a pseudo-terminal here), and nothing in a log."""
+    import pty
+    height = height_map(os.path.join(work, "terraces.pgm"), 1024, terraces=6)
+    args = [QDMR, "bake", "cone", height, "--kind", "relaxed", "-o", os.path.join(work, "progress.exr")]
+    master, slave = pty.openpty()
+    p = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=slave)
+    os.close(slave)
+    shown = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the terminal's other end closed: the bake ended
+            break
+        if not chunk:
+            break
+        shown += chunk
+    os.close(master)
+    assert p.wait(timeout=120) == 0
+    done = re.search(rb"relaxed cone map 1024x1024: done in ([0-9.]+) s", shown)
+    if not done:
+        pytest.skip(f"no progress line: the bake took less than a second ({shown!r})")
+    assert re.search(rb"\rrelaxed cone map 1024x1024 +[0-9]+% \([0-9]+ s\)", shown), shown
+    logged = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert logged.returncode == 0 and logged.stderr == "", logged.stderr
 
 
 # --- two processes, one folder or file -------------------------------------------------------------------------
