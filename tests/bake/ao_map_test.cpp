@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include "bake/ao_pattern.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "support/test_support.hpp"
@@ -106,6 +107,77 @@ TEST(AoMap, SameBitsForAnyThreadCount) {
     tbb::task_arena(1).execute([&] { one = bake_ao_map(f, 0.05, d); });
     EXPECT_EQ(all.texels, one.texels);
   }
+}
+
+// The bake's definition (ao_map.hpp), evaluated the plain way: every tap's slope divided out, every direction's
+// visibility computed, the coarse taps' pyramid cell maxima found by scanning the level-0 texels the cell covers.
+// The bake takes a shortcut that must keep every bit of the map (one division per direction for coarse taps).
+// The map stores floats, so a last-bit slip in double would rarely show here; a wrong choice of tap does.
+double defined_texel_ao(const HeightField& f, double ds, const AoDesc& d, int i, int j, int map_w, int map_h) {
+  const double u = (i + 0.5) / map_w, v = (j + 0.5) / map_h;
+  const auto bilinear_depth = [&](double tu, double tv) { return bilinear_surface_depth(f, ds, tu, tv); };
+  const auto cell_max = [&](int level, std::int64_t x, std::int64_t y) {
+    int w = f.width, h = f.height;  // level `level`'s size: max(1, floor(n / 2)) per step
+    for (int k = 0; k < level; ++k) w = std::max(1, w / 2), h = std::max(1, h / 2);
+    const std::int64_t cx = std::min<std::int64_t>(x >> level, w - 1), cy = std::min<std::int64_t>(y >> level, h - 1);
+    // The cell's level-0 texels: [c 2^level, (c + 1) 2^level), the last cell running to the edge.
+    const std::int64_t x0 = cx << level, y0 = cy << level;
+    const std::int64_t x1 = cx == w - 1 ? f.width : (cx + 1) << level, y1 = cy == h - 1 ? f.height : (cy + 1) << level;
+    double m = 0.0;
+    for (std::int64_t ty = y0; ty < y1; ++ty)
+      for (std::int64_t tx = x0; tx < x1; ++tx) m = std::max(m, f.h[std::size_t(ty * f.width + tx)]);
+    return m;
+  };
+  const int n = ao::direction_count(d);
+  const int rotation = d.jitter ? ao::rotation(std::uint32_t(i), std::uint32_t(j), d.seed) : 0;
+  const ao::Taps taps = ao::make_taps(d, f.width, f.height);
+  const double s = bilinear_depth(u, v);
+  double visible = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const int index = ao::direction_index(n, k, rotation);
+    const double dx = ao::kDirections.cos[std::size_t(index)], dy = ao::kDirections.sin[std::size_t(index)];
+    double slope = 0.0;
+    for (int t = 0; t < taps.count; ++t) {
+      const ao::Tap& tap = taps.tap[std::size_t(t)];
+      const double tu = u + dx * double(tap.distance), tv = v + dy * double(tap.distance);
+      double depth;
+      if (d.coarse) {
+        const auto x = HeightField::texel_index(std::int64_t(std::floor(tu * f.width)), f.width, f.address);
+        const auto y = HeightField::texel_index(std::int64_t(std::floor(tv * f.height)), f.height, f.address);
+        int top = 0;
+        for (int w = f.width, h = f.height; w > 1 || h > 1; w = std::max(1, w / 2), h = std::max(1, h / 2)) ++top;
+        depth = ds * (1.0 - cell_max(std::min(tap.level, top), x, y));
+      } else {
+        depth = bilinear_depth(tu, tv);
+      }
+      slope = std::max(slope, (s - depth) / double(tap.distance));
+    }
+    visible += 1.0 - slope / std::sqrt(1.0 + slope * slope);
+  }
+  return visible / double(n);
+}
+
+TEST(AoMap, BakeIsTheDefinitionBitForBit) {
+  // Odd sizes (leftover pyramid cells), every address mode, jitter, a map of another size than the field, and
+  // depth scales from shallow to steep (most directions open, most closed); coarse with radii of 1 to 5 taps.
+  int cases = 0;
+  for (AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
+    for (bool coarse : {true, false})
+      for (double ds : {0.002, 0.05, 2.0})
+        for (float radius : {0.03f, 0.2f, 0.6f}) {
+          const HeightField f = random_field(37, 23, address, std::uint32_t(7 + cases));
+          AoDesc d = baked_desc(coarse);
+          d.radius = radius;
+          d.jitter = cases % 2 == 1;
+          d.resolution = cases % 3 == 0 ? 29 : 0;
+          const Image map = bake_ao_map(f, ds, d);
+          for (int j = 0; j < map.height; ++j)
+            for (int i = 0; i < map.width; ++i)
+              ASSERT_EQ(map.at(i, j, 0), float(defined_texel_ao(f, ds, d, i, j, map.width, map.height)))
+                  << "texel " << i << "," << j << " address " << int(address) << " coarse " << coarse << " ds " << ds
+                  << " radius " << radius;
+          ++cases;
+        }
 }
 
 fs::path only_file(const fs::path& dir) {
