@@ -164,7 +164,6 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   }
   qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
   frame.stats.load_ms = load_ms;
-  frame.stats.prepare_steps = steps.finished_steps();
   qdmr::check_outputs(outputs);  // and now also the MTL files, the maps they name and the caches read
 
   qdmr::throw_if_stop_requested();  // Ctrl-C while drawing: nothing is written
@@ -479,7 +478,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   qdmr::cli::stop_on_signals();
-  qdmr::set_progress_sink(&steps);  // on the terminal only (logs and CI stay quiet), and for --stats
+  qdmr::set_progress_sink(&steps);  // lines on a terminal only (logs and CI stay quiet)
   try {
     if (render_cmd->parsed()) return run_render(render_scene, render);
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);

@@ -27,16 +27,10 @@ void StepProgress::advanced(const void* step, const std::string&, double fractio
 void StepProgress::finished(const void* step, const std::string& name, double seconds) {
   const std::lock_guard<std::mutex> guard(mutex_);
   running_.erase(step);
-  finished_.push_back({name, seconds * 1000.0});
   if (step != shown_) return;
   shown_ = nullptr;
   std::fprintf(stderr, "\r%-.60s: %s in %.1f s%20s\n", name.c_str(), stop_requested() ? "stopped" : "done", seconds, "");
   std::fflush(stderr);
-}
-
-std::vector<PrepareStep> StepProgress::finished_steps() {
-  const std::lock_guard<std::mutex> guard(mutex_);
-  return finished_;
 }
 
 void StepProgress::tick() {

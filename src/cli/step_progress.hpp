@@ -1,18 +1,16 @@
 #pragma once
 // What the command does with long steps' progress (qdmr/core/progress.hpp): on a terminal, a line for the newest
 // step that has run for a second ("relaxed cone map 4096x4096  37% (12 s)", refreshed five times a second by a
-// thread of its own, then the step's time when it ends); always, the finished steps for `render --stats`
-// (RenderStats::prepare_steps).
+// thread of its own, then the step's time when it ends). The steps' times in `render --stats` come from the
+// renderer itself (RenderStats::prepare_steps).
 #include <chrono>
 #include <condition_variable>
 #include <map>
 #include <mutex>
 #include <string>
 #include <thread>
-#include <vector>
 
 #include "qdmr/core/progress.hpp"
-#include "qdmr/core/stats.hpp"
 
 namespace qdmr::cli {
 
@@ -23,7 +21,6 @@ public:
   void started(const void* step, const std::string& name) override;
   void advanced(const void* step, const std::string& name, double fraction, double seconds) override;
   void finished(const void* step, const std::string& name, double seconds) override;
-  std::vector<PrepareStep> finished_steps();
 
 private:
   using Clock = std::chrono::steady_clock;
@@ -41,7 +38,6 @@ private:
   std::thread ticker_;
   std::map<const void*, Running> running_;
   const void* shown_ = nullptr;  // the step on the terminal line now
-  std::vector<PrepareStep> finished_;
 };
 
 }  // namespace qdmr::cli

@@ -3,6 +3,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 
+#include <algorithm>
+#include <chrono>
 #include <map>
 #include <mutex>
 
@@ -93,11 +95,13 @@ struct Previous {
 
 class Preparer {
 public:
-  Preparer(const FramePlan& plan, const Previous& previous, Assets& assets)
-      : plan_(plan), previous_(previous), assets_(assets), file_(plan.scene.file.string()) {}
+  Preparer(const FramePlan& plan, const Previous& previous, Assets& assets,
+           const std::function<void(double)>& progress)
+      : plan_(plan), previous_(previous), assets_(assets), progress_(progress), file_(plan.scene.file.string()) {}
 
   void run() {
     const std::vector<std::string> items = plan_.items();
+    items_ = items.size();
     weight_maps();
     meshes();
     textures();
@@ -107,12 +111,20 @@ public:
     for (const std::string& item : items)
       (std::find(built_.begin(), built_.end(), item) != built_.end() ? assets_.built : assets_.reused).push_back(item);
     if (assets_.built.size() != built_.size()) throw Error("prepare", "built an item the plan does not list");
+    std::sort(steps_.begin(), steps_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto& [order, step] : steps_) assets_.steps.push_back(std::move(step));
   }
 
 private:
-  void record(const std::string& item) {
+  using Clock = std::chrono::steady_clock;
+
+  // An item built: `order` is its place in plan_.items(), `step` what it was and when its build began.
+  void record(const std::string& item, std::size_t order, PrepareStep step, Clock::time_point start) {
+    step.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     std::lock_guard lock(mutex_);
     built_.push_back(item);
+    steps_.emplace_back(order, std::move(step));
+    if (progress_) progress_(double(built_.size()) / double(std::max<std::size_t>(items_, 1)));
   }
 
   // The weight maps of blended materials whose meshes or weight textures are built (not reused), made once.
@@ -140,6 +152,7 @@ private:
         assets_.meshes[i] = it->second;
         return;
       }
+      const auto start = Clock::now();
       const ObjectDesc& object = plan_.scene.objects[i];
       std::shared_ptr<const MeshData> mesh =
           object.obj_mesh ? object.obj_mesh
@@ -153,7 +166,7 @@ private:
         mesh = std::move(weighted);
       }
       assets_.meshes[i] = std::move(mesh);
-      record("mesh " + mp.key);
+      record("mesh " + mp.key, i, {"mesh " + std::to_string(i), mp.kind, file_ + ": /objects/" + std::to_string(i)}, start);
     });
   }
 
@@ -181,8 +194,10 @@ private:
               }
               const ProgressStep step("texture " + std::to_string(request.width) + "x" + std::to_string(request.height) +
                                       " (" + request.where + ")");  // a line on a terminal when it takes seconds
+              const auto start = Clock::now();
               assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
-              record("texture " + request.key);
+              record("texture " + request.key, plan_.meshes.size() + i,
+                     {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
             }));
   }
 
@@ -193,6 +208,7 @@ private:
       out = it->second;
       return;
     }
+    const auto start = Clock::now();
     const MaterialPlan& m = plan_.materials[std::size_t(d.material)];
     const MaterialDesc& desc = m.desc;
     const ProgressStep step(std::string(derived_kind_name(d.kind)) + " of " + m.name);  // (and Ctrl-C stops here)
@@ -263,14 +279,18 @@ private:
         out.texture = mip(bilinear_upper_bound(*input(0).field), TexelFormat::R32F, MipReduce::Max);
         break;
     }
-    record(d.key);
+    record(d.key, plan_.meshes.size() + plan_.textures.size() + index,
+           {"derived " + std::to_string(index), derived_kind_name(d.kind), d.where}, start);
   }
 
   const FramePlan& plan_;
   const Previous& previous_;
   Assets& assets_;
+  const std::function<void(double)>& progress_;
   std::string file_;
+  std::size_t items_ = 0;
   std::mutex mutex_;
+  std::vector<std::pair<std::size_t, PrepareStep>> steps_;
   std::map<std::size_t, Image> weight_maps_;
   std::vector<std::string> built_;
 };
@@ -291,10 +311,11 @@ std::uint64_t Assets::mesh_bytes() const {
   return bytes;
 }
 
-Assets prepare(const FramePlan& plan, const Assets* previous, const FramePlan* previous_plan) {
+Assets prepare(const FramePlan& plan, const Assets* previous, const FramePlan* previous_plan,
+               const std::function<void(double)>& progress) {
   Assets assets;
   const Previous reuse(previous, previous_plan);
-  Preparer(plan, reuse, assets).run();
+  Preparer(plan, reuse, assets, progress).run();
   return assets;
 }
 

@@ -3,6 +3,7 @@
 // the derived data (weight textures, combined surfaces and quadtrees, fp64 height fields, AO and cone maps).
 // Read-only while drawing; shared (by content key) with the assets of the next plan, so a re-plan that keeps
 // an item's key keeps the item.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,14 +37,17 @@ struct Assets {
   std::vector<DerivedAsset> derived;                    // parallel to FramePlan::derived
   // FramePlan::items() lines: what this prepare built, and what it took from the previous assets.
   std::vector<std::string> built, reused;
+  std::vector<PrepareStep> steps;  // what building each built item took, in plan order
 
   std::uint64_t texture_bytes() const;
   std::uint64_t mesh_bytes() const;
 };
 
 // Builds what the plan lists, in parallel (in the caller's task arena); items whose key is in `previous` are
-// shared instead of rebuilt. Cone and AO maps go through the bake cache in default_cache_dir(). Throws
-// qdmr::Error on bad input.
-Assets prepare(const FramePlan& plan, const Assets* previous = nullptr, const FramePlan* previous_plan = nullptr);
+// shared instead of rebuilt. Cone and AO maps go through the bake cache in default_cache_dir(). `progress`, when
+// set, is called with the fraction of the plan's items done each time an item is built (from the building thread,
+// one call at a time). Throws qdmr::Error on bad input.
+Assets prepare(const FramePlan& plan, const Assets* previous = nullptr, const FramePlan* previous_plan = nullptr,
+               const std::function<void(double fraction)>& progress = {});
 
 }  // namespace qdmr

@@ -83,6 +83,7 @@ struct Renderer::State {
   Frame frame;
   double pending_plan_ms = 0, pending_prepare_ms = 0;
   std::uint64_t pending_built = 0, pending_reused = 0;
+  std::vector<PrepareStep> pending_steps;  // the next frame's stats: what the last prepare built
 
   // The memory of the framebuffer's planes, those lent to the last frame included, and of the draw's arrays.
   std::uint64_t frame_bytes() const {
@@ -146,8 +147,10 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   }
   start = Clock::now();
   if (s.options.progress) s.options.progress("prepare", 0.0);
+  std::function<void(double)> prepare_progress;
+  if (s.options.progress) prepare_progress = [&report = s.options.progress](double f) { report("prepare", f); };
   s.arena.execute([&] {
-    Assets assets = prepare(plan, &s.assets, s.plan ? &*s.plan : nullptr);
+    Assets assets = prepare(plan, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress);
     // Programs point into the new assets: make them before the old assets go.
     std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel);
     s.programs = std::move(programs);
@@ -157,6 +160,7 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   if (s.options.progress) s.options.progress("prepare", 1.0);
   s.pending_prepare_ms = ms_since(start);
   s.pending_built = s.assets.built.size();
+  s.pending_steps = s.assets.steps;
   s.pending_reused = s.assets.reused.size();
 }
 
@@ -175,6 +179,7 @@ const Frame& Renderer::draw() {
   stats.prepare_ms = std::exchange(s.pending_prepare_ms, 0.0);
   stats.items_built = std::exchange(s.pending_built, 0);
   stats.items_reused = std::exchange(s.pending_reused, 0);
+  stats.prepare_steps = std::exchange(s.pending_steps, {});
   stats.threads = s.threads;
   stats.texture_bytes = s.assets.texture_bytes();
   stats.textures = s.assets.texture_stats;

@@ -87,6 +87,45 @@ TEST(Renderer, CameraAndSizeChangesRePrepareNothing) {
   EXPECT_EQ(again.items_built + again.items_reused, 0u);
 }
 
+// The stats name every item prepare built, once, in the plan's order, with its build time; the progress callback
+// sees the fraction of the plan's items grow to 1, one call at a time; a re-prepare that builds nothing has no steps.
+TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
+  SceneDesc scene = small_scene("terrain");
+  const FramePlan plan = plan_frame(scene, {});
+  std::vector<double> fractions;
+  RenderOptions options;
+  options.progress = [&](const char* stage, double fraction) {
+    if (std::string(stage) == "prepare") fractions.push_back(fraction);
+  };
+  Renderer renderer(options);
+  renderer.set_scene(scene);
+  const RenderStats first = renderer.draw().stats;
+  ASSERT_EQ(first.prepare_steps.size(), first.items_built);
+  ASSERT_EQ(first.items_built, plan.meshes.size() + plan.textures.size() + plan.derived.size());
+  std::vector<std::string> expected;
+  for (std::size_t i = 0; i < plan.meshes.size(); ++i) expected.push_back("mesh " + std::to_string(i));
+  for (std::size_t i = 0; i < plan.textures.size(); ++i) expected.push_back("texture " + std::to_string(i));
+  for (std::size_t i = 0; i < plan.derived.size(); ++i) expected.push_back("derived " + std::to_string(i));
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const PrepareStep& step = first.prepare_steps[i];
+    EXPECT_EQ(step.item, expected[i]);
+    EXPECT_GE(step.ms, 0.0) << step.item;
+    EXPECT_LE(step.ms, first.prepare_ms) << step.item;  // each step lies inside prepare
+    EXPECT_FALSE(step.what.empty()) << step.item;
+    EXPECT_NE(step.where.find(scene.file.string()), std::string::npos) << step.item;
+  }
+  EXPECT_EQ(first.prepare_steps.back().what, "blend_ao_map");
+  // 0 first, then one call per item built with the fraction done, then 1 when prepare is over.
+  ASSERT_EQ(fractions.size(), expected.size() + 2);
+  EXPECT_EQ(fractions.front(), 0.0);
+  for (std::size_t i = 1; i + 1 < fractions.size(); ++i) EXPECT_DOUBLE_EQ(fractions[i], double(i) / double(expected.size()));
+  EXPECT_EQ(fractions.back(), 1.0);
+
+  scene.camera.position.x += 0.5f;
+  renderer.set_scene(scene);
+  EXPECT_TRUE(renderer.draw().stats.prepare_steps.empty());
+}
+
 // Whatever changes a texture's content changes its key: a persistent renderer must never re-use the texture of
 // the previous scene for a new storage (BC3, a format) or a float that differs in its last bit. Each new scene's
 // frame is its one-shot render.

@@ -21,6 +21,16 @@ struct TextureStat {
   double bc3_max_error = 0, bc3_rms_error = 0;
 };
 
+// One item prepare built (not one it reused), as `qdmr plan` numbers it: its build's wall time. Items are built
+// in parallel where they do not depend on each other, so the steps' times overlap and may add up to more than
+// prepare_ms.
+struct PrepareStep {
+  std::string item;   // "mesh 0", "texture 3", "derived 7": the plan's numbering
+  std::string what;   // the texture's purpose or the derived kind: "albedo", "combined_quadtree", "blend_ao_map"
+  std::string where;  // the scene field it came from
+  double ms = 0;
+};
+
 // The program that ran for one material: its variant, taken from the instantiated program type.
 struct MaterialStat {
   std::string name;
@@ -36,13 +46,6 @@ struct TextureCacheStats {
   std::uint64_t accesses = 0, hits = 0, misses = 0;
   double miss_ratio = 0, accesses_per_pixel = 0, misses_per_pixel = 0, bytes_per_pixel = 0;  // bytes: misses x line
   std::uint64_t footprint_bytes = 0;  // the textures' memory in this layout (padding and 3D slices included)
-};
-
-// A long preparation step (a cone or AO bake) and its wall time: filled by the command from its progress sink
-// (qdmr/core/progress.hpp), one line each in `--stats`.
-struct PrepareStep {
-  std::string name;
-  double ms = 0;
 };
 
 struct RenderStats {
@@ -64,7 +67,7 @@ struct RenderStats {
   std::string simd_arch;  // the draw kernel's ISA: "sse4.2", "avx2"
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, peak_rss_bytes = 0;
   std::uint64_t items_built = 0, items_reused = 0;  // prepare: plan items built, and taken from the previous frame
-  std::vector<PrepareStep> prepare_steps;
+  std::vector<PrepareStep> prepare_steps;           // the items built, in plan order
   std::vector<TextureStat> textures;
   std::vector<MaterialStat> materials;
   TextureCacheStats texture_cache;
