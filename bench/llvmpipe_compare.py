@@ -12,11 +12,15 @@ QDM at depth scales 0.1 and 0.3, and the 1 M-triangle grid (issue #12's table).
    (timed only) is scenes/plane.json's normal-mapped plane as a 710x710 grid (1,008,200 triangles) in both:
    `qdmr bench scenes/plane.json --set /objects/0/mesh=...` and `llvmpipe_bench --mesh grid`. The table gives
    the median over rounds, llvmpipe / qdmr, and the issue's goal (>= 2x normal, POM, relief and the grid;
-   >= 4x QDM).
-The load average is printed before and after.
+   >= 4x QDM). Filtering is compared like for like, in two pairs (--pairs): `exact`, qdmr's float filter weights
+   against llvmpipe with GALLIVM_PERF=no_aos_sampling (its float filtering path), and `hw8`, qdmr's 8-bit
+   fixed-point weights (precision=hw8) against llvmpipe's default (8-bit fixed-point filtering of 8-bit textures).
+   Each pair is a column group of its own; the rounds alternate renderers and pairs.
+The CPU model, qdmr's kernel ISA and the load average (before and after) are printed with the table.
 
     bench/llvmpipe_compare.py [-B BUILD_DIR] [--qdmr QDMR] [--rounds 5] [--frames 5] [--warmup 2]
-                              [--threads 2] [--isa auto] [--check-only | --timing-only] [--keep DIR]
+                              [--threads 2] [--isa auto] [--pairs exact,hw8] [--check-only | --timing-only]
+                              [--keep DIR]
 
 Needs: qdmr and llvmpipe_bench built (cmake --build build/release --target qdmr_cli llvmpipe_bench), and a
 python3 with numpy and OpenImageIO's module (Debian's python3-openimageio: run it with the system python3).
@@ -47,6 +51,8 @@ GOALS = {"normal": 2.0, "pom": 2.0, "relief": 2.0, "qdm": 4.0, "grid": 2.0}  # l
 GRID_SCENE = os.path.join(ROOT, "scenes", "plane.json")
 GRID_MESH = '/objects/0/mesh={"type":"grid","size":[4,4],"resolution":710,"uv_scale":[2,2]}'  # as llvmpipe_bench's
 LLVMPIPE_ENV = {"LIBGL_ALWAYS_SOFTWARE": "1", "GALLIUM_DRIVER": "llvmpipe"}
+# The precision pairs: qdmr's sampling/precision, and what llvmpipe's environment adds for the same arithmetic.
+PAIRS = {"exact": ("exact", {"GALLIVM_PERF": "no_aos_sampling"}), "hw8": ("hw8", {})}
 
 
 def arguments():
@@ -58,6 +64,9 @@ def arguments():
     p.add_argument("--warmup", type=int, default=2, help="qdmr bench's untimed frames (llvmpipe: always one)")
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--isa", default="auto", help="qdmr's kernel (qdmr bench --isa): auto, avx512, avx2, sse4.2")
+    p.add_argument("--pairs", default="exact,hw8",
+                   help="precision pairs to time, comma-separated: exact (qdmr exact vs llvmpipe float filtering), "
+                        "hw8 (qdmr hw8 vs llvmpipe's default 8-bit filtering)")
     p.add_argument("--width", type=int, default=1920)
     p.add_argument("--height", type=int, default=1080)
     p.add_argument("--check-width", type=int, default=480)
@@ -82,11 +91,25 @@ def run_json(cmd, env=None, json_file=None):
     return json.loads(out.strip().splitlines()[-1])
 
 
-def llvmpipe_env(threads):
+def llvmpipe_env(threads, pair=None):
     env = dict(os.environ)
+    env.pop("GALLIVM_PERF", None)  # the pair decides
     env.update(LLVMPIPE_ENV)
     env["LP_NUM_THREADS"] = str(threads)
+    if pair:
+        env.update(PAIRS[pair][1])
     return env
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown CPU"
 
 
 def read_pfm(path):
@@ -162,35 +185,39 @@ def texel_check(qdmr, llvmpipe, args, tmp):
     return not failed
 
 
-def time_qdmr(qdmr, technique, depth, args, tmp):
+def time_qdmr(qdmr, technique, depth, pair, args, tmp):
     out = os.path.join(tmp, "qdmr_bench.json")
-    scene = [GRID_SCENE, "--set", GRID_MESH] if technique == "grid" else [SCENE] + technique_sets(technique, depth)
+    if technique == "grid":
+        scene = [GRID_SCENE, "--set", GRID_MESH, "--set", f"/materials/bricks/sampling/precision={PAIRS[pair][0]}"]
+    else:
+        scene = [SCENE] + technique_sets(technique, depth) + ["--set", f"{MATERIAL}/sampling/precision={PAIRS[pair][0]}"]
     result = run_json([qdmr, "bench"] + scene + ["--frames", str(args.frames), "--warmup", str(args.warmup),
                       "--threads", str(args.threads), "--width", str(args.width), "--height", str(args.height),
                       "--isa", args.isa, "--json", out], json_file=out)
     return result["draw_ms"]["median"], result
 
 
-def time_llvmpipe(llvmpipe, technique, depth, args):
+def time_llvmpipe(llvmpipe, technique, depth, pair, args):
     case = ["--mesh", "grid"] if technique == "grid" else ["--technique", technique, "--depth", str(depth)]
     result = run_json([llvmpipe] + case + ["--width", str(args.width), "--height", str(args.height),
-                                           "--runs", str(args.frames)], env=llvmpipe_env(args.threads))
+                                           "--runs", str(args.frames)], env=llvmpipe_env(args.threads, pair))
     return result["median_ms"], result
 
 
-def measure_rounds(qdmr, llvmpipe, args, tmp):
-    """{case: {"qdmr": [ms per round], "llvmpipe": [...]}} and the last JSON of each renderer. Within a round each
-    case runs in both renderers back to back; which goes first flips every round."""
-    times = {case: {"qdmr": [], "llvmpipe": []} for case in TIMED_CASES}
+def measure_rounds(qdmr, llvmpipe, pairs, args, tmp):
+    """{(pair, case): {"qdmr": [ms per round], "llvmpipe": [...]}} and the last JSON of each renderer. Within a
+    round each case runs in both renderers back to back, pair after pair; which goes first flips every round."""
+    times = {(pair, case): {"qdmr": [], "llvmpipe": []} for pair in pairs for case in TIMED_CASES}
     info = {}
     for r in range(args.rounds):
         for case in TIMED_CASES:
-            for who in ("llvmpipe", "qdmr") if r % 2 == 0 else ("qdmr", "llvmpipe"):
-                if who == "qdmr":
-                    ms, info[who] = time_qdmr(qdmr, *case, args, tmp)
-                else:
-                    ms, info[who] = time_llvmpipe(llvmpipe, *case, args)
-                times[case][who].append(ms)
+            for pair in pairs if r % 2 == 0 else pairs[::-1]:
+                for who in ("llvmpipe", "qdmr") if r % 2 == 0 else ("qdmr", "llvmpipe"):
+                    if who == "qdmr":
+                        ms, info[who] = time_qdmr(qdmr, *case, pair, args, tmp)
+                    else:
+                        ms, info[who] = time_llvmpipe(llvmpipe, *case, pair, args)
+                    times[(pair, case)][who].append(ms)
         print(f"round {r + 1}/{args.rounds} done, load average {os.getloadavg()[0]:.2f}", file=sys.stderr, flush=True)
     return times, info
 
@@ -200,24 +227,31 @@ def per_round(values):
 
 
 def timing(qdmr, llvmpipe, args, tmp):
+    pairs = [p.strip() for p in args.pairs.split(",") if p.strip()]
+    unknown = [p for p in pairs if p not in PAIRS]
+    if not pairs or unknown:
+        sys.exit(f"llvmpipe_compare.py: --pairs: unknown pair(s) {unknown}; choose from {', '.join(PAIRS)}")
     print(f"\n## Timing: {args.width}x{args.height}, {args.threads} threads each, {args.rounds} rounds; "
           f"qdmr bench {args.frames} frames after {args.warmup}, llvmpipe {args.frames} after 1\n")
-    times, info = measure_rounds(qdmr, llvmpipe, args, tmp)
+    times, info = measure_rounds(qdmr, llvmpipe, pairs, args, tmp)
     with open(os.path.join(tmp, "timing.json"), "w") as f:  # every round's times, kept with --keep
-        json.dump([{"technique": c[0], "depth": c[1], **times[c]} for c in TIMED_CASES], f, indent=1)
-    print(f"qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
+        json.dump([{"pair": p, "technique": c[0], "depth": c[1], **times[(p, c)]} for p in pairs for c in TIMED_CASES],
+                  f, indent=1)
+    print(f"CPU: {cpu_model()}; qdmr: {info['qdmr']['isa']} kernel, {info['qdmr']['threads']} threads, "
           f"{info['qdmr']['pixels_shaded']} pixels shaded; llvmpipe: {info['llvmpipe']['renderer']}, "
           f"{info['llvmpipe']['pixels_covered']} pixels covered (last case)\n")
-    print("| technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met "
+    print("| pair | technique | depth | llvmpipe ms | qdmr ms | llvmpipe / qdmr | goal | met "
           "| llvmpipe ms per round | qdmr ms per round |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for technique, depth in TIMED_CASES:
-        t = times[(technique, depth)]
-        lp, q = statistics.median(t["llvmpipe"]), statistics.median(t["qdmr"])
-        ratio, goal = lp / q, GOALS[technique]
-        depth_text = "-" if depth is None or technique == "normal" else f"{depth:g}"
-        print(f"| {technique} | {depth_text} | {lp:.1f} | {q:.1f} | **{ratio:.2f}x** | >= {goal:g}x "
-              f"| {'yes' if ratio >= goal else 'no'} | {per_round(t['llvmpipe'])} | {per_round(t['qdmr'])} |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for pair in pairs:
+        label = {"exact": "exact / float", "hw8": "hw8 / 8-bit"}[pair]
+        for technique, depth in TIMED_CASES:
+            t = times[(pair, (technique, depth))]
+            lp, q = statistics.median(t["llvmpipe"]), statistics.median(t["qdmr"])
+            ratio, goal = lp / q, GOALS[technique]
+            depth_text = "-" if depth is None or technique == "normal" else f"{depth:g}"
+            print(f"| {label} | {technique} | {depth_text} | {lp:.1f} | {q:.1f} | **{ratio:.2f}x** | >= {goal:g}x "
+                  f"| {'yes' if ratio >= goal else 'no'} | {per_round(t['llvmpipe'])} | {per_round(t['qdmr'])} |")
 
 
 def load_line(when):
