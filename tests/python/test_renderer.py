@@ -56,9 +56,10 @@ def test_stats_and_preparation_kept_across_scenes():
     renderer.set_scene(qdmr.load_scene(PLANE, SMALL))
     first = renderer.draw().stats
     assert first["prepare"]["items_built"] > 0 and renderer.stats == first
+    assert len(first["prepare"]["steps"]) == first["prepare"]["items_built"]
     renderer.set_scene(qdmr.load_scene(PLANE, {**SMALL, "/camera/fov_deg": 30}))  # a new camera builds nothing
     second = renderer.draw().stats
-    assert second["prepare"] == {"items_built": 0, "items_reused": first["prepare"]["items_built"]}
+    assert second["prepare"] == {"items_built": 0, "items_reused": first["prepare"]["items_built"], "steps": []}
 
 
 def test_arrays_outlive_the_next_draw_and_the_renderer():
