@@ -13,7 +13,8 @@
 namespace qdmr {
 namespace {
 
-// What an entry's name says it holds ("cone-relaxed-<16 hex>.bin", "ao-<16 hex>.bin"), or "" for other files.
+// What an entry's name says it holds ("cone-relaxed-<16 hex>.bin", "ao-<16 hex>.bin", "gltf-image-<40 hex>.png"),
+// or "" for other files.
 std::string entry_kind(const std::string& name) {
   const auto hex_bin = [&](std::size_t from) {
     return name.size() == from + 20 && name.compare(from + 16, 4, ".bin") == 0 &&
@@ -22,6 +23,10 @@ std::string entry_kind(const std::string& name) {
   if (name.starts_with("cone-relaxed-") && hex_bin(13)) return "cone map (relaxed)";
   if (name.starts_with("cone-conservative-") && hex_bin(18)) return "cone map (conservative)";
   if (name.starts_with("ao-") && hex_bin(3)) return "AO map";
+  // An image embedded in a glTF asset, stored under its SHA-1 to be read by qdmr's image readers (mesh/gltf.cpp).
+  if (name.starts_with("gltf-image-") && name.size() == 11 + 40 + 4 &&
+      (name.ends_with(".png") || name.ends_with(".jpg")) && name.find_first_not_of("0123456789abcdef", 11) == 51)
+    return "glTF embedded image";
   return "";
 }
 

@@ -21,6 +21,7 @@
 #include "io/input_file.hpp"
 #include "mesh/builders.hpp"
 #include "mesh/gltf_files.hpp"
+#include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
@@ -135,7 +136,10 @@ fs::path store_embedded_image(const std::string& bytes, const std::string& where
   if (fs::is_regular_file(file, ec) && fs::file_size(file, ec) == bytes.size()) {
     std::ifstream in(file, std::ios::binary);
     std::string stored(bytes.size(), '\0');
-    if (in.read(stored.data(), std::streamsize(stored.size())) && stored == bytes) return file;
+    if (in.read(stored.data(), std::streamsize(stored.size())) && stored == bytes) {
+      touch_bake_cache_entry(file);  // recently used: evicted last (qdmr/bake/bake_cache.hpp)
+      return file;
+    }
   }
   fs::create_directories(file.parent_path(), ec);
   write_atomically(file, "embedded glTF image", [&](const fs::path& temporary) -> std::string {

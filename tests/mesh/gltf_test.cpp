@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mesh/builders.hpp"
+#include "qdmr/bake/bake_cache.hpp"
 #include "mesh/gltf_files.hpp"
 #include "qdmr/core/error.hpp"
 #include "support/test_support.hpp"
@@ -79,6 +80,11 @@ TEST(Gltf, EmbeddedExternalAndBinaryAreTheSameAsset) {
     const fs::path albedo = m.materials.at(0).layers[0].albedo.file;
     EXPECT_NE(albedo, external.materials[0].layers[0].albedo.file) << name << ": stored in the cache folder";
     EXPECT_EQ(test::read_file(albedo), test::read_file(asset("checker.png"))) << name;
+    // An entry of the bake cache (listed by `qdmr cache`, trimmed with it).
+    const auto entries = bake_cache_entries(albedo.parent_path());
+    EXPECT_TRUE(std::any_of(entries.begin(), entries.end(), [&](const BakeCacheEntry& e) {
+      return e.file == albedo && e.kind == "glTF embedded image";
+    })) << name;
   }
 }
 

@@ -11,7 +11,7 @@ namespace qdmr {
 
 struct BakeCacheEntry {
   std::filesystem::path file;
-  std::string kind;  // "cone map (relaxed)", "cone map (conservative)", "AO map"
+  std::string kind;  // "cone map (relaxed)", "cone map (conservative)", "AO map", "glTF embedded image"
   std::uint64_t bytes = 0;
   std::filesystem::file_time_type last_used;  // the file's modification time: set when written and when read
 };
