@@ -9,6 +9,7 @@
 #include <glm/trigonometric.hpp>
 #include <tbb/parallel_for.h>
 
+#include "qdmr/core/progress.hpp"
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
 #include "qdmr/texture/cache_model.hpp"
@@ -244,6 +245,7 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
   const int report_every = std::max(1, grid.count() / 100);
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.count(), 1), [&](const auto& range) {
     for (int tile = range.begin(); tile != range.end(); ++tile) {
+      throw_if_stop_requested();  // Ctrl-C (qdmr/core/progress.hpp): the frame stops at the next tile
       TileCounters& counters = tile_counters[std::size_t(tile)];
       counters.reset();
       kernel.raster_tile(context, tile, grid.rect(tile), bins, counters);

@@ -9,6 +9,7 @@
 
 #include "cli/cli_test_util.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/progress.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
@@ -124,6 +125,19 @@ TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
   scene.camera.position.x += 0.5f;
   renderer.set_scene(scene);
   EXPECT_TRUE(renderer.draw().stats.prepare_steps.empty());
+}
+
+// A stop request (the command's SIGINT or SIGTERM handler calls request_stop) ends a draw at its next tile with
+// qdmr::Interrupted; once the request is cleared the renderer draws the same frame as before.
+TEST(Renderer, AStopRequestEndsTheDrawAtTheNextTile) {
+  const SceneDesc scene = small_scene("plane");
+  Renderer renderer;
+  renderer.set_scene(scene);
+  const PixelBuffer before = renderer.draw().color;
+  request_stop();
+  EXPECT_THROW(renderer.draw(), Interrupted);
+  clear_stop_request();
+  EXPECT_TRUE(same_bits(renderer.draw().color, before));
 }
 
 // Whatever changes a texture's content changes its key: a persistent renderer must never re-use the texture of
