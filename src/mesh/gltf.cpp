@@ -3,6 +3,7 @@
 // callbacks here, decodes no image (qdmr's readers do, from the file or from the embedded bytes stored in the
 // cache folder), and every accessor, buffer view and index is checked here before it is read.
 #include <tiny_gltf.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -347,6 +348,7 @@ public:
   MeshData build(const MeshDesc& desc) {
     check_nodes();
     const std::vector<int> roots = drawn_roots(desc);
+    check_drawn_size(roots);
     for (std::size_t m = 0; m < model_.materials.size(); ++m) materials_.push_back(convert_material(int(m)));
     for (const int root : roots) visit(root, parent_world(root));
     if (mesh_.indices.empty()) throw Error(where_, "no triangles to draw in " + shown_path(file_));
@@ -399,6 +401,43 @@ private:
       state[at] = 2;
       for (std::size_t w : walk) state[w] = 2;
     }
+  }
+
+  // A mesh drawn by several nodes is copied for each: the copies' size, from the accessors' counts (each at most
+  // the bytes of its buffer view: a count that lies is refused later, by name), is bounded before anything is read,
+  // by the triangle limit and by the machine's memory.
+  void check_drawn_size(const std::vector<int>& roots) const {
+    const auto count = [&](int accessor) -> std::uint64_t {
+      if (accessor < 0 || std::size_t(accessor) >= model_.accessors.size()) return 0;
+      const tinygltf::Accessor& a = model_.accessors[std::size_t(accessor)];
+      const bool view = a.bufferView >= 0 && std::size_t(a.bufferView) < model_.bufferViews.size();
+      return view ? std::min<std::uint64_t>(a.count, model_.bufferViews[std::size_t(a.bufferView)].byteLength) : 0;
+    };
+    std::uint64_t vertices = 0, corners = 0;
+    std::vector<int> stack(roots.begin(), roots.end());
+    while (!stack.empty()) {
+      const tinygltf::Node& node = model_.nodes[std::size_t(stack.back())];
+      stack.pop_back();
+      stack.insert(stack.end(), node.children.begin(), node.children.end());
+      if (node.mesh < 0 || std::size_t(node.mesh) >= model_.meshes.size()) continue;
+      for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(node.mesh)].primitives) {
+        const auto position = prim.attributes.find("POSITION");
+        const std::uint64_t v = position == prim.attributes.end() ? 0 : count(position->second);
+        const std::uint64_t c = prim.indices >= 0 ? count(prim.indices) : v;
+        vertices += std::max(v, c);  // flat normals: one vertex per corner
+        corners += c;
+      }
+      if (corners / 3 > limits::kMaxTriangles)
+        throw Error(where_, "the drawn nodes hold more than " + std::to_string(limits::kMaxTriangles) +
+                                " triangles (a mesh drawn by several nodes counts for each)");
+    }
+    // position, normal, tangent, uv per vertex; an index per corner and a material per triangle, doubled for the
+    // copies made while reading
+    const std::uint64_t bytes = 2 * (vertices * (3 + 3 + 4 + 2) * sizeof(float) + corners * 2 * sizeof(std::uint32_t));
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && page > 0 && bytes > std::uint64_t(pages) * std::uint64_t(page))
+      throw Error(where_, "the drawn meshes need " + std::to_string(bytes >> 20) +
+                              " MiB while they are read, more than this machine's memory");
   }
 
   std::vector<int> drawn_roots(const MeshDesc& desc) {

@@ -250,6 +250,23 @@ TEST(Gltf, EachBadElementIsNamed) {
   // A data: URI tinygltf cannot decode stays a URI (found by fuzz_gltf: it was taken for a file name).
   EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "data:image/png;base28,iVBO"; }),
                   "/images/0: a data: URI that is not base64 data of a known media type"));
+  // A mesh drawn by many nodes is copied for each: 1000 nodes drawing one mesh whose indices claim 2^19 triangles
+  // make 524 M triangles, refused from the counts before anything is read.
+  EXPECT_TRUE(has(edited_error([](J& d) {
+                    const int indices = d["meshes"][0]["primitives"][0]["indices"];
+                    d["accessors"][indices]["count"] = 3 << 19;  // a lie, refused later by name: here only counted
+                    d["bufferViews"][d["accessors"][indices]["bufferView"].get<int>()]["byteLength"] = 1 << 22;
+                    J root = J::object(), nodes = J::array();
+                    root["children"] = J::array();
+                    nodes.push_back(root);
+                    for (int n = 1; n <= 1000; ++n) {
+                      nodes.push_back(J::object({{"mesh", 0}}));
+                      nodes[0]["children"].push_back(n);
+                    }
+                    d["nodes"] = nodes;
+                    d["scenes"][0]["nodes"] = {0};
+                  }),
+                  "the drawn nodes hold more than 268435456 triangles"));
   // An image that is not one.
   EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "quad.bin"; }), "quad.bin"));
 }
