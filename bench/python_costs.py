@@ -102,6 +102,16 @@ def dask_costs(args):
     return one, spread, starts
 
 
+def print_pair(case, python_name, python, command_name, command, unit, digits, target):
+    """One line: the median (and range) of each side's times, and the median of the per-round ratios."""
+    def side(name, times):
+        return (f"{name} {statistics.median(times):.{digits}f} {unit} "
+                f"({min(times):.{digits}f} - {max(times):.{digits}f})")
+    ratios = [p / c for p, c in zip(python, command)]
+    print(f"{case}: {side(python_name, python)}, {side(command_name, command)}: ratio {statistics.median(ratios):.3f} "
+          f"(target <= {target:g}); load {load()}")
+
+
 def main():
     parser = bench_util.arguments(__doc__.split("\n")[0])
     parser.add_argument("--threads", type=int, default=2, help="threads of the draw and study cases (default 2)")
@@ -112,18 +122,12 @@ def main():
     if args.only in (None, "draw"):
         for width, height in ((480, 270), (1920, 1080)):
             python, command = draw_costs(args, cli, width, height)
-            ratios = [p / c for p, c in zip(python, command)]
-            print(f"draw {width}x{height}, {args.threads} threads: Python draw() {statistics.median(python):.3f} ms "
-                  f"({min(python):.3f} - {max(python):.3f}), qdmr bench {statistics.median(command):.3f} ms "
-                  f"({min(command):.3f} - {max(command):.3f}): ratio {statistics.median(ratios):.3f} "
-                  f"(target <= 1.05); load {load()}")
+            print_pair(f"draw {width}x{height}, {args.threads} threads", "Python draw()", python, "qdmr bench", command,
+                       "ms", 3, 1.05)
     if args.only in (None, "study"):
         python, command = study_costs(args, cli)
-        ratios = [p / c for p, c in zip(python, command)]
-        print(f"study, 100 configurations, {args.threads} threads: qdmr.study.run {statistics.median(python):.2f} s "
-              f"({min(python):.2f} - {max(python):.2f}), qdmr study {statistics.median(command):.2f} s "
-              f"({min(command):.2f} - {max(command):.2f}): ratio {statistics.median(ratios):.3f} (target <= 1.1); "
-              f"load {load()}")
+        print_pair(f"study, 100 configurations, {args.threads} threads", "qdmr.study.run", python, "qdmr study", command,
+                   "s", 2, 1.1)
     if args.only in (None, "dask"):
         one, spread, starts = dask_costs(args)
         ratios = [s / o for s, o in zip(spread, one)]
