@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The whole-process targets of issue #12 (docs/performance.md, section 5), measured side by side in one run:
+"""The whole-process targets of issue #12 (docs/performance.md, "Targets"), measured side by side in one run:
 
   - `qdmr --help` and `qdmr plan` of a procedural scene, of one whose textures are PNG and JPEG files, of one
     with a TIFF, an OpenEXR, a PGM and a PFM texture (all read in process), and of one with a TIFF stored "min is

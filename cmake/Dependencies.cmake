@@ -22,7 +22,7 @@ pkg_check_modules(LIBDEFLATE REQUIRED IMPORTED_TARGET libdeflate)
 
 # The qdmr command's allocator (src/cli/allocator.cpp): jemalloc, which keeps freed memory for reuse and backs it
 # with transparent huge pages, so a one-shot render does not pay the first touch of every buffer it allocates
-# (docs/performance.md). Not in sanitizer builds, whose runtime replaces the allocator.
+# (docs/performance.md, "Cold frames"). Not in sanitizer builds, whose runtime replaces the allocator.
 if(NOT QDMR_SANITIZE AND NOT QDMR_FUZZ)
   pkg_check_modules(JEMALLOC REQUIRED IMPORTED_TARGET jemalloc)
 endif()

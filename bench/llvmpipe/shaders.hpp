@@ -9,7 +9,7 @@ namespace llvmpipe_bench {
 // Position and UV in, world position and UV out (the plane's frame is constant: normal +z, tangent +x).
 std::string vertex_shader();
 
-// plane.json's normal mapping (the shader of the measurements in docs/performance.md section 5's first table).
+// plane.json's normal mapping (the `grid` case of docs/performance.md, "Mesa llvmpipe vs qdmr").
 std::string legacy_fragment_shader();
 
 // canonical.json's material with the technique: the trace of qdmr's program (its knobs compiled in as

@@ -1,7 +1,7 @@
 #pragma once
 // Content hashes of the bake caches: XXH3's 64-bit hash (xxHash) over raw bytes, and its 16-digit hex form for file
 // names. Byte-wise FNV-1a, which they used before, took ~110 ms for the default scene's 72 MiB blended surface, on
-// one thread of its prepare; XXH3 takes a few (docs/performance.md, session 28).
+// one thread of its prepare; XXH3 takes a few (docs/performance-history.md, session 28).
 #include <cstddef>
 #include <cstdint>
 #include <string>

@@ -3,7 +3,7 @@
 // libraries OpenImageIO's own readers call, in the same way: the same pixels, refusals and header; PBM, PGM and
 // PPM files as Netpbm defines them (imageio/pnm_reader.cpp: where OpenImageIO's reader got them wrong), and PFM
 // files as OpenImageIO read them. They are the formats of textures, and reading them without OpenImageIO spares a
-// job the loading of the image module (~260 shared libraries, 0.3-0.5 s: docs/performance.md). Every other file
+// job the loading of the image module (~260 shared libraries, 0.3-0.5 s: docs/performance-history.md). Every other file
 // goes to the backend (imageio/backend.hpp): the TIFF layouts OpenImageIO converts (imageio/tiff_reader.cpp says
 // which; their header alone is read here: read_header), and formats qdmr does not take as textures (refused after
 // the backend names them).

@@ -83,7 +83,7 @@ Bytes igzip_band(const unsigned char* in, std::size_t size, bool last) {
 // The IDAT payload: every row with the Up filter, as one zlib stream: from igzip at kPngFastLevel, in bands
 // (rows_per_band), else from libdeflate at `level`. Up is the fastest filter to apply; on the canonical 1080p
 // render it gives 1.67 MB with libdeflate's level 1, where libpng's per-row choice among all five with zlib level 3
-// gave 1.71 MB (docs/performance.md). Empty on failure. Its buffers are not zeroed first (every byte is written)
+// gave 1.71 MB (docs/performance-history.md). Empty on failure. Its buffers are not zeroed first (every byte is written)
 // and take huge pages where they are large (DefaultInitAllocator): fresh pages cost a fault each otherwise.
 Bytes compressed_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows, int level) {
   const std::size_t filtered_row = row_bytes + 1;

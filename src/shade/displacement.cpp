@@ -472,7 +472,7 @@ void DisplacementProgram::shade_group(const Fragments* const* in, ShadeOutput* c
 
 // A blend's sparse batches are packed into fewer (shade_compacted): up to eight at once, with at most four
 // batches' worth of covered lanes (replayed on the terrain's batches, larger groups of eight left hardly fewer
-// packed batches: docs/performance.md).
+// packed batches: docs/performance-history.md).
 static_assert(simd::LaneCompaction::kMaxBatches <= kMaxGroupBatches);
 
 int DisplacementProgram::group_batches() const {
