@@ -16,8 +16,8 @@
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
-#include "shade/ambient_occlusion.hpp"
-#include "shade/height_surface.hpp"
+#include "kernel/ambient_occlusion.hpp"
+#include "kernel/height_surface.hpp"
 
 namespace {
 

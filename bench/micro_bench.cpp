@@ -20,7 +20,7 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "raster/binner.hpp"
-#include "raster/tile_raster.hpp"
+#include "kernel/tile_raster.hpp"
 
 namespace {
 

@@ -21,7 +21,7 @@
 
 #include "qdmr/texture/mip_texture.hpp"
 #include "texture/reference_sampler.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 namespace {
 

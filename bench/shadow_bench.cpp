@@ -12,8 +12,8 @@
 
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
-#include "shade/height_surface.hpp"
-#include "shade/self_shadow.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/self_shadow.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/gather.hpp"
+#include "kernel/gather.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "draw/kernel.hpp"
+#include "kernel/kernel.hpp"
 #include "prepare/assets.hpp"
 #include "qdmr/core/stats.hpp"
 #include "raster/binner.hpp"

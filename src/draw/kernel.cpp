@@ -1,4 +1,4 @@
-#include "draw/kernel.hpp"
+#include "kernel/kernel.hpp"
 
 #include "qdmr/core/error.hpp"
 

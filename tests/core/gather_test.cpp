@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "core/gather.hpp"
+#include "kernel/gather.hpp"
 
 namespace qdmr {
 namespace {

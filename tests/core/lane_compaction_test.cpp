@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "core/lane_compaction.hpp"
+#include "kernel/lane_compaction.hpp"
 #include "support/lane_values.hpp"
 
 namespace qdmr {

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <random>
 
-#include "core/lane_packing.hpp"
+#include "kernel/lane_packing.hpp"
 #include "support/lane_values.hpp"
 
 namespace qdmr {

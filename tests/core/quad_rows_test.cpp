@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "core/quad_rows.hpp"
+#include "kernel/quad_rows.hpp"
 
 namespace qdmr {
 namespace {

@@ -7,9 +7,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "program/batch.hpp"
+#include "kernel/batch.hpp"
 #include "raster/binner.hpp"
-#include "raster/tile_raster.hpp"
+#include "kernel/tile_raster.hpp"
 
 namespace qdmr::test {
 

@@ -13,9 +13,9 @@
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
-#include "shade/ambient_occlusion.hpp"
+#include "kernel/ambient_occlusion.hpp"
 #include "bake/ao_pattern.hpp"
-#include "shade/height_surface.hpp"
+#include "kernel/height_surface.hpp"
 
 namespace qdmr {
 namespace {

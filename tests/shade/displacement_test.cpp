@@ -10,7 +10,7 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "shade/displacement_test_util.hpp"
-#include "shade/traversal.hpp"
+#include "kernel/traversal.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {

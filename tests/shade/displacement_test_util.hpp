@@ -14,7 +14,7 @@
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/texture.hpp"
-#include "shade/displacement.hpp"
+#include "kernel/displacement.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {

@@ -10,7 +10,7 @@
 
 #include "displacement_test_util.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
-#include "shade/self_shadow.hpp"
+#include "kernel/self_shadow.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {

@@ -10,7 +10,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "shade/lighting_models.hpp"
+#include "kernel/lighting_models.hpp"
 
 namespace qdmr::shading {
 namespace {

@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <random>
 
-#include "core/lane_packing.hpp"
+#include "kernel/lane_packing.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "shade/normal_mapping.hpp"
+#include "kernel/normal_mapping.hpp"
 
 namespace qdmr {
 namespace {

@@ -17,8 +17,8 @@
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
-#include "shade/height_surface.hpp"
-#include "shade/self_shadow.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/self_shadow.hpp"
 #include "reference/shadow_shapes.hpp"
 
 namespace qdmr::test {

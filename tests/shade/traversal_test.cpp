@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <random>
 
-#include "shade/traversal.hpp"
+#include "kernel/traversal.hpp"
 
 namespace qdmr {
 namespace {

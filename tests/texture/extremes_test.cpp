@@ -18,7 +18,7 @@
 
 #include "qdmr/texture/texture.hpp"
 #include "texture/reference_sampler.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <random>
 
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 #include "texture/sampler_test_util.hpp"
 
 namespace qdmr {

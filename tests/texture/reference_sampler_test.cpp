@@ -15,7 +15,7 @@
 #include <string>
 
 #include "texture/reference_sampler.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "program/variant.hpp"
 #include "qdmr/texture/twin_texels.hpp"
-#include "shade/height_surface.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/sampler.hpp"
 #include "texture/sampler_test_util.hpp"
 
 namespace qdmr {

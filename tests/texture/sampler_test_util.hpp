@@ -5,7 +5,7 @@
 #include <cstring>
 #include <limits>
 
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr::test {
 

@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "qdmr/scene/scene.hpp"
-#include "shade/trace_ray.hpp"
+#include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

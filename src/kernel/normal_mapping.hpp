@@ -1,11 +1,11 @@
 #pragma once
 // The first shading program: albedo with tangent-space normal mapping, lit by the material's lighting model
 // (lighting_models.hpp) from directional lights plus ambient.
-#include "core/lane_packing.hpp"
+#include "kernel/lane_packing.hpp"
 #include "program/light_rig.hpp"
-#include "program/batch.hpp"
-#include "shade/shading_math.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/batch.hpp"
+#include "kernel/shading_math.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

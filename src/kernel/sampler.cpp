@@ -1,6 +1,6 @@
 // The SIMD sampler: its instantiations for the common keys, the generic entry points and TextureSampler
 // (the code itself is in sampling_code.hpp).
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 #include <algorithm>
 #include <iterator>
@@ -8,7 +8,7 @@
 
 #include "core/det_math.hpp"
 #include "qdmr/core/error.hpp"
-#include "texture/sampling_code.hpp"
+#include "kernel/sampling_code.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {

@@ -2,7 +2,7 @@
 // Refinement of a box-surface hit (qdm, csm, rcsm) against the filtered surface.
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/heightfield.hpp"
-#include "shade/trace_ray.hpp"
+#include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

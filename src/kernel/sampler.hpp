@@ -7,11 +7,11 @@
 #include <cstdint>
 
 #include "core/det_math.hpp"
-#include "core/gather.hpp"
+#include "kernel/gather.hpp"
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -1,6 +1,6 @@
-#include "shade/blended_surface.hpp"
+#include "kernel/blended_surface.hpp"
 
-#include "shade/traversal.hpp"
+#include "kernel/traversal.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {

@@ -1,4 +1,4 @@
-#include "shade/height_surface.hpp"
+#include "kernel/height_surface.hpp"
 
 #include <utility>
 

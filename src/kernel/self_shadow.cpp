@@ -1,13 +1,13 @@
-#include "shade/self_shadow.hpp"
+#include "kernel/self_shadow.hpp"
 
 #include <algorithm>
 #include <cstddef>
 #include <limits>
 
-#include "shade/blended_surface.hpp"
-#include "shade/height_surface.hpp"
-#include "shade/traversal.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/blended_surface.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/traversal.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {

@@ -1,10 +1,10 @@
 // The draw kernel of one ISA. This file (with raster/tile_raster.cpp, shade/ and texture/sampler.cpp) is compiled
 // once per ISA with that ISA's flags; QDMR_ISA names its namespace and QDMR_ISA_ENUM its Isa value.
-#include "draw/kernel.hpp"
+#include "kernel/kernel.hpp"
 #include "program/variant.hpp"
-#include "raster/tile_raster.hpp"
-#include "shade/displacement.hpp"
-#include "shade/normal_mapping.hpp"
+#include "kernel/tile_raster.hpp"
+#include "kernel/displacement.hpp"
+#include "kernel/normal_mapping.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {

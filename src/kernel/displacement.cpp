@@ -1,25 +1,25 @@
-#include "shade/displacement.hpp"
+#include "kernel/displacement.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <type_traits>
 
-#include "core/lane_compaction.hpp"
+#include "kernel/lane_compaction.hpp"
 #include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/core/limits.hpp"
-#include "shade/ambient_occlusion.hpp"
-#include "shade/self_shadow.hpp"
-#include "shade/shading_math.hpp"
-#include "shade/cone_step.hpp"
-#include "shade/pom.hpp"
-#include "shade/qdm.hpp"
-#include "shade/refine.hpp"
-#include "shade/relief.hpp"
-#include "shade/traversal.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/ambient_occlusion.hpp"
+#include "kernel/self_shadow.hpp"
+#include "kernel/shading_math.hpp"
+#include "kernel/cone_step.hpp"
+#include "kernel/pom.hpp"
+#include "kernel/qdm.hpp"
+#include "kernel/refine.hpp"
+#include "kernel/relief.hpp"
+#include "kernel/traversal.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {

@@ -7,19 +7,19 @@
 #include <optional>
 #include <vector>
 
-#include "core/lane_compaction.hpp"
+#include "kernel/lane_compaction.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/heightfield.hpp"
-#include "shade/blended_surface.hpp"
-#include "shade/height_surface.hpp"
+#include "kernel/blended_surface.hpp"
+#include "kernel/height_surface.hpp"
 #include "program/light_rig.hpp"
-#include "shade/lighting_models.hpp"
-#include "program/batch.hpp"
+#include "kernel/lighting_models.hpp"
+#include "kernel/batch.hpp"
 #include "program/inputs.hpp"
 #include "program/variant.hpp"
-#include "shade/shading_math.hpp"
-#include "shade/trace_ray.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/shading_math.hpp"
+#include "kernel/trace_ray.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Relief mapping: linear search, then binary search.
 #include "qdmr/scene/scene.hpp"
-#include "shade/trace_ray.hpp"
+#include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

@@ -5,8 +5,8 @@
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "program/light_rig.hpp"
-#include "program/batch.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/batch.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 

@@ -9,8 +9,8 @@
 // max(hmax_i * wmax_i) — "QDM1 * QDM2 = conservative QDM" — with wmax_i the largest weight over the UV box the
 // queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
 #include "qdmr/texture/layer_heights.hpp"
-#include "shade/height_surface.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

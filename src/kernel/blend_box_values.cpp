@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-#include "shade/blended_surface.hpp"
+#include "kernel/blended_surface.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

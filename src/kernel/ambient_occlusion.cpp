@@ -1,10 +1,10 @@
-#include "shade/ambient_occlusion.hpp"
+#include "kernel/ambient_occlusion.hpp"
 
-#include "core/gather.hpp"
+#include "kernel/gather.hpp"
 #include "bake/ao_pattern.hpp"
-#include "shade/blended_surface.hpp"
-#include "shade/height_surface.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/blended_surface.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -12,8 +12,8 @@
 
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "texture/sampler.hpp"
-#include "texture/sampling_code.hpp"
+#include "kernel/sampler.hpp"
+#include "kernel/sampling_code.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -4,10 +4,10 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "shade/height_surface.hpp"
-#include "shade/trace_ray.hpp"
-#include "texture/sampler.hpp"
-#include "texture/sampling_code.hpp"
+#include "kernel/height_surface.hpp"
+#include "kernel/trace_ray.hpp"
+#include "kernel/sampler.hpp"
+#include "kernel/sampling_code.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

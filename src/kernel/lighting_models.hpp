@@ -14,7 +14,7 @@
 #include "core/simd.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "program/light_rig.hpp"
-#include "shade/shading_math.hpp"
+#include "kernel/shading_math.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 

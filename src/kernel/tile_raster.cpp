@@ -1,4 +1,4 @@
-#include "raster/tile_raster.hpp"
+#include "kernel/tile_raster.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +9,8 @@
 
 #include <immintrin.h>
 
-#include "core/quad_rows.hpp"
-#include "program/batch.hpp"
+#include "kernel/quad_rows.hpp"
+#include "kernel/batch.hpp"
 #include "qdmr/core/limits.hpp"
 #include "texture/fetch_recorder.hpp"
 

@@ -1,7 +1,7 @@
 #pragma once
 // Parallax occlusion mapping: view-dependent step count, linear intersection of the last two samples.
 #include "qdmr/scene/scene.hpp"
-#include "shade/trace_ray.hpp"
+#include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

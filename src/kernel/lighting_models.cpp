@@ -1,4 +1,4 @@
-#include "shade/lighting_models.hpp"
+#include "kernel/lighting_models.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 namespace {

@@ -1,4 +1,4 @@
-#include "shade/refine.hpp"
+#include "kernel/refine.hpp"
 
 #include <algorithm>
 

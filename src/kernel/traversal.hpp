@@ -6,7 +6,7 @@
 #include <type_traits>
 
 #include "core/simd.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/fetch_trace.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -4,7 +4,7 @@
 
 #include "core/simd.hpp"
 #include "qdmr/core/sampling.hpp"
-#include "shade/traversal.hpp"
+#include "kernel/traversal.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 

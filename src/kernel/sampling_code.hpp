@@ -6,11 +6,11 @@
 // from exact float arithmetic or from fixed point with 8 or 6 fractional bits, as texture units do.
 #include <algorithm>
 
-#include "core/gather.hpp"
+#include "kernel/gather.hpp"
 #include "core/simd.hpp"
-#include "texture/fetch_trace.hpp"
+#include "kernel/fetch_trace.hpp"
 #include "texture/internal.hpp"
-#include "texture/sampler.hpp"
+#include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::sampling_code {
 

@@ -1,7 +1,7 @@
-#include "shade/normal_mapping.hpp"
+#include "kernel/normal_mapping.hpp"
 
-#include "shade/lighting_models.hpp"
-#include "shade/shading_math.hpp"
+#include "kernel/lighting_models.hpp"
+#include "kernel/shading_math.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
