@@ -1,4 +1,4 @@
-// Ambient occlusion cost: the per-frame horizon AO (shade/ambient_occlusion.hpp) per pixel for each mode, and the
+// Ambient occlusion cost: the per-frame horizon AO (kernel/ambient_occlusion.hpp) per pixel for each mode, and the
 // baked map (bake_ao_map) per texel, 1 and 2 threads. A plain timing program: every case runs --reps times and
 // the median is printed as a markdown row.
 //   qdmr_ao_bench [--size 512] [--pixels 512] [--reps 5] [--no-bake]

@@ -41,8 +41,9 @@ Workload make_workload(const std::vector<SceneOverride>& overrides) {
   Workload w;
   w.scene = load_scene(std::string(QDMR_SOURCE_DIR) + "/scenes/plane.json", overrides);
   w.plan = plan_frame(w.scene);
-  w.assets = prepare(w.plan);
-  w.programs = make_programs(w.plan, w.assets, kernel_for(Isa::QDMR_ISA_ENUM));  // this benchmark's own kernel
+  const Kernel& kernel = kernel_for(Isa::QDMR_ISA_ENUM);  // this benchmark's own kernel
+  w.assets = prepare(w.plan, kernel);
+  w.programs = make_programs(w.plan, w.assets, kernel);
   // The plane scene's single object has the identity transform.
   w.draws.push_back({w.assets.meshes[0].get(), glm::mat4(1.0f), w.plan.meshes[0].material, {}});
   const CameraDesc& cam = w.scene.camera;

@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <random>
 
+#include "kernel/kernel.hpp"
+#include "qdmr/core/isa.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace {
@@ -20,11 +22,13 @@ void max_build(benchmark::State& state, TexelFormat format) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (float& v : level0.texels) v = u(rng);
-  Texture texture = make_mip_texture(level0, format, false, MipReduce::Max);
+  // The reducer of the kernel a frame would run here (as preparation does).
+  const MipExtremum extremum = kernel_for(resolve_isa(Isa::Auto)).mip_extremum();
+  Texture texture = make_mip_texture(level0, format, false, MipReduce::Max, extremum);
 
   tbb::task_arena(threads).execute([&] {
     for (auto _ : state) {
-      build_mip_levels(texture, MipReduce::Max);
+      build_mip_levels(texture, MipReduce::Max, extremum);
       benchmark::DoNotOptimize(texture.storage.data());
       benchmark::ClobberMemory();
     }

@@ -1,4 +1,4 @@
-// Self-shadowing cost per mode (shade/self_shadow.hpp) on one thread: 2^16 lanes per run, each a random point
+// Self-shadowing cost per mode (kernel/self_shadow.hpp) on one thread: 2^16 lanes per run, each a random point
 // on the box surface of a 1024^2 procedural noise height map (R16, as procedural heights are stored), depth
 // scale 0.05, the light at the given elevation (degrees) and a random azimuth per lane. Time per lane x 1e6 =
 // ms per million lanes. Counters: fetches per lane (the iterations the mode reports), fraction shadowed (< 1).

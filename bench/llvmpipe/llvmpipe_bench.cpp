@@ -8,7 +8,7 @@
 //  --technique normal|pom|relief|qdm --depth D: bench/llvmpipe/canonical.json, the scene of the llvmpipe
 //     comparison (bench/llvmpipe_compare.py): its camera, light, the same cobbles height map (canonical.cpp
 //     generates the bits qdmr generates, stored as r16 like qdmr stores them) and GLSL versions of qdmr's
-//     POM, relief and QDM (src/shade/pom.hpp, relief.hpp, qdm.hpp, traversal.hpp, refine.hpp) with the
+//     POM, relief and QDM (src/kernel/pom.hpp, relief.hpp, qdm.hpp, traversal.hpp, refine.hpp) with the
 //     scene's knobs (shaders.cpp), then Blinn-Phong shading as qdmr's shade_lights does.
 //
 // Colour target: RGBA32F (qdmr keeps float colour), depth: 32F. Prints, as one JSON line, the median of --runs

@@ -66,7 +66,7 @@ float height_at(vec2 uv) { return textureLod(height_map, uv, 0.0).r; }
 #endif
 
 #ifdef TECHNIQUE_POM
-// src/shade/pom.hpp: step count lerped from MAX_STEPS (grazing) to MIN_STEPS (along the normal), then the
+// src/kernel/pom.hpp: step count lerped from MAX_STEPS (grazing) to MIN_STEPS (along the normal), then the
 // intersection of the ray with the line through the last two samples. gap = surface depth - ray depth.
 float trace(vec2 uv0, vec2 duv, float ds, float cos_view, inout float iterations) {
   float n = floor(float(MAX_STEPS) + float(MIN_STEPS - MAX_STEPS) * clamp(cos_view, 0.0, 1.0) + 0.5);
@@ -90,7 +90,7 @@ float trace(vec2 uv0, vec2 duv, float ds, float cos_view, inout float iterations
 #endif
 
 #ifdef TECHNIQUE_RELIEF
-// src/shade/relief.hpp: LINEAR_STEPS + 1 samples from the top, then BINARY_STEPS bisections of the last step.
+// src/kernel/relief.hpp: LINEAR_STEPS + 1 samples from the top, then BINARY_STEPS bisections of the last step.
 float trace(vec2 uv0, vec2 duv, float ds, float cos_view, inout float iterations) {
   float step = ds / float(LINEAR_STEPS);
   float lo = ds - step, hi = ds;  // not found: the bottom (h >= 0 everywhere) is the hit
@@ -116,7 +116,7 @@ float trace(vec2 uv0, vec2 duv, float ds, float cos_view, inout float iterations
 #endif
 
 #ifdef TECHNIQUE_QDM
-// src/shade/qdm.hpp and traversal.hpp, sm4 math (integer cells stepped across walls, fp32 crossings), plain
+// src/kernel/qdm.hpp and traversal.hpp, sm4 math (integer cells stepped across walls, fp32 crossings), plain
 // max fetches (texelFetch), level_up "one", no lod_stop (the hit is at level 0), then linear refinement
 // (refine.hpp). Positions in level-0 texels: p(t) = p0 + d t at depth t.
 const float INF = uintBitsToFloat(0x7F800000u);
@@ -198,7 +198,7 @@ float trace(vec2 uv0, vec2 duv, float ds, float cos_view, inout float iterations
 
 void main() {
   vec3 view = normalize(eye - world);
-  // src/shade/displacement.cpp: the ray leaves the polygon along -view, uv(s) = uv0 + duv s for depth s.
+  // src/kernel/displacement.cpp: the ray leaves the polygon along -view, uv(s) = uv0 + duv s for depth s.
   float vz = max(view.z, 1e-4);
   vec2 duv = -view.xy / vz;
   float iterations = 0.0;
@@ -216,7 +216,7 @@ void main() {
   vec3 albedo = textureGrad(albedo_map, hit, gx, gy).rgb;
   vec3 n = normalize(textureGrad(normal_map, hit, gx, gy).xyz * 2.0 - 1.0);
 #endif
-  // src/shade/lighting_models.cpp, Blinn-Phong, one directional light (above the plane: facing = 1).
+  // src/kernel/lighting_models.cpp, Blinn-Phong, one directional light (above the plane: facing = 1).
   float n_dot_l = max(dot(n, light_dir), 0.0);
   vec3 h = normalize(light_dir + view);
   float spec = pow(max(dot(n, h), 0.0), shininess) * specular_scale * min(n_dot_l * 8.0, 1.0);

@@ -1,7 +1,7 @@
 #pragma once
 // Where horizon-based ambient occlusion looks: the same pattern for the per-frame AO (SIMD, float) and the
 // baked AO map (scalar, double), so both see the same directions and tap distances. The per-lane jitter
-// rotation is in shade/ambient_occlusion.hpp.
+// rotation is in kernel/ambient_occlusion.hpp.
 //
 // Directions: n = clamp(directions, 4, 16) equally spaced directions in the UV plane, direction i at
 //   angle 2 pi (i + r / kRotations) / n,

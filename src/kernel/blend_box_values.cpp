@@ -1,12 +1,13 @@
 // The blend's level-0 box values (qdmr/texture/blend_box_values.hpp), computed by this kernel with the code its
-// QDM walks run at a level-0 cell (level0_box_value), so a walk reading them keeps its bits.
-#include "qdmr/texture/blend_box_values.hpp"
-
+// QDM walks run at a level-0 cell (level0_box_value), so a walk reading them keeps its bits. Preparation runs it
+// (Kernel::blend_box_values).
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 
 #include "kernel/blended_surface.hpp"
+#include "kernel/kernel_calls.hpp"
+#include "kernel/preparation.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -14,6 +15,7 @@ using simd::Int;
 using simd::kLanes;
 
 void blend_box_values(const BlendBoxSource& source, float* out) {
+  kernel_calls.box_values.fetch_add(1, std::memory_order_relaxed);
   const LayerHeights& heights = *source.heights;
   const int period = heights.width * source.repeats;
   const SamplerState state = weight_sampler_state(SamplerState{});

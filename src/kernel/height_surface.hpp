@@ -6,7 +6,7 @@
 //   cell_max(level, cx, cy, needed)  a conservative maximum over a cell of the level-0 texel grid (wrap
 //                                addressing), exact at level 0 (the box surface QDM intersects), in the lanes of
 //                                `needed` (every lane by default; the others get any value).
-// SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (shade/blend.hpp) combines
+// SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (kernel/blended_surface.hpp) combines
 // up to four. Both are small per-batch values; the algorithms are templates over the surface type.
 #include <cstdint>
 

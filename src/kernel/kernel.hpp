@@ -1,7 +1,10 @@
 #pragma once
-// A draw kernel: the code of a frame that runs per pixel, compiled once per ISA (kernel_isa.cpp with that
-// ISA's flags) and chosen at run time. Everything else of the frame is baseline x86-64 and reaches the kernel
-// only through this interface.
+// A kernel: the code of a frame that is compiled once per ISA (everything in src/kernel/, with that ISA's flags)
+// and chosen at run time. Everything else is baseline x86-64 and reaches a kernel only through this table: the
+// draw (programs, tiles) and preparation (the blend's box values, max/min mip chains), both with the Renderer's
+// kernel, so `--isa` holds for every stage of a frame.
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -10,9 +13,18 @@
 #include "program/program.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
+#include "qdmr/texture/mip_texture.hpp"
 #include "raster/raster_context.hpp"
 
 namespace qdmr {
+
+// How often a kernel's own code ran, per entry point: counted inside the per-ISA functions (not by the table),
+// so a call that reaches a kernel some other way still counts under the ISA that ran. Once per material, tile,
+// mip level or box-value table: relaxed atomics, no cost worth measuring.
+struct KernelCalls {
+  std::atomic<std::uint64_t> programs{0}, tiles{0}, mip_levels{0}, box_values{0};
+};
 
 class Kernel {
 public:
@@ -22,12 +34,19 @@ public:
   // The shading program of one material (normal mapping, or a displacement technique), for this kernel.
   virtual std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
                                                  const LightRig& lights) const = 0;
-  // Clears and draws one tile (see raster/tile_raster.hpp); the context's programs must come from this kernel.
+  // Clears and draws one tile (see kernel/tile_raster.hpp); the context's programs must come from this kernel.
   virtual void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                            TileCounters& counters) const = 0;
+  // Preparation: a blend's level-0 box values (qdmr/texture/blend_box_values.hpp) into `out`, which holds
+  // blend_box_value_count(source) floats (not 0); every kernel gives the same bits.
+  virtual void blend_box_values(const BlendBoxSource& source, float* out) const = 0;
+  // Preparation: the max/min reduction of one mip level (MipReduce::Max / Min), for make_mip_texture.
+  virtual MipExtremum mip_extremum() const = 0;
+  virtual const KernelCalls& calls() const = 0;
 };
 
-// The kernel of a resolved ISA (not Auto); throws qdmr::Error when it is not built into this binary.
+// The kernel of a resolved ISA (not Auto); throws qdmr::Error when it is not built into this binary. Defined in
+// draw/kernel.cpp: kernel/ holds only code compiled per ISA.
 const Kernel& kernel_for(Isa isa);
 
 }  // namespace qdmr

@@ -1,10 +1,12 @@
-// The draw kernel of one ISA. This file (with raster/tile_raster.cpp, shade/ and texture/sampler.cpp) is compiled
-// once per ISA with that ISA's flags; QDMR_ISA names its namespace and QDMR_ISA_ENUM its Isa value.
-#include "kernel/kernel.hpp"
-#include "program/variant.hpp"
-#include "kernel/tile_raster.hpp"
+// The kernel table of one ISA. This file, as all of src/kernel/, is compiled once per ISA with that ISA's flags;
+// QDMR_ISA names its namespace and QDMR_ISA_ENUM its Isa value.
 #include "kernel/displacement.hpp"
+#include "kernel/kernel.hpp"
+#include "kernel/kernel_calls.hpp"
 #include "kernel/normal_mapping.hpp"
+#include "kernel/preparation.hpp"
+#include "kernel/tile_raster.hpp"
+#include "program/variant.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
@@ -16,6 +18,7 @@ public:
 
   std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
                                         const LightRig& lights) const override {
+    kernel_calls.programs.fetch_add(1, std::memory_order_relaxed);
     if (material.technique.kind == TechniqueKind::Normal && inputs.layers.size() == 1) {
       const LayerInputs& l = inputs.layers[0];
       return std::make_unique<NormalMappingProgram>(program_variant(material), *l.albedo, *l.normal, l.twin_texels,
@@ -29,6 +32,14 @@ public:
                    TileCounters& counters) const override {
     qdmr::QDMR_ISA::raster_tile(context, tile_index, tile, bins, counters);
   }
+
+  void blend_box_values(const BlendBoxSource& source, float* out) const override {
+    qdmr::QDMR_ISA::blend_box_values(source, out);
+  }
+
+  MipExtremum mip_extremum() const override { return &qdmr::QDMR_ISA::mip_extremum; }
+
+  const KernelCalls& calls() const override { return kernel_calls; }
 };
 
 }  // namespace

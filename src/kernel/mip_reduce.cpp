@@ -1,19 +1,18 @@
-// The max/min reducers of one ISA (compiled once per ISA, like the draw kernels): whole vectors of texel pairs
-// with SSE4.1 or AVX2 intrinsics (xsimd 8 has no byte/word pack or lane permute), the rest scalar.
-#include "texture/mip_reduce.hpp"
-
+// A kernel's max/min reducer (Kernel::mip_extremum): the scalar reduction of texture/mip_reduce.hpp around a loop
+// over whole vectors of texel pairs with SSE4.1 or AVX2 intrinsics (xsimd 8 has no byte/word pack or lane
+// permute; the AVX-512 kernel runs the AVX2 loop).
 #include <type_traits>
 
 #include <immintrin.h>
 
-#include "qdmr/core/isa.hpp"
+#include "kernel/kernel_calls.hpp"
+#include "texture/mip_reduce.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::mip {
 namespace {
 
 // ---- SIMD primitives: the same names on 256-bit (AVX2) or 128-bit (SSE4.1) vectors ----
 #if defined(__AVX2__)
-#define QDMR_MIP_SIMD 1
 using VecI = __m256i;
 using VecF = __m256;
 constexpr int kVecBytes = 32;
@@ -42,8 +41,7 @@ VecF even_f(VecF a, VecF b) { return _mm256_shuffle_ps(a, b, 0x88); }
 VecF odd_f(VecF a, VecF b) { return _mm256_shuffle_ps(a, b, 0xDD); }
 VecF as_f(VecI v) { return _mm256_castsi256_ps(v); }
 VecI as_i(VecF v) { return _mm256_castps_si256(v); }
-#elif defined(__SSE4_1__)
-#define QDMR_MIP_SIMD 1
+#else  // SSE4.2: every kernel has SSE4.1 at least
 using VecI = __m128i;
 using VecF = __m128;
 constexpr int kVecBytes = 16;
@@ -73,140 +71,59 @@ VecF as_f(VecI v) { return _mm_castsi128_ps(v); }
 VecI as_i(VecF v) { return _mm_castps_si128(v); }
 #endif
 
-// The scalar forms return what MAXPS / MINPS return (the second operand unless the first wins), so the
-// vector body and the scalar tail agree even on NaN and signed zeros.
-struct MaxOp {
-  template <class T>
-  static T scalar(T a, T b) { return a > b ? a : b; }
-#ifdef QDMR_MIP_SIMD
-  static VecI u8(VecI a, VecI b) { return max_u8(a, b); }
-  static VecI u16(VecI a, VecI b) { return max_u16(a, b); }
-  static VecF f32(VecF a, VecF b) { return max_f(a, b); }
-#endif
-};
-
-struct MinOp {
-  template <class T>
-  static T scalar(T a, T b) { return a < b ? a : b; }
-#ifdef QDMR_MIP_SIMD
-  static VecI u8(VecI a, VecI b) { return min_u8(a, b); }
-  static VecI u16(VecI a, VecI b) { return min_u16(a, b); }
-  static VecF f32(VecF a, VecF b) { return min_f(a, b); }
-#endif
-};
-
 // out texel i = op over texels 2i and 2i+1 of rows a and b (vertical first, then horizontal), for the first
 // pairs that fill whole vectors; returns how many were done. T is the channel type, C the channel count.
-template <class Op, class T, int C>
-int reduce_pairs_simd([[maybe_unused]] const std::uint8_t* a, [[maybe_unused]] const std::uint8_t* b,
-                      [[maybe_unused]] std::uint8_t* out, [[maybe_unused]] int pairs) {
-#ifdef QDMR_MIP_SIMD
-  constexpr int kTexelBytes = C * int(sizeof(T));
-  constexpr int kStep = kVecBytes / kTexelBytes;  // output texels per iteration
-  int i = 0;
-  for (; i + kStep <= pairs; i += kStep) {
-    const std::uint8_t* pa = a + std::size_t(i) * 2 * kTexelBytes;
-    const std::uint8_t* pb = b + std::size_t(i) * 2 * kTexelBytes;
-    std::uint8_t* po = out + std::size_t(i) * kTexelBytes;
-    if constexpr (std::is_same_v<T, float>) {
-      const VecF v0 = Op::f32(load_f(pa), load_f(pb));
-      const VecF v1 = Op::f32(load_f(pa + kVecBytes), load_f(pb + kVecBytes));
-      store_f(po, lane_order(Op::f32(even_f(v0, v1), odd_f(v0, v1))));
-    } else {
-      const auto op = [](VecI x, VecI y) {
-        if constexpr (sizeof(T) == 1) return Op::u8(x, y);
-        else return Op::u16(x, y);
-      };
-      const VecI v0 = op(load_i(pa), load_i(pb));
-      const VecI v1 = op(load_i(pa + kVecBytes), load_i(pb + kVecBytes));
-      // Bring texel 2i+1 onto texel 2i, combine, then keep the low texel of each pair.
-      if constexpr (kTexelBytes == 1) {
-        const VecI h0 = and_i(op(v0, shift_right_16(v0)), low_bytes_mask());
-        const VecI h1 = and_i(op(v1, shift_right_16(v1)), low_bytes_mask());
-        store_i(po, lane_order(pack_u16(h0, h1)));
-      } else if constexpr (kTexelBytes == 2) {
-        const VecI h0 = and_i(op(v0, shift_right_32(v0)), low_words_mask());
-        const VecI h1 = and_i(op(v1, shift_right_32(v1)), low_words_mask());
-        store_i(po, lane_order(pack_u32(h0, h1)));
+struct Vectors {
+  template <class Op, class T, int C>
+  static int pairs(const std::uint8_t* a, const std::uint8_t* b, std::uint8_t* out, int pairs) {
+    constexpr int kTexelBytes = C * int(sizeof(T));
+    constexpr int kStep = kVecBytes / kTexelBytes;  // output texels per iteration
+    int i = 0;
+    for (; i + kStep <= pairs; i += kStep) {
+      const std::uint8_t* pa = a + std::size_t(i) * 2 * kTexelBytes;
+      const std::uint8_t* pb = b + std::size_t(i) * 2 * kTexelBytes;
+      std::uint8_t* po = out + std::size_t(i) * kTexelBytes;
+      if constexpr (std::is_same_v<T, float>) {
+        const auto op = [](VecF x, VecF y) { return Op::kMax ? max_f(x, y) : min_f(x, y); };
+        const VecF v0 = op(load_f(pa), load_f(pb));
+        const VecF v1 = op(load_f(pa + kVecBytes), load_f(pb + kVecBytes));
+        store_f(po, lane_order(op(even_f(v0, v1), odd_f(v0, v1))));
       } else {
-        static_assert(kTexelBytes == 4);
-        const VecI h0 = op(v0, shift_right_64(v0)), h1 = op(v1, shift_right_64(v1));
-        store_i(po, as_i(lane_order(even_f(as_f(h0), as_f(h1)))));
-      }
-    }
-  }
-  return i;
-#else
-  return 0;
-#endif
-}
-
-// One output row from input rows a and b (b == a for a single row) of in_width texels.
-template <class Op, class T, int C>
-void reduce_two_rows(const std::uint8_t* a, const std::uint8_t* b, int in_width, std::uint8_t* out, int out_width) {
-  if (in_width == 1) {
-    for (int c = 0; c < C; ++c) store<T>(out, c, Op::scalar(load<T>(a, c), load<T>(b, c)));
-    return;
-  }
-  for (int i = reduce_pairs_simd<Op, T, C>(a, b, out, out_width); i < out_width; ++i)
-    for (int c = 0; c < C; ++c) {
-      const std::size_t left = std::size_t(2 * i) * C + c, right = left + C;
-      const T l = Op::scalar(load<T>(a, left), load<T>(b, left));
-      const T r = Op::scalar(load<T>(a, right), load<T>(b, right));
-      store<T>(out, std::size_t(i) * C + c, Op::scalar(l, r));
-    }
-  if (in_width & 1)  // the last texel also covers the leftover column
-    for (int c = 0; c < C; ++c) {
-      const std::size_t last = std::size_t(in_width - 1) * C + c, o = std::size_t(out_width - 1) * C + c;
-      store<T>(out, o, Op::scalar(load<T>(out, o), Op::scalar(load<T>(a, last), load<T>(b, last))));
-    }
-}
-
-template <class Op, class T, int C>
-void reduce_extremum(const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out, int out_w, int out_h) {
-  const std::size_t in_row = std::size_t(in_w) * C * sizeof(T), out_row = std::size_t(out_w) * C * sizeof(T);
-  for_rows(out_h, out_row, [&](int y0, int y1) {
-    for (int y = y0; y < y1; ++y) {
-      const Taps ty = taps(y, in_h, out_h);
-      const std::uint8_t* r0 = in + std::size_t(ty.first) * in_row;
-      std::uint8_t* o = out + std::size_t(y) * out_row;
-      reduce_two_rows<Op, T, C>(r0, ty.count > 1 ? r0 + in_row : r0, in_w, o, out_w);
-      if (ty.count == 3) {  // the leftover row of an odd height: once per level, scalar
-        const std::uint8_t* r2 = r0 + 2 * in_row;
-        for (int x = 0; x < out_w; ++x) {
-          const Taps tx = taps(x, in_w, out_w);
-          for (int c = 0; c < C; ++c) {
-            T v = load<T>(r2, std::size_t(tx.first) * C + c);
-            for (int i = 1; i < tx.count; ++i) v = Op::scalar(v, load<T>(r2, std::size_t(tx.first + i) * C + c));
-            const std::size_t oi = std::size_t(x) * C + c;
-            store<T>(o, oi, Op::scalar(load<T>(o, oi), v));
-          }
+        const auto op = [](VecI x, VecI y) {
+          if constexpr (sizeof(T) == 1) return Op::kMax ? max_u8(x, y) : min_u8(x, y);
+          else return Op::kMax ? max_u16(x, y) : min_u16(x, y);
+        };
+        const VecI v0 = op(load_i(pa), load_i(pb));
+        const VecI v1 = op(load_i(pa + kVecBytes), load_i(pb + kVecBytes));
+        // Bring texel 2i+1 onto texel 2i, combine, then keep the low texel of each pair.
+        if constexpr (kTexelBytes == 1) {
+          const VecI h0 = and_i(op(v0, shift_right_16(v0)), low_bytes_mask());
+          const VecI h1 = and_i(op(v1, shift_right_16(v1)), low_bytes_mask());
+          store_i(po, lane_order(pack_u16(h0, h1)));
+        } else if constexpr (kTexelBytes == 2) {
+          const VecI h0 = and_i(op(v0, shift_right_32(v0)), low_words_mask());
+          const VecI h1 = and_i(op(v1, shift_right_32(v1)), low_words_mask());
+          store_i(po, lane_order(pack_u32(h0, h1)));
+        } else {
+          static_assert(kTexelBytes == 4);
+          const VecI h0 = op(v0, shift_right_64(v0)), h1 = op(v1, shift_right_64(v1));
+          store_i(po, as_i(lane_order(even_f(as_f(h0), as_f(h1)))));
         }
       }
     }
-  });
-}
-
-template <class Op>
-void reduce_format(TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out, int out_w,
-                   int out_h) {
-  switch (format) {
-    case TexelFormat::R8: reduce_extremum<Op, std::uint8_t, 1>(in, in_w, in_h, out, out_w, out_h); break;
-    case TexelFormat::RG8: reduce_extremum<Op, std::uint8_t, 2>(in, in_w, in_h, out, out_w, out_h); break;
-    case TexelFormat::RGBA8: reduce_extremum<Op, std::uint8_t, 4>(in, in_w, in_h, out, out_w, out_h); break;
-    case TexelFormat::R16: reduce_extremum<Op, std::uint16_t, 1>(in, in_w, in_h, out, out_w, out_h); break;
-    case TexelFormat::R32F: reduce_extremum<Op, float, 1>(in, in_w, in_h, out, out_w, out_h); break;
+    return i;
   }
-}
+};
 
 }  // namespace
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::mip
 
-void reduce_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out,
-                     int out_w, int out_h) {
-  if (max)
-    reduce_format<MaxOp>(format, in, in_w, in_h, out, out_w, out_h);
-  else
-    reduce_format<MinOp>(format, in, in_w, in_h, out, out_w, out_h);
+namespace qdmr::QDMR_ISA_NAMESPACE {
+
+void mip_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out,
+                  int out_w, int out_h) {
+  kernel_calls.mip_levels.fetch_add(1, std::memory_order_relaxed);
+  mip::extremum<mip::Vectors>(max, format, in, in_w, in_h, out, out_w, out_h);
 }
 
-}  // namespace qdmr::QDMR_ISA_NAMESPACE::mip
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,5 +1,5 @@
 #pragma once
-// Quadtree displacement mapping over a max-quadtree; V is the trace variant (shade/displacement.hpp).
+// Quadtree displacement mapping over a max-quadtree; V is the trace variant (kernel/displacement.hpp).
 #include <limits>
 
 #include "qdmr/scene/scene.hpp"

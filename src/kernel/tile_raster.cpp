@@ -9,8 +9,9 @@
 
 #include <immintrin.h>
 
-#include "kernel/quad_rows.hpp"
 #include "kernel/batch.hpp"
+#include "kernel/kernel_calls.hpp"
+#include "kernel/quad_rows.hpp"
 #include "qdmr/core/limits.hpp"
 #include "texture/fetch_recorder.hpp"
 
@@ -588,6 +589,7 @@ void stream_floats(float* dst, const float* src, std::size_t n) {
 
 void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                  TileCounters& counters) {
+  kernel_calls.tiles.fetch_add(1, std::memory_order_relaxed);
   Framebuffer& fb = *context.framebuffer;
   fb.clear_aovs(tile.x0, tile.y0, tile.x1, tile.y1);
   const int width = tile.x1 - tile.x0 + 1, height = tile.y1 - tile.y0 + 1;

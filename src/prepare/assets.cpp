@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 
+#include "kernel/kernel.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/progress.hpp"
@@ -21,8 +22,9 @@ namespace {
 
 // A layer's heights through the storage the scene asks for (quantisation, BC3), so what is rendered is what a
 // GPU would sample; the BC3 error goes to `stat`.
-HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, TextureStat& stat) {
-  HeightTexture stored = make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce);
+HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, MipExtremum extremum, TextureStat& stat) {
+  HeightTexture stored =
+      make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce, extremum);
   stat.height_format = format_name(stored.texture.format);
   if (stored.bc3) {
     stat.bc3 = true;
@@ -34,24 +36,24 @@ HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, Tex
 
 // Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
 // texture_working_bytes counts the most this holds at once, step by step.
-Texture build_texture(const TextureRequest& request, TextureStat& stat) {
+Texture build_texture(const TextureRequest& request, MipExtremum extremum, TextureStat& stat) {
   Texture texture;
   if (request.purpose == TexturePurpose::Height) {
-    texture = stored_height(request, request.reduce, stat).texture;
+    texture = stored_height(request, request.reduce, extremum, stat).texture;
     add_linear_copy(texture);
     if (request.wrap_footprints) add_wrap_footprints(texture);
   } else {
     Image level0;
     if (request.desc.source == TextureSource::FromHeight) {
       // Behind a from_height normal map only level 0 is used: any reduction will do.
-      const Image height = stored_height(request, MipReduce::Box, stat).texture.level_image(0);
+      const Image height = stored_height(request, MipReduce::Box, extremum, stat).texture.level_image(0);
       level0 = make_texture(request.desc, request.purpose, request.layer, &height, request.where);
     } else {
       level0 = make_texture(request.desc, request.purpose, request.layer, nullptr, request.where);
     }
     if (request.purpose == TexturePurpose::Normal)
       for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
-    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce);
+    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce, extremum);
     add_linear_copy(texture);
   }
   stat.where = request.where;
@@ -95,9 +97,10 @@ struct Previous {
 
 class Preparer {
 public:
-  Preparer(const FramePlan& plan, const Previous& previous, Assets& assets,
+  Preparer(const FramePlan& plan, const Kernel& kernel, const Previous& previous, Assets& assets,
            const std::function<void(double)>& progress)
-      : plan_(plan), previous_(previous), assets_(assets), progress_(progress), file_(plan.scene.file.string()) {}
+      : plan_(plan), kernel_(kernel), previous_(previous), assets_(assets), progress_(progress),
+        file_(plan.scene.file.string()) {}
 
   void run() {
     const std::vector<std::string> items = plan_.items();
@@ -195,7 +198,8 @@ private:
               const ProgressStep step("texture " + std::to_string(request.width) + "x" + std::to_string(request.height) +
                                       " (" + request.where + ")");  // a line on a terminal when it takes seconds
               const auto start = Clock::now();
-              assets_.textures[i] = std::make_shared<const Texture>(build_texture(request, assets_.texture_stats[i]));
+              assets_.textures[i] = std::make_shared<const Texture>(
+                  build_texture(request, kernel_.mip_extremum(), assets_.texture_stats[i]));
               record("texture " + request.key, plan_.meshes.size() + i,
                      {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
             }));
@@ -213,8 +217,8 @@ private:
     const MaterialDesc& desc = m.desc;
     const ProgressStep step(std::string(derived_kind_name(d.kind)) + " of " + m.name);  // (and Ctrl-C stops here)
     const auto input = [&](std::size_t k) -> const DerivedAsset& { return assets_.derived[std::size_t(d.inputs.at(k))]; };
-    const auto mip = [](Image image, TexelFormat format, MipReduce reduce) {
-      return std::make_shared<const Texture>(make_mip_texture(image, format, false, reduce));
+    const auto mip = [&](Image image, TexelFormat format, MipReduce reduce) {
+      return std::make_shared<const Texture>(make_mip_texture(image, format, false, reduce, kernel_.mip_extremum()));
     };
     switch (d.kind) {
       case DerivedKind::WeightTexture: {
@@ -226,7 +230,7 @@ private:
             const MeshData& mesh = *assets_.meshes[o];
             rasterize_vertex_weights(mesh.uvs, mesh.indices, vertex_weights(map, mesh.uvs, w.scale), w.scale, level0);
           }
-        out.texture = std::make_shared<const Texture>(make_weight_texture(level0));
+        out.texture = std::make_shared<const Texture>(make_weight_texture(level0, kernel_.mip_extremum()));
         break;
       }
       case DerivedKind::CombinedSurface: {
@@ -239,14 +243,18 @@ private:
         break;
       }
       case DerivedKind::CombinedQuadtree: {
-        out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field));
+        out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field, kernel_.mip_extremum()));
         std::vector<const Texture*> chains;
         for (const LayerPlan& l : m.layers) chains.push_back(assets_.textures[std::size_t(l.height_max)].get());
         if (LayerHeights heights = interleave_layer_heights(chains); heights.width > 0) {
           out.layer_heights = std::make_shared<const LayerHeights>(std::move(heights));
-          std::vector<float> values = blend_box_values(
-              {input(1).texture.get(), m.weights_scale, out.layer_heights.get(), desc.blend.op, int(m.layers.size())});
-          if (!values.empty()) out.box_values = std::make_shared<const std::vector<float>>(std::move(values));
+          const BlendBoxSource source{input(1).texture.get(), m.weights_scale, out.layer_heights.get(), desc.blend.op,
+                                      int(m.layers.size())};
+          if (const std::size_t count = blend_box_value_count(source); count > 0) {
+            std::vector<float> values(count);
+            kernel_.blend_box_values(source, values.data());
+            out.box_values = std::make_shared<const std::vector<float>>(std::move(values));
+          }
         }
         break;
       }
@@ -284,6 +292,7 @@ private:
   }
 
   const FramePlan& plan_;
+  const Kernel& kernel_;
   const Previous& previous_;
   Assets& assets_;
   const std::function<void(double)>& progress_;
@@ -311,11 +320,11 @@ std::uint64_t Assets::mesh_bytes() const {
   return bytes;
 }
 
-Assets prepare(const FramePlan& plan, const Assets* previous, const FramePlan* previous_plan,
+Assets prepare(const FramePlan& plan, const Kernel& kernel, const Assets* previous, const FramePlan* previous_plan,
                const std::function<void(double)>& progress) {
   Assets assets;
   const Previous reuse(previous, previous_plan);
-  Preparer(plan, reuse, assets, progress).run();
+  Preparer(plan, kernel, reuse, assets, progress).run();
   return assets;
 }
 

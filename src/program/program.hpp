@@ -1,7 +1,7 @@
 #pragma once
 // A shading program as the rest of the frame sees it: made by a draw kernel (one per ISA) for one material,
 // named by its variant, run by that kernel's rasterizer. What it runs on (lanes, SIMD types) is the kernel's
-// business: see program/batch.hpp.
+// business: see kernel/batch.hpp.
 #include <string>
 
 #include "program/varyings.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 // Program variants: the options a material fixes that a displacement program's inner loops would otherwise test
-// per iteration are template arguments of the program's trace (shade/displacement.cpp instantiates every
+// per iteration are template arguments of the program's trace (kernel/displacement.cpp instantiates every
 // combination below, 23 per ISA). The plan derives the options from the material (trace_options) and names the
 // variant; the program reports the name of the instantiation it runs, from its template arguments. A test checks
 // that the two agree.

@@ -150,7 +150,7 @@ void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   std::function<void(double)> prepare_progress;
   if (s.options.progress) prepare_progress = [&report = s.options.progress](double f) { report("prepare", f); };
   s.arena.execute([&] {
-    Assets assets = prepare(plan, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress);
+    Assets assets = prepare(plan, *s.kernel, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress);
     // Programs point into the new assets: make them before the old assets go.
     std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel);
     s.programs = std::move(programs);

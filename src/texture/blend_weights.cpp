@@ -130,8 +130,8 @@ Image resample_weight_map(const Image& map, int resolution) {
   return level0;
 }
 
-Texture make_weight_texture(const Image& level0) {
-  return make_mip_texture(level0, TexelFormat::RGBA8, false, MipReduce::Max);
+Texture make_weight_texture(const Image& level0, MipExtremum extremum) {
+  return make_mip_texture(level0, TexelFormat::RGBA8, false, MipReduce::Max, extremum);
 }
 
 void rasterize_vertex_weights(const std::vector<glm::vec2>& uvs, const std::vector<std::uint32_t>& indices,
@@ -229,7 +229,7 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   return field;
 }
 
-Texture combined_quadtree(const HeightField& surface) {
+Texture combined_quadtree(const HeightField& surface, MipExtremum extremum) {
   Image level1(surface.width / 2, surface.height / 2, 1);
   const auto at = [&](int x, int y) { return surface.h[std::size_t(y) * std::size_t(surface.width) + std::size_t(x)]; };
   tbb::parallel_for(0, level1.height, [&](int y) {
@@ -241,7 +241,7 @@ Texture combined_quadtree(const HeightField& surface) {
       level1.at(x, y, 0) = float(std::min(1.0, std::ceil((top + 1e-6) * 65535.0) / 65535.0));
     }
   });
-  return make_mip_texture(level1, TexelFormat::R16, false, MipReduce::Max);
+  return make_mip_texture(level1, TexelFormat::R16, false, MipReduce::Max, extremum);
 }
 
 }  // namespace qdmr

@@ -30,8 +30,8 @@ void rasterize_vertex_weights(const std::vector<glm::vec2>& uvs, const std::vect
                               const std::vector<glm::vec4>& weights, float scale, Image& texture);
 
 // The per-pixel weight texture from its level 0 (resampled or rasterized): RGBA8 linear, with a max chain so
-// coarse levels bound the weights of regions.
-Texture make_weight_texture(const Image& level0);
+// coarse levels bound the weights of regions (reduced by `extremum`, see make_mip_texture).
+Texture make_weight_texture(const Image& level0, MipExtremum extremum = nullptr);
 // The map resampled (bilinear, wrapping) to resolution x resolution.
 Image resample_weight_map(const Image& map, int resolution);
 
@@ -42,7 +42,8 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
                              BlendOperator op);
 
 // The precomputed combined quadtree of such a surface (WeightTexture::combined): level k = the maxima over cells
-// of level k + 1, R16 rounded up (conservative for the fp32 box values the shader computes).
-Texture combined_quadtree(const HeightField& surface);
+// of level k + 1, R16 rounded up (conservative for the fp32 box values the shader computes); levels 2.. reduced by
+// `extremum` (make_mip_texture).
+Texture combined_quadtree(const HeightField& surface, MipExtremum extremum = nullptr);
 
 }  // namespace qdmr

@@ -6,7 +6,7 @@
 // them: per phase, the k-th texel of every lane of the warp, then the (k+1)-th. Lanes are pixels and warps are
 // runs of whole quads in draw order, so the result does not depend on the SIMD width or the thread count.
 // ISA-neutral and out of line (the kernels of every ISA call the same copy), reached through
-// texture/fetch_trace.hpp.
+// kernel/fetch_trace.hpp.
 #include <cstdint>
 #include <vector>
 

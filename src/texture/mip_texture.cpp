@@ -1,6 +1,6 @@
 // Typed mip chains: quantisation of level 0, and Box / BoxNormal / Max / Min reductions level by level.
-// Max and Min are exact in the stored values and run on SIMD vectors (AVX2 or SSE4.1, whichever the build
-// targets); a scalar tail computes the same operations in the same order, so every build gives the same bits.
+// Max and Min are exact in the stored values: a kernel's reducer (on its vectors) and the portable one (scalar)
+// give the same bits.
 #include "qdmr/texture/mip_texture.hpp"
 
 #include <tbb/blocked_range.h>
@@ -272,7 +272,7 @@ Texture allocate_texture(int width, int height, TexelFormat format, bool srgb) {
   return t;
 }
 
-Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, MipReduce reduce) {
+Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, MipReduce reduce, MipExtremum extremum) {
   if (level0.channels < 1 || level0.channels > 4)
     throw Error("texture", "level 0 must have 1 to 4 channels, not " + std::to_string(level0.channels));
   Texture t = allocate_texture(level0.width, level0.height, format, srgb);
@@ -288,11 +288,12 @@ Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, Mip
         }
     });
   });
-  build_mip_levels(t, reduce);
+  build_mip_levels(t, reduce, extremum);
   return t;
 }
 
-void build_mip_levels(Texture& texture, MipReduce reduce) {
+void build_mip_levels(Texture& texture, MipReduce reduce, MipExtremum extremum) {
+  if (extremum == nullptr) extremum = &mip::extremum<mip::NoVectors>;
   if (texture.levels.empty()) throw Error("texture", "build_mip_levels: the texture has no level 0");
   if (reduce == MipReduce::BoxNormal && (texture.format != TexelFormat::RGBA8 || texture.srgb))
     throw Error("texture", "normal maps need the rgba8 format without sRGB, not " + format_name(texture.format) +
@@ -311,10 +312,10 @@ void build_mip_levels(Texture& texture, MipReduce reduce) {
         reduce_box<true>(texture, k, Codec<TexelFormat::RGBA8, false>{}, out_base);
         break;
       case MipReduce::Max:
-        reduce_extremum_best(true, texture.format, in_base, in.width, in.height, out_base, out.width, out.height);
+        extremum(true, texture.format, in_base, in.width, in.height, out_base, out.width, out.height);
         break;
       case MipReduce::Min:
-        reduce_extremum_best(false, texture.format, in_base, in.width, in.height, out_base, out.width, out.height);
+        extremum(false, texture.format, in_base, in.width, in.height, out_base, out.width, out.height);
         break;
     }
   }

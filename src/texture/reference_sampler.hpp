@@ -1,7 +1,7 @@
 #pragma once
 // The scalar reference sampler: qdmr's documented sampling behaviour written plainly, one sample at a time,
 // over Texture::texel() (which throws on any out-of-range texel). It shares no code with the SIMD sampler
-// (src/texture/sampler.cpp); the tests require the two to agree bit for bit in every lane.
+// (src/kernel/sampler.cpp); the tests require the two to agree bit for bit in every lane.
 //
 // The behaviour (docs/sampling.md):
 //  - non-finite u or v: level-0 texel (0, 0);

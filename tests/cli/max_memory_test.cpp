@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "kernel/kernel.hpp"
 #include "prepare/assets.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/bake/cone_map.hpp"
@@ -189,7 +190,7 @@ TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
       const DerivedPlan& cones = plan.derived[std::size_t(plan.materials[0].cones)];
       ASSERT_EQ(cones.inputs.size(), 1u);
       const DerivedPlan& field_plan = plan.derived[std::size_t(cones.inputs[0])];
-      const Assets assets = prepare(plan);
+      const Assets assets = prepare(plan, kernel_for(resolve_isa(Isa::Auto)));
       const HeightField& field = *assets.derived[std::size_t(cones.inputs[0])].field;
       const ConeMap& map = *assets.derived[std::size_t(plan.materials[0].cones)].cones;
       EXPECT_EQ(field.width, 48);
@@ -371,7 +372,7 @@ TEST(MaxMemory, ThePlanCountsTheAoBakersWorkingMemory) {
     EXPECT_EQ(item.working_bytes, ao_bake_bytes(64, 32, plan.materials[0].desc.ao));
     EXPECT_EQ(item.bytes, mip_chain_bytes(32, 16, TexelFormat::R16));
     EXPECT_GE(plan.working_bytes, item.working_bytes);
-    const Assets assets = prepare(plan);
+    const Assets assets = prepare(plan, kernel_for(resolve_isa(Isa::Auto)));
     const Texture& map = *assets.derived[std::size_t(ao)].texture;
     EXPECT_EQ(map.width(), 32);
     EXPECT_EQ(map.height(), 16);
@@ -460,7 +461,7 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
     return plan_frame(load_scene(dir / "scene.json"));
   };
   // The image module loaded and oneTBB's threads made before any measurement.
-  (void)prepare(scene(R"("albedo": "small.pgm")", "normal"));
+  (void)prepare(scene(R"("albedo": "small.pgm")", "normal"), kernel_for(resolve_isa(Isa::Auto)));
   struct Case {
     std::string layer, technique;
   };
@@ -473,8 +474,9 @@ TEST(MaxMemory, ThePlanCoversTheTextureBuildsPeak) {
     const FramePlan plan = scene(c.layer, c.technique);
     ASSERT_GT(plan.texture_working_bytes, 0u);
     const std::uint64_t estimate = plan.texture_bytes + plan.texture_working_bytes;
+    const Kernel& kernel = kernel_for(resolve_isa(Isa::Auto));
     const std::optional<std::uint64_t> measured =
-        peak_growth([&] { EXPECT_EQ(prepare(plan).texture_bytes(), plan.texture_bytes); });
+        peak_growth([&] { EXPECT_EQ(prepare(plan, kernel).texture_bytes(), plan.texture_bytes); });
     if (!measured) GTEST_SKIP() << "cannot reset the peak resident memory (/proc/self/clear_refs)";
     // The finished textures are resident at the end whatever the schedule, but the working memory of builds that
     // may run at once peaks together only where the scheduler runs them together: on a loaded machine they ran

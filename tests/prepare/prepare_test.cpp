@@ -7,6 +7,7 @@
 #include <set>
 
 #include "cli/cli_test_util.hpp"
+#include "kernel/kernel.hpp"
 #include "prepare/assets.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
@@ -35,7 +36,7 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
     const FramePlan plan = plan_frame(scene, PlanOptions{aovs});
     const std::vector<std::string> items = plan.items();
     EXPECT_EQ(std::set<std::string>(items.begin(), items.end()).size(), items.size()) << "an item is listed twice";
-    const Assets assets = prepare(plan);
+    const Assets assets = prepare(plan, kernel_for(resolve_isa(Isa::Auto)));
     EXPECT_EQ(assets.built, items) << shipped.name;
     EXPECT_TRUE(assets.reused.empty());
     ASSERT_EQ(assets.meshes.size(), plan.meshes.size());
@@ -64,7 +65,7 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
       }
     }
     // Prepared again with the first assets as the previous ones: nothing is built, everything shared.
-    const Assets again = prepare(plan, &assets, &plan);
+    const Assets again = prepare(plan, kernel_for(resolve_isa(Isa::Auto)), &assets, &plan);
     EXPECT_TRUE(again.built.empty());
     EXPECT_EQ(again.reused, items);
     for (std::size_t i = 0; i < assets.textures.size(); ++i) EXPECT_EQ(again.textures[i], assets.textures[i]);
@@ -92,22 +93,22 @@ TEST(PrepareReuse, ACameraChangeRebuildsNothingADepthScaleChangeOnlyItsDerivedDa
   const ShippedScene csm{"pom_vs_qdm_depth_1.0", false};
   const SceneDesc base = load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}});
   const FramePlan plan = plan_frame(base);
-  const Assets assets = prepare(plan);
+  const Assets assets = prepare(plan, kernel_for(resolve_isa(Isa::Auto)));
 
   const SceneDesc moved = load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/camera/fov_deg", "20"}});
   const FramePlan moved_plan = plan_frame(moved);
   EXPECT_EQ(moved_plan.items(), plan.items());
-  EXPECT_TRUE(prepare(moved_plan, &assets, &plan).built.empty());
+  EXPECT_TRUE(prepare(moved_plan, kernel_for(resolve_isa(Isa::Auto)), &assets, &plan).built.empty());
 
   // The cone map is baked from the heights alone: a new depth scale keeps it; new heights rebuild it.
   const SceneDesc deeper =
       load_shipped(csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/materials/surface/technique/depth_scale", "0.2"}});
   const FramePlan deeper_plan = plan_frame(deeper);
-  EXPECT_TRUE(prepare(deeper_plan, &assets, &plan).built.empty());
+  EXPECT_TRUE(prepare(deeper_plan, kernel_for(resolve_isa(Isa::Auto)), &assets, &plan).built.empty());
   const SceneDesc other = load_shipped(
       csm, {{"/materials/surface/technique/name", "\"csm\""}, {"/materials/surface/layers/0/height/seed", "77"}});
   const FramePlan other_plan = plan_frame(other);
-  const Assets rebuilt = prepare(other_plan, &assets, &plan);
+  const Assets rebuilt = prepare(other_plan, kernel_for(resolve_isa(Isa::Auto)), &assets, &plan);
   ASSERT_FALSE(rebuilt.built.empty());
   // (The interleaved albedo and normal map hold the normal map, made from the heights.)
   for (const std::string& item : rebuilt.built)

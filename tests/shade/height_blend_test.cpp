@@ -6,11 +6,13 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "displacement_test_util.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
+#include "kernel/kernel.hpp"
 #include "kernel/self_shadow.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {
@@ -371,9 +373,9 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
   EXPECT_EQ(wrong, 0) << "of " << checked << " starts";
 }
 
-// The blend's level-0 box values over one period (blend_box_values, from the best kernel this CPU runs) are the
-// values a walk computes at its level-0 cells, bit for bit, for every operator: a walk reading them keeps its bits.
-// Checked over every cell of the period, on the surface without the table (layer chains, and the interleaved
+// The blend's level-0 box values over one period (Kernel::blend_box_values, of every kernel this CPU runs) are
+// the values a walk computes at its level-0 cells, bit for bit, for every operator: a walk reading them keeps its
+// bits. Checked over every cell of the period, on the surface without the table (layer chains, and the interleaved
 // heights) and with it, in batches that mix level-0 cells inside the period, outside it and coarse cells.
 TEST(HeightBlend, BoxValuesAreTheLevelZeroValuesAWalkComputes) {
   const int n = 16, repeats = 3, period = n * repeats;
@@ -401,8 +403,15 @@ TEST(HeightBlend, BoxValuesAreTheLevelZeroValuesAWalkComputes) {
   std::vector<const Texture*> box_pointers;
   for (const Texture& t : box) box_pointers.push_back(&t);
   for (BlendOperator op : {BlendOperator::Height, BlendOperator::Alpha, BlendOperator::HeightWidth}) {
-    const std::vector<float> values = blend_box_values({&weights, repeats, &interleaved, op, kLayers});
-    ASSERT_EQ(values.size(), std::size_t(period) * std::size_t(period));
+    const BlendBoxSource source{&weights, repeats, &interleaved, op, kLayers};
+    ASSERT_EQ(blend_box_value_count(source), std::size_t(period) * std::size_t(period));
+    std::vector<float> values(blend_box_value_count(source));
+    kernel_for(resolve_isa(Isa::Auto)).blend_box_values(source, values.data());
+    for (const Isa isa : usable_isas()) {  // every kernel: the same bits
+      std::vector<float> again(values.size());
+      kernel_for(isa).blend_box_values(source, again.data());
+      ASSERT_EQ(std::memcmp(again.data(), values.data(), values.size() * sizeof(float)), 0) << isa_name(isa);
+    }
     const Texture tree = combined_quadtree(combined_surface(box_pointers, weights, repeats, op));
     const TextureSampler tree_view(tree, sampler);
     const WeightTexture chains_only{&weight_view, float(repeats), &tree_view, period, period};

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "kernel/kernel.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "texture/internal.hpp"
@@ -308,12 +309,22 @@ void expect_extremum_chain(const Texture& t, bool is_max) {
         }
 }
 
+// The portable reducer's chains, and every kernel's this CPU runs: the same bits.
 void check_sizes(TexelFormat format, const std::vector<std::pair<int, int>>& sizes) {
   std::mt19937 rng(11);
   for (const auto& [w, h] : sizes) {
     const Image level0 = random_image(w, h, channel_count(format), rng);
-    expect_extremum_chain(make_mip_texture(level0, format, false, MipReduce::Max), true);
-    expect_extremum_chain(make_mip_texture(level0, format, false, MipReduce::Min), false);
+    const Texture max = make_mip_texture(level0, format, false, MipReduce::Max);
+    const Texture min = make_mip_texture(level0, format, false, MipReduce::Min);
+    expect_extremum_chain(max, true);
+    expect_extremum_chain(min, false);
+    for (const Isa isa : usable_isas()) {
+      const MipExtremum extremum = kernel_for(isa).mip_extremum();
+      ASSERT_EQ(make_mip_texture(level0, format, false, MipReduce::Max, extremum).storage, max.storage)
+          << isa_name(isa) << " max, " << w << "x" << h << " " << format_name(format);
+      ASSERT_EQ(make_mip_texture(level0, format, false, MipReduce::Min, extremum).storage, min.storage)
+          << isa_name(isa) << " min, " << w << "x" << h << " " << format_name(format);
+    }
   }
 }
 
@@ -359,8 +370,9 @@ TEST(MipTexture, ThreadCountDoesNotChangeTheResult) {
   const auto build = [&](int threads) {
     std::vector<std::vector<std::uint8_t>> out;
     tbb::task_arena(threads).execute([&] {
-      out.push_back(make_mip_texture(gray, TexelFormat::R8, false, MipReduce::Max).storage);
-      out.push_back(make_mip_texture(gray, TexelFormat::R32F, false, MipReduce::Min).storage);
+      const MipExtremum extremum = kernel_for(resolve_isa(Isa::Auto)).mip_extremum();
+      out.push_back(make_mip_texture(gray, TexelFormat::R8, false, MipReduce::Max, extremum).storage);
+      out.push_back(make_mip_texture(gray, TexelFormat::R32F, false, MipReduce::Min, extremum).storage);
       out.push_back(make_mip_texture(colour, TexelFormat::RGBA8, true, MipReduce::Box).storage);
       out.push_back(make_mip_texture(colour, TexelFormat::RGBA8, false, MipReduce::BoxNormal).storage);
     });

@@ -1,6 +1,6 @@
 #pragma once
 // Baked ambient occlusion (the talk: AO "need[s] to calculate only when height field changes ... use at content
-// generation"): the per-frame horizon AO of shade/ambient_occlusion.hpp evaluated once per texel of a map, in
+// generation"): the per-frame horizon AO of kernel/ambient_occlusion.hpp evaluated once per texel of a map, in
 // double precision, to be sampled bilinearly at the hit UV.
 //
 // Texel (i, j) of a W' x H' map holds the AO of the surface point above UV ((i + 0.5) / W', (j + 0.5) / H'):

@@ -19,7 +19,7 @@ namespace qdmr {
 ReferenceHit intersect_reference(const HeightField& field, double depth_scale, const SurfaceRay& ray,
                                  ReferenceSurface surface, std::int64_t max_cells = 1 << 22);
 
-// Whether a point on the Box surface sees a directional light: the hard self-shadow (shade/self_shadow.hpp
+// Whether a point on the Box surface sees a directional light: the hard self-shadow (kernel/self_shadow.hpp
 // implements the same rule in fp32). The light ray climbs from start = (u, v, depth): after climbing c it is
 // at (u + climb.x c, v + climb.y c, depth - c), climb being the UV change per unit of depth climbed
 // (light_tangent.xy / light_tangent.z). Each level-0 texel is a column below its top depth

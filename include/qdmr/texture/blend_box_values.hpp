@@ -5,8 +5,8 @@
 // by the operator. A QDM walk over the blend then reads one float per lane at a level-0 cell where it would
 // blend there (about 200 instructions per batch, the same for 4 lanes as for 8): the same bits, and the walk's
 // level-0 steps stop costing what its coarse steps do not.
+#include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/layer_heights.hpp"
@@ -14,7 +14,7 @@
 
 namespace qdmr {
 
-// What blend_box_values() keeps for layers of width x height whose weights span `repeats` repeats, with
+// What the box values keep for layers of width x height whose weights span `repeats` repeats, with
 // interleaved level-0 heights of layer_heights_bytes: 4 bytes per cell of the period, where those heights exist
 // (layer_heights_bytes > 0) and the period is square; else 0 (the walk blends at its level-0 cells).
 std::uint64_t blend_box_values_bytes(int width, int height, int repeats, std::uint64_t layer_heights_bytes);
@@ -27,8 +27,8 @@ struct BlendBoxSource {
   int layers = 1;
 };
 
-// period x period floats (period = heights->width * repeats), row by row, from the best draw kernel this CPU runs
-// (every kernel gives the same bits); empty where blend_box_values_bytes() is 0 for the source or no kernel runs.
-std::vector<float> blend_box_values(const BlendBoxSource& source);
+// How many floats the values of `source` are: period x period (period = heights->width * repeats), row by row,
+// or 0 where blend_box_values_bytes() is 0. A draw kernel computes them (Kernel::blend_box_values, src/kernel/).
+std::size_t blend_box_value_count(const BlendBoxSource& source);
 
 }  // namespace qdmr

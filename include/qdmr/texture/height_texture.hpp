@@ -19,6 +19,8 @@ struct HeightTexture {
   std::optional<Bc3Report> bc3;  // the encode error, when compressed
 };
 
-HeightTexture make_height_texture(const Image& height, const TextureDesc& desc, MipReduce reduce);
+// The chain's Max / Min levels by `extremum` (make_mip_texture).
+HeightTexture make_height_texture(const Image& height, const TextureDesc& desc, MipReduce reduce,
+                                  MipExtremum extremum = nullptr);
 
 }  // namespace qdmr

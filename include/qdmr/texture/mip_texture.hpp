@@ -87,11 +87,19 @@ void add_wrap_footprints(Texture& texture);
 // Allocates the chain for a w x h level 0 (all levels, zeroed, with the tail padding).
 Texture allocate_texture(int width, int height, TexelFormat format, bool srgb);
 
+// The max (or min) of each output texel's taps, level `in` (in_w x in_h) to level `out`: MipReduce::Max / Min.
+// Exact in the stored values, so every reducer gives the same bits; a draw kernel's runs on its vectors
+// (Kernel::mip_extremum, which preparation passes so that `--isa` holds there too).
+using MipExtremum = void (*)(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h,
+                             std::uint8_t* out, int out_w, int out_h);
+
 // Quantises level 0 (values in [0,1]; normals as 0.5 + 0.5 n already) into `format` and builds the chain.
-// Channels beyond the image's are filled with 0 (alpha with 1). Rounds to nearest; clamps to [0,1].
-Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, MipReduce reduce);
+// Channels beyond the image's are filled with 0 (alpha with 1). Rounds to nearest; clamps to [0,1]. Max and Min
+// run `extremum`; null: the portable reducer (scalar, baseline x86-64).
+Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, MipReduce reduce,
+                         MipExtremum extremum = nullptr);
 
 // Rebuilds levels 1.. from level 0 with the given reduction (level 0 already filled in storage).
-void build_mip_levels(Texture& texture, MipReduce reduce);
+void build_mip_levels(Texture& texture, MipReduce reduce, MipExtremum extremum = nullptr);
 
 }  // namespace qdmr

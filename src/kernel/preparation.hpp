@@ -1,0 +1,19 @@
+#pragma once
+// The per-ISA work of preparation, behind Kernel::blend_box_values and Kernel::mip_extremum.
+#include <cstdint>
+
+#include "core/isa_namespace.hpp"
+#include "qdmr/texture/blend_box_values.hpp"
+#include "qdmr/texture/format.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+
+// A blend's level-0 box values into `out` (blend_box_values_bytes() of the source), with the code its QDM walks run
+// at a level-0 cell (kernel/blend_box_values.cpp).
+void blend_box_values(const BlendBoxSource& source, float* out);
+
+// A MipExtremum (qdmr/texture/mip_texture.hpp) on this kernel's vectors (kernel/mip_reduce.cpp).
+void mip_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out,
+                  int out_w, int out_h);
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE
