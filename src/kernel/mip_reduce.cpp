@@ -1,75 +1,71 @@
 // A kernel's max/min reducer (Kernel::mip_extremum): the scalar reduction of texture/mip_reduce.hpp around a loop
-// over whole vectors of texel pairs with SSE4.1 or AVX2 intrinsics (xsimd 8 has no byte/word pack or lane
-// permute; the AVX-512 kernel runs the AVX2 loop).
+// over whole vectors of texel pairs, in xsimd at the kernel's width.
+#include <cstddef>
+#include <cstdint>
 #include <type_traits>
 
 #include <immintrin.h>
 
+#include "core/simd.hpp"
 #include "kernel/kernel_calls.hpp"
+#include "kernel/preparation.hpp"
 #include "texture/mip_reduce.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::mip {
 namespace {
 
-// ---- SIMD primitives: the same names on 256-bit (AVX2) or 128-bit (SSE4.1) vectors ----
-#if defined(__AVX2__)
-using VecI = __m256i;
-using VecF = __m256;
-constexpr int kVecBytes = 32;
-VecI load_i(const std::uint8_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
-void store_i(std::uint8_t* p, VecI v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
-VecF load_f(const std::uint8_t* p) { return _mm256_loadu_ps(reinterpret_cast<const float*>(p)); }
-void store_f(std::uint8_t* p, VecF v) { _mm256_storeu_ps(reinterpret_cast<float*>(p), v); }
-VecI max_u8(VecI a, VecI b) { return _mm256_max_epu8(a, b); }
-VecI min_u8(VecI a, VecI b) { return _mm256_min_epu8(a, b); }
-VecI max_u16(VecI a, VecI b) { return _mm256_max_epu16(a, b); }
-VecI min_u16(VecI a, VecI b) { return _mm256_min_epu16(a, b); }
-VecF max_f(VecF a, VecF b) { return _mm256_max_ps(a, b); }
-VecF min_f(VecF a, VecF b) { return _mm256_min_ps(a, b); }
-VecI shift_right_16(VecI v) { return _mm256_srli_epi16(v, 8); }
-VecI shift_right_32(VecI v) { return _mm256_srli_epi32(v, 16); }
-VecI shift_right_64(VecI v) { return _mm256_srli_epi64(v, 32); }
-VecI low_bytes_mask() { return _mm256_set1_epi16(0x00FF); }
-VecI low_words_mask() { return _mm256_set1_epi32(0xFFFF); }
-VecI and_i(VecI a, VecI b) { return _mm256_and_si256(a, b); }
-// pack and shuffle work within 128-bit lanes: put the 64-bit quarters back in order.
-VecI lane_order(VecI v) { return _mm256_permute4x64_epi64(v, 0xD8); }
-VecF lane_order(VecF v) { return _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(v), 0xD8)); }
-VecI pack_u16(VecI a, VecI b) { return _mm256_packus_epi16(a, b); }
-VecI pack_u32(VecI a, VecI b) { return _mm256_packus_epi32(a, b); }
-VecF even_f(VecF a, VecF b) { return _mm256_shuffle_ps(a, b, 0x88); }
-VecF odd_f(VecF a, VecF b) { return _mm256_shuffle_ps(a, b, 0xDD); }
-VecF as_f(VecI v) { return _mm256_castsi256_ps(v); }
-VecI as_i(VecF v) { return _mm256_castps_si256(v); }
-#else  // SSE4.2: every kernel has SSE4.1 at least
-using VecI = __m128i;
-using VecF = __m128;
-constexpr int kVecBytes = 16;
-VecI load_i(const std::uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
-void store_i(std::uint8_t* p, VecI v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
-VecF load_f(const std::uint8_t* p) { return _mm_loadu_ps(reinterpret_cast<const float*>(p)); }
-void store_f(std::uint8_t* p, VecF v) { _mm_storeu_ps(reinterpret_cast<float*>(p), v); }
-VecI max_u8(VecI a, VecI b) { return _mm_max_epu8(a, b); }
-VecI min_u8(VecI a, VecI b) { return _mm_min_epu8(a, b); }
-VecI max_u16(VecI a, VecI b) { return _mm_max_epu16(a, b); }
-VecI min_u16(VecI a, VecI b) { return _mm_min_epu16(a, b); }
-VecF max_f(VecF a, VecF b) { return _mm_max_ps(a, b); }
-VecF min_f(VecF a, VecF b) { return _mm_min_ps(a, b); }
-VecI shift_right_16(VecI v) { return _mm_srli_epi16(v, 8); }
-VecI shift_right_32(VecI v) { return _mm_srli_epi32(v, 16); }
-VecI shift_right_64(VecI v) { return _mm_srli_epi64(v, 32); }
-VecI low_bytes_mask() { return _mm_set1_epi16(0x00FF); }
-VecI low_words_mask() { return _mm_set1_epi32(0xFFFF); }
-VecI and_i(VecI a, VecI b) { return _mm_and_si128(a, b); }
-VecI lane_order(VecI v) { return v; }
-VecF lane_order(VecF v) { return v; }
-VecI pack_u16(VecI a, VecI b) { return _mm_packus_epi16(a, b); }
-VecI pack_u32(VecI a, VecI b) { return _mm_packus_epi32(a, b); }
-VecF even_f(VecF a, VecF b) { return _mm_shuffle_ps(a, b, 0x88); }
-VecF odd_f(VecF a, VecF b) { return _mm_shuffle_ps(a, b, 0xDD); }
-VecF as_f(VecI v) { return _mm_castsi128_ps(v); }
-VecI as_i(VecF v) { return _mm_castps_si128(v); }
+template <class T>
+using Batch = xsimd::batch<T, simd::Arch>;
+constexpr int kVecBytes = int(Batch<std::uint8_t>::size);
+
+template <class To, class From>
+Batch<To> as(const Batch<From>& v) {
+  return xsimd::bitwise_cast<Batch<To>>(v);
+}
+
+template <class Op, class T>
+Batch<T> op(const Batch<T>& a, const Batch<T>& b) {
+  if constexpr (Op::kMax)
+    return xsimd::max(a, b);
+  else
+    return xsimd::min(a, b);
+}
+
+// The even (or odd) 32-bit lanes of a, then those of b.
+template <int First, class T>
+Batch<T> every_other_lane(const Batch<T>& a, const Batch<T>& b) {
+  static_assert(sizeof(T) == 4);
+  struct Index {  // lanes First, First + 2, ... in each half
+    static constexpr std::uint32_t get(std::size_t i, std::size_t n) { return std::uint32_t((2 * i + First) % n); }
+  };
+  struct LowHalf {
+    static constexpr bool get(std::size_t i, std::size_t n) { return i < n / 2; }
+  };
+  const auto index = xsimd::make_batch_constant<Batch<std::uint32_t>, Index>();
+  return xsimd::select(xsimd::make_batch_bool_constant<Batch<T>, LowHalf>(), xsimd::swizzle(a, index),
+                       xsimd::swizzle(b, index));
+}
+
+// The lanes of a, then those of b, each cut to its low half (the values fit in it).
+template <class Wide>
+Batch<std::uint8_t> narrow(const Batch<Wide>& a, const Batch<Wide>& b) {
+  static_assert(std::is_same_v<Wide, std::uint16_t> || std::is_same_v<Wide, std::uint32_t>);
+  constexpr bool k16 = std::is_same_v<Wide, std::uint16_t>;
+  // Raw intrinsics: xsimd 8 has no narrowing conversion of integer lanes. The packs work per 128-bit block (a's
+  // and b's halves alternate by 64-bit quarters); the swizzle puts the quarters back in order.
+#if defined(__AVX512BW__)
+  const Batch<std::uint64_t> packed(k16 ? _mm512_packus_epi16(a, b) : _mm512_packus_epi32(a, b));
+#elif defined(__AVX2__)
+  const Batch<std::uint64_t> packed(k16 ? _mm256_packus_epi16(a, b) : _mm256_packus_epi32(a, b));
+#else
+  const Batch<std::uint64_t> packed(k16 ? _mm_packus_epi16(a, b) : _mm_packus_epi32(a, b));
 #endif
+  if constexpr (Batch<std::uint64_t>::size == 2) return as<std::uint8_t>(packed);  // one block: in order
+  struct Quarters {  // the even quarters (a's), then the odd ones (b's)
+    static constexpr std::uint64_t get(std::size_t i, std::size_t n) { return 2 * i % n + (2 * i >= n ? 1 : 0); }
+  };
+  return as<std::uint8_t>(xsimd::swizzle(packed, xsimd::make_batch_constant<Batch<std::uint64_t>, Quarters>()));
+}
 
 // out texel i = op over texels 2i and 2i+1 of rows a and b (vertical first, then horizontal), for the first
 // pairs that fill whole vectors; returns how many were done. T is the channel type, C the channel count.
@@ -78,37 +74,28 @@ struct Vectors {
   static int pairs(const std::uint8_t* a, const std::uint8_t* b, std::uint8_t* out, int pairs) {
     constexpr int kTexelBytes = C * int(sizeof(T));
     constexpr int kStep = kVecBytes / kTexelBytes;  // output texels per iteration
+    const auto load = [](const std::uint8_t* p) { return Batch<T>::load_unaligned(reinterpret_cast<const T*>(p)); };
     int i = 0;
     for (; i + kStep <= pairs; i += kStep) {
       const std::uint8_t* pa = a + std::size_t(i) * 2 * kTexelBytes;
       const std::uint8_t* pb = b + std::size_t(i) * 2 * kTexelBytes;
       std::uint8_t* po = out + std::size_t(i) * kTexelBytes;
+      const Batch<T> v0 = op<Op>(load(pa), load(pb));
+      const Batch<T> v1 = op<Op>(load(pa + kVecBytes), load(pb + kVecBytes));
       if constexpr (std::is_same_v<T, float>) {
-        const auto op = [](VecF x, VecF y) { return Op::kMax ? max_f(x, y) : min_f(x, y); };
-        const VecF v0 = op(load_f(pa), load_f(pb));
-        const VecF v1 = op(load_f(pa + kVecBytes), load_f(pb + kVecBytes));
-        store_f(po, lane_order(op(even_f(v0, v1), odd_f(v0, v1))));
+        op<Op>(every_other_lane<0>(v0, v1), every_other_lane<1>(v0, v1)).store_unaligned(reinterpret_cast<float*>(po));
+      } else if constexpr (kTexelBytes == 4) {
+        // Bring texel 2i+1 onto texel 2i, combine, then keep the even texels.
+        const auto h0 = as<std::uint32_t>(op<Op>(v0, as<T>(as<std::uint64_t>(v0) >> 32)));
+        const auto h1 = as<std::uint32_t>(op<Op>(v1, as<T>(as<std::uint64_t>(v1) >> 32)));
+        every_other_lane<0>(h0, h1).store_unaligned(reinterpret_cast<std::uint32_t*>(po));
       } else {
-        const auto op = [](VecI x, VecI y) {
-          if constexpr (sizeof(T) == 1) return Op::kMax ? max_u8(x, y) : min_u8(x, y);
-          else return Op::kMax ? max_u16(x, y) : min_u16(x, y);
-        };
-        const VecI v0 = op(load_i(pa), load_i(pb));
-        const VecI v1 = op(load_i(pa + kVecBytes), load_i(pb + kVecBytes));
         // Bring texel 2i+1 onto texel 2i, combine, then keep the low texel of each pair.
-        if constexpr (kTexelBytes == 1) {
-          const VecI h0 = and_i(op(v0, shift_right_16(v0)), low_bytes_mask());
-          const VecI h1 = and_i(op(v1, shift_right_16(v1)), low_bytes_mask());
-          store_i(po, lane_order(pack_u16(h0, h1)));
-        } else if constexpr (kTexelBytes == 2) {
-          const VecI h0 = and_i(op(v0, shift_right_32(v0)), low_words_mask());
-          const VecI h1 = and_i(op(v1, shift_right_32(v1)), low_words_mask());
-          store_i(po, lane_order(pack_u32(h0, h1)));
-        } else {
-          static_assert(kTexelBytes == 4);
-          const VecI h0 = op(v0, shift_right_64(v0)), h1 = op(v1, shift_right_64(v1));
-          store_i(po, as_i(lane_order(even_f(as_f(h0), as_f(h1)))));
-        }
+        using Pair = std::conditional_t<kTexelBytes == 1, std::uint16_t, std::uint32_t>;
+        const Batch<Pair> low(Pair(kTexelBytes == 1 ? 0xFFu : 0xFFFFu));
+        const auto h0 = as<Pair>(op<Op>(v0, as<T>(as<Pair>(v0) >> (8 * kTexelBytes)))) & low;
+        const auto h1 = as<Pair>(op<Op>(v1, as<T>(as<Pair>(v1) >> (8 * kTexelBytes)))) & low;
+        narrow(h0, h1).store_unaligned(po);
       }
     }
     return i;

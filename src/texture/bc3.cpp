@@ -12,7 +12,9 @@ namespace qdmr {
 namespace {
 
 using Palette = std::array<std::uint8_t, 8>;
-// The 16 texels of a block in one SSE2 register (part of x86-64: the same integer kernel on every CPU).
+// The 16 texels of a block in one SSE2 register. SSE2 is part of x86-64, so this preparation code stays baseline (not
+// in src/kernel/): the same instructions on every CPU and under every --isa; a wider ISA would pay only with a
+// search over several blocks per register.
 using Texels = xsimd::batch<std::uint8_t, xsimd::sse2>;
 static_assert(Texels::size == 16);
 
