@@ -340,6 +340,52 @@ public:
     has_scene_ = true;
   }
 
+  void set_frame(py::handle frame) {
+    const int n = int_arg(frame, "Renderer.set_frame", "frame");
+    Busy busy(*this, "set_frame");
+    if (!has_scene_) throw std::runtime_error("Renderer.set_frame(): no scene (call set_scene first)");
+    py::gil_scoped_release release;
+    try {
+      renderer_->set_frame(n);
+    } catch (const Error& e) {
+      throw BadValue(std::string("Renderer.set_frame(): ") + e.what());
+    }
+  }
+
+  // A height field for layer `layer` of `material`, (H, W), row 0 at the top (as images and frames are): row 0 of
+  // the texture (v = 0) is the array's last row.
+  void update_layer(py::handle material, py::handle layer, py::handle height) {
+    const char* fn = "Renderer.update_layer";
+    const std::string name = str_arg(material, fn, "material");
+    const int index = int_arg(layer, fn, "layer");
+    using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
+    if (!py::isinstance<py::array>(height)) type_error(fn, "height", "a numpy array of shape (H, W)", height);
+    Floats values = Floats::ensure(height);
+    if (!values) {
+      PyErr_Clear();
+      type_error(fn, "height", "a numpy array of numbers", height);
+    }
+    if (values.ndim() != 2 || values.shape(0) < 1 || values.shape(1) < 1 || values.shape(0) > limits::kMaxTextureSide ||
+        values.shape(1) > limits::kMaxTextureSide)
+      throw BadValue("Renderer.update_layer(): height must have the shape (H, W), 1 to " +
+                     std::to_string(limits::kMaxTextureSide) + " a side");
+    Busy busy(*this, "update_layer");
+    if (!has_scene_) throw std::runtime_error("Renderer.update_layer(): no scene (call set_scene first)");
+    const int h = int(values.shape(0)), w = int(values.shape(1));
+    Image image(w, h, 1);
+    const float* data = values.data();
+    for (int y = 0; y < h; ++y)
+      std::copy(data + std::size_t(h - 1 - y) * std::size_t(w), data + std::size_t(h - y) * std::size_t(w), &image.at(0, y, 0));
+    py::gil_scoped_release release;
+    try {
+      renderer_->update_height(name, index, std::move(image));
+    } catch (const Error& e) {
+      std::string_view message = e.what();  // "update_height: ...": the C++ call's name
+      if (message.starts_with("update_height: ")) message.remove_prefix(15);
+      throw BadValue("Renderer.update_layer(): " + std::string(message));
+    }
+  }
+
   PyFrame draw() {
     Busy busy(*this, "draw");
     if (!has_scene_) throw std::runtime_error("Renderer.draw(): no scene (call set_scene first)");
@@ -545,6 +591,14 @@ PYBIND11_MODULE(_qdmr, m) {
       .def("set_scene", &PyRenderer::set_scene, py::arg("scene"), py::arg("aovs") = py::none(),
            "set_scene(scene, aovs=None)\n\nPlans the scene with these AOVs (None: the renderer's) and prepares what\n"
            "the previous scene did not already have: a new camera, size or lighting builds nothing.")
+      .def("set_frame", &PyRenderer::set_frame, py::arg("frame"),
+           "set_frame(frame)\n\nThe current scene at frame `frame` of its animation: only the plan's dynamic items\n"
+           "(made from time-dependent textures) are rebuilt.")
+      .def("update_layer", &PyRenderer::update_layer, py::arg("material"), py::arg("layer"), py::kw_only(),
+           py::arg("height"),
+           "update_layer(material, layer, *, height)\n\nNew heights for a layer, drawn from the next draw on: a float\n"
+           "(H, W) array in [0, 1], row 0 at the top. Its mip chain, max-quadtree, normals from_height and AO maps\n"
+           "are rebuilt, nothing else (qdmr::Renderer::update_height).")
       .def("draw", &PyRenderer::draw,
            "draw() -> Frame\n\nDraws the current scene. Ctrl-C stops it at the next tile (KeyboardInterrupt; no frame).")
       .def_property_readonly("plan", &PyRenderer::plan, "The current scene's plan as a dict (`qdmr plan --json`).")

@@ -17,6 +17,7 @@
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
+#include "cli/frame_range.hpp"
 #include "cli/interrupt.hpp"
 #include "io/os_error.hpp"
 #include "cli/report.hpp"
@@ -58,6 +59,8 @@ struct RenderArgs {
   bool timestamp = false;  // write the current time into the images
   bool smallest_png = false;
   std::optional<std::int64_t> max_memory_mib;  // absent: half the RAM
+  std::string frames;          // --frames A:B[:STEP] of the scene's animation
+  std::optional<int> frame;    // --frame N
 };
 
 // The default of --max-memory: half the machine's physical memory, in MiB.
@@ -118,12 +121,33 @@ qdmr::RenderOptions render_options(const RenderArgs& render) {
   return options;
 }
 
+// One output of every frame: its option, and its name with or without a frame number.
+struct FrameOutput {
+  std::string option, pattern;
+  // Frame -1 (a render without --frames or --frame) takes the name as it is.
+  std::filesystem::path at(int frame) const { return frame < 0 ? pattern : qdmr::cli::frame_name(pattern, frame); }
+};
+
+// The frames a render draws: --frames or --frame of the scene's animation, else the scene as it is (frame -1).
+std::vector<int> frames_to_render(const RenderArgs& render, const qdmr::SceneDesc& scene) {
+  const bool sequence = !render.frames.empty();
+  if (!sequence && !render.frame) return {-1};
+  const std::string option = sequence ? "--frames " + render.frames : "--frame " + std::to_string(*render.frame);
+  if (!scene.animation.present)
+    throw qdmr::Error(option, scene.file.string() + " has no /animation (frames and fps) to take frames from");
+  if (sequence) return qdmr::cli::parse_frame_range(render.frames, scene.animation.frames);
+  if (*render.frame < 0 || *render.frame >= scene.animation.frames)
+    throw qdmr::Error(option, "the scene's animation has frames 0 to " + std::to_string(scene.animation.frames - 1));
+  return {*render.frame};
+}
+
 int run_render(const SceneArgs& args, const RenderArgs& render) {
   using Clock = std::chrono::steady_clock;
   qdmr::RenderOptions options = render_options(render);
+  if (!render.frames.empty() && render.frame) throw qdmr::Error("--frame", "give --frames or --frame, not both");
   check_output_type("-o", render.output);
-  std::vector<qdmr::OutputPath> outputs{{"-o", render.output}};
-  std::vector<std::pair<qdmr::Aov, std::filesystem::path>> aov_files;
+  std::vector<FrameOutput> outputs{{"-o", render.output}};
+  std::vector<qdmr::Aov> aov_kinds;
   std::set<std::string> seen;
   for (const std::string& spec : args.aovs) {
     const auto eq = spec.find('=');
@@ -131,58 +155,86 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
       throw qdmr::Error("--aov " + spec, "expected NAME=FILE, e.g. --aov depth=depth.exr");
     const std::string name = spec.substr(0, eq);
     if (!seen.insert(name).second) throw qdmr::Error("--aov " + spec, "AOV '" + name + "' given twice");
-    aov_files.emplace_back(aov_from(name), spec.substr(eq + 1));
-    check_output_type("--aov", aov_files.back().second);
-    outputs.push_back({"--aov", aov_files.back().second});
-    options.aovs.push_back(aov_files.back().first);
+    aov_kinds.push_back(aov_from(name));
+    outputs.push_back({"--aov", spec.substr(eq + 1)});
+    check_output_type("--aov", outputs.back().pattern);
+    options.aovs.push_back(aov_kinds.back());
   }
   if (!render.stats.empty()) outputs.push_back({"--stats", render.stats});
-  qdmr::check_outputs(outputs);  // folders, and outputs equal to each other, before the scene is read
+  // A sequence names every output per frame; one frame may (or may not) number its names.
+  const bool animated = !render.frames.empty() || render.frame;
+  for (const FrameOutput& o : outputs)
+    if (animated && !qdmr::cli::has_frame_number(o.option, o.pattern) && !render.frames.empty())
+      throw qdmr::Error(o.option + " " + o.pattern,
+                        "names no frame number: a sequence (--frames) needs one, e.g. out_%04d.png");
+  // Folders, and outputs equal to each other, before the scene is read (the frames are known after it).
+  const auto all_outputs = [&](const std::vector<int>& frames) {
+    std::vector<qdmr::OutputPath> paths;
+    for (int f : frames)
+      for (const FrameOutput& o : outputs) paths.push_back({o.option, o.at(f)});
+    return paths;
+  };
+  qdmr::check_outputs(all_outputs({animated ? 0 : -1}));
 
   auto start = Clock::now();
   const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  qdmr::check_outputs(outputs);  // the scene, its textures and OBJ files are known inputs now
+  const std::vector<int> frames = frames_to_render(render, scene);
+  const std::vector<qdmr::OutputPath> paths = all_outputs(frames);
+  qdmr::check_outputs(paths);  // the scene, its textures and OBJ files are known inputs now
   // The plan's estimate (`qdmr plan` prints it part by part) is checked by set_scene (against
   // options.max_memory_bytes) before anything is built.
 
   // Progress only on a terminal: logs and CI stay quiet.
+  std::string frame_text;  // "frame 3 (2/120) " while a sequence renders
   if (::isatty(STDERR_FILENO))
-    options.progress = [](const char* stage, double fraction) {
-      std::fprintf(stderr, "\r%-8s %3d%%", stage, int(fraction * 100.0 + 0.5));
-      if (fraction >= 1.0 && std::string_view(stage) == "raster") std::fprintf(stderr, "\r%15s\r", "");
+    options.progress = [&frame_text](const char* stage, double fraction) {
+      std::fprintf(stderr, "\r%s%-8s %3d%%", frame_text.c_str(), stage, int(fraction * 100.0 + 0.5));
+      if (fraction >= 1.0 && std::string_view(stage) == "raster")
+        std::fprintf(stderr, "\r%*s\r", int(frame_text.size()) + 15, "");
       std::fflush(stderr);
     };
-  // load -> plan -> prepare (set_scene) -> draw -> write.
+  // load -> plan -> prepare (set_scene) -> draw -> write, for each frame through one renderer: a frame after the
+  // first prepares only the plan's dynamic items (those whose content changes with time).
   qdmr::Renderer renderer(options);
-  try {
-    renderer.set_scene(scene, options.aovs);
-  } catch (const qdmr::Error& e) {
-    const std::string what = e.what();
-    if (what.find("MiB (see qdmr plan), more than the limit of") == std::string::npos) throw;
-    throw qdmr::Error(what + max_memory_source(render.max_memory_mib));
-  }
-  qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
-  frame.stats.load_ms = load_ms;
-  qdmr::check_outputs(outputs);  // and now also the MTL files, the maps they name and the caches read
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const int n = frames[i];
+    if (frames.size() > 1)
+      frame_text = "frame " + std::to_string(n) + " (" + std::to_string(i + 1) + "/" + std::to_string(frames.size()) + ") ";
+    try {
+      renderer.set_scene(n >= 0 ? qdmr::scene_at_frame(scene, n) : scene, options.aovs);
+    } catch (const qdmr::Error& e) {
+      const std::string what = e.what();
+      if (what.find("MiB (see qdmr plan), more than the limit of") == std::string::npos) throw;
+      throw qdmr::Error(what + max_memory_source(render.max_memory_mib));
+    }
+    qdmr::Frame frame = (renderer.draw(), renderer.take_frame());
+    frame.stats.load_ms = i == 0 ? load_ms : 0.0;
+    if (n >= 0) {
+      frame.stats.frame = n;
+      frame.stats.time_s = double(n) / scene.animation.fps;
+    }
+    qdmr::check_outputs(paths);  // and now also the MTL files, the maps they name and the caches read
 
-  qdmr::throw_if_stop_requested();  // Ctrl-C while drawing: nothing is written
-  // Every output written to a temporary first, then all renamed: all of them or none.
-  qdmr::OutputBatch batch;
-  start = Clock::now();
-  const qdmr::WriteOptions write{.timestamp = render.timestamp, .smallest_png = render.smallest_png};
-  qdmr::write_frame(frame, render.output, write);
-  for (const auto& [aov, file] : aov_files) qdmr::write_aov(frame, aov, file, write);
-  frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  if (!render.stats.empty()) qdmr::write_stats(frame.stats, render.stats);
-  qdmr::throw_if_stop_requested();  // and while writing: the batch removes its temporaries
-  batch.commit();
-  const qdmr::RenderStats& s = frame.stats;
-  std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n", render.output.c_str(),
-              frame.width, frame.height, static_cast<unsigned long long>(s.triangles_rasterized),
-              static_cast<unsigned long long>(s.pixels_shaded),
-              s.load_ms + s.plan_ms + s.prepare_ms + s.draw_ms() + s.write_ms, s.threads,
-              s.simd_arch.c_str());
+    qdmr::throw_if_stop_requested();  // Ctrl-C while drawing: nothing of this frame is written
+    // Every output of the frame written to a temporary first, then all renamed: all of them or none.
+    qdmr::OutputBatch batch;
+    start = Clock::now();
+    const qdmr::WriteOptions write{.timestamp = render.timestamp, .smallest_png = render.smallest_png};
+    const int at = n;
+    qdmr::write_frame(frame, outputs[0].at(at), write);
+    for (std::size_t a = 0; a < aov_kinds.size(); ++a) qdmr::write_aov(frame, aov_kinds[a], outputs[1 + a].at(at), write);
+    frame.stats.write_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    if (!render.stats.empty()) qdmr::write_stats(frame.stats, outputs.back().at(at));
+    qdmr::throw_if_stop_requested();  // and while writing: the batch removes its temporaries
+    batch.commit();
+    const qdmr::RenderStats& s = frame.stats;
+    std::printf("%s: %dx%d, %llu triangles, %llu pixels shaded, %.1f ms (%d threads, %s)\n",
+                outputs[0].at(at).c_str(), frame.width, frame.height,
+                static_cast<unsigned long long>(s.triangles_rasterized), static_cast<unsigned long long>(s.pixels_shaded),
+                s.load_ms + s.plan_ms + s.prepare_ms + s.draw_ms() + s.write_ms, s.threads, s.simd_arch.c_str());
+    renderer.recycle_frame(std::move(frame));  // the next frame draws into its buffers
+  }
   return 0;
 }
 
@@ -339,6 +391,10 @@ int main(int argc, char** argv) {
       ->required();
   render_cmd->add_option("--width", render.width, "Override /output/width (pixels)");
   render_cmd->add_option("--height", render.height, "Override /output/height (pixels)");
+  render_cmd->add_option("--frames", render.frames,
+                         "Render frames FIRST:LAST[:STEP] (inclusive) of the scene's animation through one renderer; "
+                         "-o, --aov and --stats then name a frame number, e.g. -o out_%04d.png");
+  render_cmd->add_option("--frame", render.frame, "Render frame N of the scene's animation (names may hold %04d)");
   render_cmd->add_option("--threads", render.threads, "Worker threads, 1 to 256 (default: every core)");
   render_cmd->add_option("--tile", render.tile, "Screen tile size in pixels, a multiple of 8 (default 64)");
   render_cmd->add_option("--isa", render.isa,

@@ -14,6 +14,8 @@ nlohmann::json RenderStats::to_json() const {
                   {"geometry", geometry_ms}, {"binning", binning_ms},   {"raster_shade", raster_shade_ms},
                   {"draw", draw_ms()},       {"write", write_ms},
                   {"total", load_ms + plan_ms + prepare_ms + draw_ms() + write_ms}};
+  if (frame >= 0)
+    j["frame"] = {{"number", frame}, {"time_s", time_s}, {"rebuild_ms", prepare_ms}, {"draw_ms", draw_ms()}};
   j["triangles"] = {{"in", triangles_in}, {"culled", triangles_culled}, {"clipped", triangles_clipped},
                     {"rasterized", triangles_rasterized}};
   j["tiles"] = {{"count", tiles}, {"size", tile_size}, {"bin_entries", tile_bin_entries}};

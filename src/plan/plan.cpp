@@ -39,9 +39,14 @@ std::string source_key(const TextureDesc& d) {
       const ProceduralDesc& p = d.procedural;
       k << "proc:" << int(p.pattern) << ":" << p.size << ":" << p.seed << ":" << p.cells << ":" << p.octaves << ":" << p.gain
         << ":" << p.mortar;
+      for (const WaveDesc& w : p.waves)
+        k << ":wave" << w.amplitude << "," << w.speed << "," << w.sharpness << "," << w.cycles_u << "," << w.cycles_v;
+      // Time is content only where the pattern moves: a still texture keeps its key from frame to frame.
+      if (time_dependent(p)) k << ":scroll" << p.scroll.x << "," << p.scroll.y << ":t" << p.time;
       break;
     }
     case TextureSource::FromHeight: k << "from_height"; break;
+    case TextureSource::Pixels: k << "pixels:" << d.pixels_version; break;
   }
   return k.str();
 }
@@ -60,9 +65,8 @@ std::string request_key(const TextureDesc& d, TexturePurpose purpose, const Laye
       << d.color_high.y << "," << d.color_high.z << ":var" << d.variation;
   if (purpose == TexturePurpose::Normal)
     k << ":conv" << int(layer.normal_convention) << ":strength" << layer.normal_strength;
-  if (purpose == TexturePurpose::Height || d.source == TextureSource::FromHeight ||
-      (purpose == TexturePurpose::Albedo && d.source == TextureSource::Procedural))
-    k << "|height:" << height_key(layer);
+  // What is made from the layer's heights (a procedural albedo is coloured by its own pattern, not by them).
+  if (purpose == TexturePurpose::Height || d.source == TextureSource::FromHeight) k << "|height:" << height_key(layer);
   return k.str();
 }
 
@@ -79,6 +83,7 @@ SourceInfo texture_source(const TextureDesc& d, const LayerDesc& layer, const st
     case TextureSource::None:
     case TextureSource::Constant: return {};
     case TextureSource::Procedural: return {d.procedural.size, d.procedural.size, 16, std::nullopt};
+    case TextureSource::Pixels: return {d.pixels->width, d.pixels->height, d.pixels->source_bits, std::nullopt};
     case TextureSource::FromHeight:
       if (layer.height.source == TextureSource::None || layer.height.source == TextureSource::FromHeight) return {};
       return texture_source(layer.height, layer, where);
@@ -177,6 +182,11 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.bytes = mip_chain_bytes(r.width, r.height, r.format) + linear_copy_bytes(r.width, r.height, r.format, r.srgb) +
             (wrap_footprints ? wrap_footprint_bytes(r.width, r.height, r.format, r.srgb) : 0);
   r.working_bytes = texture_working_bytes(r, source);
+  // Dynamic exactly when the key carries time or a handed-over version: the key then changes every frame.
+  const auto changes = [](const TextureDesc& t) { return time_dependent(t) || t.source == TextureSource::Pixels; };
+  const bool from_height = purpose == TexturePurpose::Height || desc.source == TextureSource::FromHeight;
+  r.dynamic = changes(desc) || (from_height && changes(layer.height));
+  if (from_height) r.height_key = height_key(layer);
   r.users.push_back(user);
   textures.push_back(std::move(r));
   return int(textures.size() - 1);
@@ -331,7 +341,11 @@ public:
       return l.field;
     };
     std::string heights;
-    for (const LayerPlan& l : m.layers) heights += (l.height >= 0 ? plan_.textures[std::size_t(l.height)].key : "-") + "|";
+    bool heights_dynamic = false;
+    for (const LayerPlan& l : m.layers) {
+      heights += (l.height >= 0 ? plan_.textures[std::size_t(l.height)].key : "-") + "|";
+      heights_dynamic = heights_dynamic || (l.height >= 0 && plan_.textures[std::size_t(l.height)].dynamic);
+    }
 
     // Albedo and normal map interleaved where the program samples them as twins (TwinSampler: RGBA8 chains of one
     // size, the albedo with its decoded copy, under a sampling whose twins share addresses).
@@ -356,7 +370,8 @@ public:
       const bool needs_combined = c.combined_quadtree || m.reference || c.blend_ao;
       if (m.weight_mode == WeightMode::Pixel || needs_combined)
         m.weights = add(DerivedKind::WeightTexture, wkey, where + "/blend/weights", {}, index,
-                        mip_chain_bytes(w.resolution, w.resolution, TexelFormat::RGBA8));
+                        mip_chain_bytes(w.resolution, w.resolution, TexelFormat::RGBA8), -1, 0, -1,
+                        time_dependent(w.height));
       if (needs_combined) {
         if (!whole)
           throw Error(where + "/blend/weights/scale", m.reference ? "error AOVs of a blend need a whole number of repeats"
@@ -372,7 +387,8 @@ public:
         Key op;
         op("op").v(int(desc.blend.op))("width").v(desc.blend.width);
         m.combined_surface = add(DerivedKind::CombinedSurface, "combined|" + heights + wkey + "|" + op.str(),
-                                 where + "/blend", {m.weights}, index, texels * sizeof(double));
+                                 where + "/blend", {m.weights}, index, texels * sizeof(double), -1, 0, -1,
+                                 heights_dynamic);
         const std::string& combined_key = plan_.derived[std::size_t(m.combined_surface)].key;
         if (c.combined_quadtree)
           m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + combined_key, where + "/blend/quadtree",
@@ -408,6 +424,13 @@ public:
       const int field = field_of(0);
       const TextureRequest& h = plan_.textures[std::size_t(m.layers[0].height)];
       const std::string& field_key = plan_.derived[std::size_t(field)].key;
+      if (m.cone_map && plan_.derived[std::size_t(field)].dynamic && !scene_.animation.rebake_cones)
+        throw Error(where + "/technique/name",
+                    std::string("'") + technique_name(m.technique) +
+                        "' marches a cone map baked from the heights, and this material's heights change every frame "
+                        "(a bake per frame takes seconds to minutes): use qdm or pom for dynamic surfaces (qdm rebuilds "
+                        "its max-quadtree per frame in well under a millisecond), or set /animation/rebake_cones to "
+                        "true to bake every frame");
       if (m.cone_map) {
         const std::uint64_t map = std::uint64_t(h.width) * std::uint64_t(h.height) * sizeof(float);
         m.cones = add(DerivedKind::ConeMap, "cones|" + std::to_string(int(m.cone_kind)) + "|" + field_key,
@@ -425,12 +448,16 @@ public:
   }
 
 private:
+  // `dynamic`: made from something that changes every frame besides its inputs and textures (a blend's heights).
   int add(DerivedKind kind, const std::string& key, const std::string& where, std::vector<int> inputs, std::uint32_t material,
-          std::uint64_t bytes, int texture = -1, int side = 0, int second_texture = -1) {
+          std::uint64_t bytes, int texture = -1, int side = 0, int second_texture = -1, bool dynamic = false) {
     const std::string full = std::string(derived_kind_name(kind)) + "|" + key;
     for (std::size_t i = 0; i < plan_.derived.size(); ++i)
       if (plan_.derived[i].key == full) return int(i);
+    for (int in : inputs) dynamic = dynamic || plan_.derived[std::size_t(in)].dynamic;
+    for (int t : {texture, second_texture}) dynamic = dynamic || (t >= 0 && plan_.textures[std::size_t(t)].dynamic);
     DerivedPlan d{kind, full, where, std::move(inputs), texture, second_texture, int(material), side, bytes};
+    d.dynamic = dynamic;
     plan_.derived.push_back(std::move(d));
     return int(plan_.derived.size() - 1);
   }
@@ -599,6 +626,7 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
     const ObjectDesc& object = scene.objects[i];
     const std::string where = file + ": /objects/" + std::to_string(i);
     MeshPlan mesh = plan_mesh(object, mesh_key(object));
+    mesh.dynamic = time_dependent(object.mesh.height_map);
     if (!object.material.empty()) {
       // An explicit material overrides the MTL: every triangle of the object uses it.
       mesh.material = planner.material(object.material, where + "/material", nullptr);
@@ -650,9 +678,23 @@ std::vector<std::string> FramePlan::items() const {
   return items;
 }
 
+std::vector<std::string> FramePlan::dynamic_items() const {
+  std::vector<std::string> items;
+  for (const MeshPlan& m : meshes)
+    if (m.dynamic) items.push_back("mesh " + m.key);
+  for (const TextureRequest& t : textures)
+    if (t.dynamic) items.push_back("texture " + t.key);
+  for (const DerivedPlan& d : derived)
+    if (d.dynamic) items.push_back(d.key);
+  return items;
+}
+
 std::string FramePlan::describe() const {
   std::ostringstream s;
   s << "output: " << width << "x" << height << "\n";
+  if (scene.animation.present)
+    s << "animation: " << scene.animation.frames << " frames at " << scene.animation.fps << " fps; "
+      << dynamic_items().size() << " dynamic items, rebuilt every frame\n";
   s << "materials (" << materials.size() << "):\n";
   for (const MaterialPlan& m : materials) {
     s << "  " << m.name << ": " << m.variant << "\n";
@@ -685,6 +727,7 @@ std::string FramePlan::describe() const {
     if (t.working_bytes >= (1 << 20) / 100) s << " (" << mib(t.working_bytes) << " more while it is built)";
     s << "  <- " << t.where;
     if (t.desc.source == TextureSource::File) s << " (" << t.desc.file.filename().string() << ")";
+    if (t.dynamic) s << ", dynamic (rebuilt every frame)";
     s << "\n";
   }
   s << "derived data to build (" << derived.size() << "):\n";
@@ -700,7 +743,7 @@ std::string FramePlan::describe() const {
     if (d.texture >= 0) s << " from texture " << d.texture;
     s << ", " << mib(d.bytes);
     if (d.working_bytes > 0) s << " (" << mib(d.working_bytes) << " more while it is baked)";
-    s << "  <- " << d.where << "\n";
+    s << "  <- " << d.where << (d.dynamic ? ", dynamic (rebuilt every frame)" : "") << "\n";
   }
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes) {
@@ -708,6 +751,7 @@ std::string FramePlan::describe() const {
       << mib(m.bytes);
     if (m.degenerate_faces > 0) s << ", " << m.degenerate_faces << " degenerate faces dropped";
     if (m.vertex_weights >= 0) s << ", per-vertex weights of " << materials[std::size_t(m.vertex_weights)].name;
+    if (m.dynamic) s << ", dynamic (rebuilt every frame)";
     if (!m.mtl_materials.empty() && (m.mtl_materials.size() > 1 || m.mtl_materials[0] != m.material)) {
       s << (m.kind.starts_with("gltf") ? ", glTF materials:" : ", MTL materials:");
       for (std::uint32_t mat : m.mtl_materials) s << " " << materials[mat].name;
@@ -755,14 +799,16 @@ nlohmann::json FramePlan::to_json() const {
     nlohmann::json entry = {{"purpose", purpose_name(t.purpose)}, {"width", t.width}, {"height", t.height},
                             {"format", format_name(t.format)}, {"srgb", t.srgb}, {"mip", reduce_name(t.reduce)},
                             {"levels", t.levels}, {"wrap_footprints", keeps_wrap_footprints(t)}, {"bytes", t.bytes},
-                            {"working_bytes", t.working_bytes}, {"where", t.where}, {"users", t.users}};
+                            {"working_bytes", t.working_bytes}, {"where", t.where}, {"users", t.users},
+                            {"dynamic", t.dynamic}};
     if (t.desc.source == TextureSource::File) entry["file"] = t.desc.file.string();
     j["textures"].push_back(entry);
   }
   j["derived"] = nlohmann::json::array();
   for (const DerivedPlan& d : derived)
     j["derived"].push_back({{"kind", derived_kind_name(d.kind)}, {"inputs", d.inputs}, {"texture", d.texture},
-                            {"bytes", d.bytes}, {"working_bytes", d.working_bytes}, {"where", d.where}});
+                            {"bytes", d.bytes}, {"working_bytes", d.working_bytes}, {"where", d.where},
+                            {"dynamic", d.dynamic}});
   j["meshes"] = nlohmann::json::array();
   for (const MeshPlan& m : meshes) {
     nlohmann::json mtl = nlohmann::json::array();
@@ -770,9 +816,11 @@ nlohmann::json FramePlan::to_json() const {
     j["meshes"].push_back({{"object", m.object}, {"kind", m.kind}, {"vertices", m.vertices}, {"triangles", m.triangles},
                            {"degenerate_faces", m.degenerate_faces}, {"bytes", m.bytes},
                            {"material", materials.empty() ? "" : materials[m.material].name},
-                           {"mtl_materials", mtl}, {"warnings", m.notes}});
+                           {"mtl_materials", mtl}, {"warnings", m.notes}, {"dynamic", m.dynamic}});
   }
   j["items"] = items();
+  j["dynamic_items"] = dynamic_items();
+  if (scene.animation.present) j["animation"] = {{"frames", scene.animation.frames}, {"fps", scene.animation.fps}};
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
   if (const TextureCacheDesc& c = scene.texture_cache; c.enabled)

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include "kernel/kernel.hpp"
 #include "qdmr/bake/ao_map.hpp"
@@ -20,11 +21,25 @@
 namespace qdmr {
 namespace {
 
+// The level 0 and stored box chain of a dynamic layer height, made once per prepare for every texture made from it
+// (its box chain, its max-quadtree, normals from it): each would otherwise make the pattern again.
+struct SharedHeight {
+  std::optional<Image> level0;
+  std::optional<HeightTexture> stored_box;
+};
+
+// A layer's heights as made from the scene (or the shared level 0).
+Image layer_height(const TextureRequest& request, const SharedHeight* shared) {
+  return shared && shared->level0 ? *shared->level0 : make_layer_height(request.layer, request.where);
+}
+
 // A layer's heights through the storage the scene asks for (quantisation, BC3), so what is rendered is what a
 // GPU would sample; the BC3 error goes to `stat`.
-HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, MipExtremum extremum, TextureStat& stat) {
-  HeightTexture stored =
-      make_height_texture(make_layer_height(request.layer, request.where), request.layer.height, reduce, extremum);
+HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, MipExtremum extremum, TextureStat& stat,
+                            const SharedHeight* shared) {
+  HeightTexture stored = shared && shared->stored_box && reduce == MipReduce::Box
+                             ? *shared->stored_box
+                             : make_height_texture(layer_height(request, shared), request.layer.height, reduce, extremum);
   stat.height_format = format_name(stored.texture.format);
   if (stored.bc3) {
     stat.bc3 = true;
@@ -36,17 +51,17 @@ HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, Mip
 
 // Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
 // texture_working_bytes counts the most this holds at once, step by step.
-Texture build_texture(const TextureRequest& request, MipExtremum extremum, TextureStat& stat) {
+Texture build_texture(const TextureRequest& request, MipExtremum extremum, TextureStat& stat, const SharedHeight* shared) {
   Texture texture;
   if (request.purpose == TexturePurpose::Height) {
-    texture = stored_height(request, request.reduce, extremum, stat).texture;
+    texture = stored_height(request, request.reduce, extremum, stat, shared).texture;
     add_linear_copy(texture);
     if (request.wrap_footprints) add_wrap_footprints(texture);
   } else {
     Image level0;
     if (request.desc.source == TextureSource::FromHeight) {
       // Behind a from_height normal map only level 0 is used: any reduction will do.
-      const Image height = stored_height(request, MipReduce::Box, extremum, stat).texture.level_image(0);
+      const Image height = stored_height(request, MipReduce::Box, extremum, stat, shared).texture.level_image(0);
       level0 = make_texture(request.desc, request.purpose, request.layer, &height, request.where);
     } else {
       level0 = make_texture(request.desc, request.purpose, request.layer, nullptr, request.where);
@@ -76,6 +91,11 @@ HeightField height_field(const Texture& h, AddressMode address) {
   for (int y = 0; y < h.height(); ++y)
     for (int x = 0; x < h.width(); ++x) field.h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
   return field;
+}
+
+// An AO map from the bake cache, or baked every frame (and not kept) for a dynamic surface.
+Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic) {
+  return dynamic ? bake_ao_map(field, depth_scale, ao) : load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir());
 }
 
 // Items of the previous assets by key, to share instead of rebuild.
@@ -173,10 +193,32 @@ private:
     });
   }
 
+  // The dynamic layer heights that more than one texture to build is made from: their level 0, and their box chain
+  // when a box-filtered height or from_height normals use it, made before the textures (one at a time, each with
+  // every thread). Still heights keep the one-build-per-texture path (and its memory plan).
+  std::map<std::string, SharedHeight> shared_heights() const {
+    std::map<std::string, std::vector<const TextureRequest*>> users;
+    for (const TextureRequest& r : plan_.textures)
+      if (r.dynamic && !r.height_key.empty() && !previous_.textures.count(r.key)) users[r.height_key].push_back(&r);
+    std::map<std::string, SharedHeight> shared;
+    for (const auto& [key, requests] : users) {
+      if (requests.size() < 2) continue;
+      SharedHeight& s = shared[key];
+      const TextureRequest& first = *requests.front();
+      s.level0 = make_layer_height(first.layer, first.where);
+      const bool box = std::any_of(requests.begin(), requests.end(), [](const TextureRequest* r) {
+        return r->purpose != TexturePurpose::Height || r->reduce == MipReduce::Box;
+      });
+      if (box) s.stored_box = make_height_texture(*s.level0, first.layer.height, MipReduce::Box, kernel_.mip_extremum());
+    }
+    return shared;
+  }
+
   void textures() {
     const std::size_t n = plan_.textures.size();
     assets_.textures.resize(n);
     assets_.texture_stats.resize(n);
+    const std::map<std::string, SharedHeight> shared = shared_heights();
     // At most kTexturesBuiltAtOnce in flight (the plan counts that many builds' working memory); each build's
     // own loops use every thread.
     std::size_t next = 0;
@@ -198,8 +240,9 @@ private:
               const ProgressStep step("texture " + std::to_string(request.width) + "x" + std::to_string(request.height) +
                                       " (" + request.where + ")");  // a line on a terminal when it takes seconds
               const auto start = Clock::now();
-              assets_.textures[i] = std::make_shared<const Texture>(
-                  build_texture(request, kernel_.mip_extremum(), assets_.texture_stats[i]));
+              const auto s = shared.find(request.height_key);
+              assets_.textures[i] = std::make_shared<const Texture>(build_texture(
+                  request, kernel_.mip_extremum(), assets_.texture_stats[i], s == shared.end() ? nullptr : &s->second));
               record("texture " + request.key, plan_.meshes.size() + i,
                      {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
             }));
@@ -262,8 +305,8 @@ private:
         AoDesc ao = desc.ao;
         ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats
         ao.resolution = d.side;
-        out.texture = mip(load_or_bake_ao_map(*input(0).field, desc.technique.depth_scale, ao, default_cache_dir()),
-                          TexelFormat::R16, MipReduce::Box);
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic), TexelFormat::R16,
+                          MipReduce::Box);
         break;
       }
       case DerivedKind::TwinTexels:
@@ -276,11 +319,14 @@ private:
         break;
       case DerivedKind::LayerAoMap:
         // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
-        out.texture = mip(load_or_bake_ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, default_cache_dir()),
-                          TexelFormat::R16, MipReduce::Box);
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic), TexelFormat::R16,
+                          MipReduce::Box);
         break;
       case DerivedKind::ConeMap:
-        out.cones = std::make_shared<const ConeMap>(load_or_bake_cone_map(*input(0).field, m.cone_kind, default_cache_dir()));
+        // A dynamic surface's maps are baked every frame and never kept: the cache would fill with frames.
+        out.cones = std::make_shared<const ConeMap>(d.dynamic ? bake_cone_map(*input(0).field, m.cone_kind)
+                                                              : load_or_bake_cone_map(*input(0).field, m.cone_kind,
+                                                                                      default_cache_dir()));
         break;
       case DerivedKind::BilinearBound:
         // QDM walks a quadtree of the 3x3 maxima, conservative for the bilinear surface it then solves exactly.

@@ -1,6 +1,8 @@
 #include <sys/resource.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -76,6 +78,8 @@ struct Renderer::State {
   std::optional<tbb::global_control> parallelism;
   tbb::task_arena arena;
   std::optional<FramePlan> plan;
+  std::optional<SceneDesc> scene;  // as given to set_scene (with heights handed over since), before any frame's time
+  std::vector<Aov> aovs;           // of the last set_scene
   Assets assets;
   std::vector<std::unique_ptr<Program>> programs;
   Framebuffer fb;
@@ -119,6 +123,58 @@ const FramePlan& Renderer::plan() const {
 }
 
 void Renderer::set_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
+  prepare_scene(scene, aovs);
+  state_->scene = scene;
+  state_->aovs = aovs;
+}
+
+void Renderer::set_frame(int frame) {
+  State& s = *state_;
+  if (!s.scene) throw Error("renderer", "no scene set");
+  const AnimationDesc& a = s.scene->animation;
+  if (frame < 0 || frame >= a.frames)
+    throw Error(s.scene->file.string() + ": /animation/frames",
+                "frame " + std::to_string(frame) + " is outside the animation's frames 0 to " + std::to_string(a.frames - 1));
+  prepare_scene(scene_at_frame(*s.scene, frame), s.aovs);
+}
+
+void Renderer::update_height(const std::string& material, int layer, Image heights) {
+  State& s = *state_;
+  const auto fail = [](const std::string& what) { return Error("update_height", what); };
+  if (!s.scene || !s.plan) throw fail("no scene set");
+  // The scene as last prepared (its frame's time included), and the one whose frames set_frame takes from.
+  SceneDesc now = s.plan->scene, base = *s.scene;
+  MaterialDesc* m = nullptr;
+  for (MaterialDesc& candidate : base.materials)
+    if (candidate.name == material) m = &candidate;
+  if (!m) throw fail("the scene has no material '" + material + "'");
+  if (layer < 0 || std::size_t(layer) >= m->layers.size())
+    throw fail("material '" + material + "' has layers 0 to " + std::to_string(m->layers.size() - 1) + ", not " +
+               std::to_string(layer));
+  if (heights.width < 1 || heights.height < 1 || heights.channels < 1) throw fail("the heights are an empty image");
+  if (heights.width > limits::kMaxTextureSide || heights.height > limits::kMaxTextureSide)
+    throw fail("the heights are " + std::to_string(heights.width) + "x" + std::to_string(heights.height) +
+               ", more than " + std::to_string(limits::kMaxTextureSide) + " a side");
+  for (int y = 0; y < heights.height; ++y)
+    for (int x = 0; x < heights.width; ++x)
+      if (!std::isfinite(heights.at(x, y, 0)))
+        throw fail("the height at (" + std::to_string(x) + ", " + std::to_string(y) + ") is not finite");
+  static std::atomic<std::uint64_t> versions{0};
+  TextureDesc handed;
+  handed.source = TextureSource::Pixels;
+  handed.format = m->layers[std::size_t(layer)].height.format;
+  handed.compression = m->layers[std::size_t(layer)].height.compression;
+  handed.pixels = std::make_shared<const Image>(std::move(heights));
+  handed.pixels_version = ++versions;
+  m->layers[std::size_t(layer)].height = handed;
+  for (MaterialDesc& candidate : now.materials)
+    if (candidate.name == material) candidate.layers[std::size_t(layer)].height = handed;
+  now.texture_cache = base.texture_cache;  // the plan turns the cache on for its AOV; set_scene does that again
+  prepare_scene(now, s.aovs);
+  s.scene = std::move(base);
+}
+
+void Renderer::prepare_scene(const SceneDesc& scene, const std::vector<Aov>& aovs) {
   State& s = *state_;
   auto start = Clock::now();
   FramePlan plan = plan_frame(scene, PlanOptions{aovs});

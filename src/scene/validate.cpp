@@ -1,6 +1,7 @@
 #include "scene/validate.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -199,12 +200,36 @@ void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
   if (slot == Slot::Height) read_height_storage(object, texture);
 }
 
+// One wave of the waves pattern; its wave vector snapped to whole cycles per repeat of a `size` texture.
+WaveDesc read_wave(const Value& value, int size) {
+  const Object object(value, {"amplitude", "wavelength", "direction_deg", "speed", "sharpness"});
+  WaveDesc w;
+  if (auto v = object.find("amplitude")) w.amplitude = static_cast<float>(v->non_negative());
+  if (auto v = object.find("wavelength")) w.wavelength = static_cast<float>(v->positive());
+  if (auto v = object.find("direction_deg")) w.direction_deg = static_cast<float>(v->number_in(-360.0, 360.0));
+  if (auto v = object.find("speed")) w.speed = static_cast<float>(v->number_in(-100.0, 100.0));
+  if (auto v = object.find("sharpness")) w.sharpness = static_cast<int>(v->integer(1, 8));
+  const double angle = double(w.direction_deg) * 3.14159265358979323846 / 180.0;
+  const double cycles = 1.0 / double(w.wavelength);
+  const double ku = std::round(std::cos(angle) * cycles), kv = std::round(std::sin(angle) * cycles);
+  const Value wavelength = member_or_self(object, "wavelength");
+  wavelength.require(ku != 0.0 || kv != 0.0, "a wavelength of " + format_number(w.wavelength) +
+                                                 " along this direction has no whole cycle per texture repeat "
+                                                 "(the pattern tiles): make it shorter");
+  wavelength.require(std::abs(ku) <= size / 2 && std::abs(kv) <= size / 2,
+                     "a wavelength of " + format_number(w.wavelength) + " is shorter than two texels of a " +
+                         std::to_string(size) + "-texel pattern");
+  w.cycles_u = static_cast<int>(ku);
+  w.cycles_v = static_cast<int>(kv);
+  return w;
+}
+
 void read_procedural(const Value& value, Slot slot, TextureDesc& texture) {
   const Object object = slot == Slot::Albedo
                             ? Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar",
-                                             "color_low", "color_high", "variation"})
+                                             "waves", "scroll", "color_low", "color_high", "variation"})
                             : Object(value, {"procedural", "size", "seed", "cells", "octaves", "gain", "mortar",
-                                             "format", "compression"});
+                                             "waves", "scroll", "format", "compression"});
   texture.source = TextureSource::Procedural;
   ProceduralDesc& p = texture.procedural;
   p.pattern = object.required("procedural")
@@ -215,11 +240,23 @@ void read_procedural(const Value& value, Slot slot, TextureDesc& texture) {
                                               {"spikes", ProceduralPattern::Spikes},
                                               {"noise", ProceduralPattern::Noise},
                                               {"flat", ProceduralPattern::Flat},
-                                              {"checker", ProceduralPattern::Checker}});
+                                              {"checker", ProceduralPattern::Checker},
+                                              {"waves", ProceduralPattern::Waves}});
   if (auto v = object.find("size")) {
     p.size = static_cast<int>(v->integer(1, limits::kMaxTextureSide));
     v->require((p.size & (p.size - 1)) == 0, "must be a power of two, got " + std::to_string(p.size));
   }
+  if (auto v = object.find("waves")) {
+    v->require(p.pattern == ProceduralPattern::Waves, "only the 'waves' pattern has waves");
+    const std::vector<Value> waves = v->array();
+    v->require(!waves.empty() && waves.size() <= 16, "expected 1 to 16 waves, got " + std::to_string(waves.size()));
+    for (const Value& w : waves) p.waves.push_back(read_wave(w, p.size));
+    v->require(std::any_of(p.waves.begin(), p.waves.end(), [](const WaveDesc& w) { return w.amplitude > 0.0f; }),
+               "at least one wave needs an amplitude above 0");
+  } else if (p.pattern == ProceduralPattern::Waves) {
+    object.required("waves");
+  }
+  if (auto v = object.find("scroll")) p.scroll = read_pair(*v, &Value::number);
   if (auto v = object.find("seed"))
     p.seed = static_cast<std::uint32_t>(v->integer(0, std::numeric_limits<std::uint32_t>::max()));
   if (auto v = object.find("cells")) p.cells = static_cast<int>(v->integer(1, 4096));
@@ -698,9 +735,19 @@ void read_mtl_override(const Value& value, MaterialDesc& material, const std::fi
                          "read as a height");
 }
 
+AnimationDesc read_animation(const Value& value) {
+  const Object object(value, {"frames", "fps", "rebake_cones"});
+  AnimationDesc a;
+  a.present = true;
+  if (auto v = object.find("frames")) a.frames = static_cast<int>(v->integer(1, limits::kMaxAnimationFrames));
+  if (auto v = object.find("fps")) a.fps = v->number_in(1e-3, 1000.0);
+  if (auto v = object.find("rebake_cones")) a.rebake_cones = v->boolean();
+  return a;
+}
+
 SceneDesc validate_scene(const json& document, const Context& context) {
   const Value root(context, document, "");
-  const Object object(root, {"output", "camera", "lights", "materials", "objects", "texture_cache"});
+  const Object object(root, {"output", "camera", "lights", "materials", "objects", "texture_cache", "animation"});
   SceneDesc scene;
   scene.file = context.file;
   if (auto v = object.find("output")) scene.output = read_output(*v);
@@ -713,6 +760,7 @@ SceneDesc validate_scene(const json& document, const Context& context) {
   }
   if (auto v = object.find("materials")) scene.materials = read_materials(*v);
   if (auto v = object.find("texture_cache")) scene.texture_cache = read_texture_cache(*v);
+  if (auto v = object.find("animation")) scene.animation = read_animation(*v);
   const std::vector<Value> objects = object.required("objects").array();
   for (std::size_t i = 0; i < objects.size(); ++i) scene.objects.push_back(read_object(objects[i], i, scene.materials));
   return scene;

@@ -310,8 +310,20 @@ struct Checker {
   }
 };
 
+// Where the pattern is read: texel centres moved back by the scroll so far (`offset`, in repeats), folded into
+// [0, 1) (patterns are periodic with period 1). A zero offset reads exactly the texel centres.
+struct Offset {
+  double u = 0.0, v = 0.0;
+};
+
+Offset scroll_offset(const ProceduralDesc& d) {
+  return {fract(double(d.scroll.x) * d.time), fract(double(d.scroll.y) * d.time)};
+}
+
+double at(double centre, double offset) { return offset == 0.0 ? centre : fract(centre - offset); }
+
 template <class Pattern>
-Image fill(int size, bool with_cells, const Pattern& pattern) {
+Image fill(int size, bool with_cells, const Pattern& pattern, Offset offset) {
   Image out(size, size, with_cells ? 2 : 1);
   tbb::parallel_for(tbb::blocked_range<int>(0, size), [&](const tbb::blocked_range<int>& rows) {
     // A pattern with a cursor evaluates a row's texels through it (it keeps what neighbouring texels share).
@@ -322,9 +334,9 @@ Image fill(int size, bool with_cells, const Pattern& pattern) {
         return std::cref(pattern);
     }();
     for (int y = rows.begin(); y != rows.end(); ++y) {
-      const double v = (y + 0.5) / size;
+      const double v = at((y + 0.5) / size, offset.v);
       for (int x = 0; x < size; ++x) {
-        const Texel t = evaluate((x + 0.5) / size, v);
+        const Texel t = evaluate(at((x + 0.5) / size, offset.u), v);
         out.at(x, y, 0) = float(t.h);
         if (with_cells) out.at(x, y, 1) = float(t.cell);
       }
@@ -334,8 +346,8 @@ Image fill(int size, bool with_cells, const Pattern& pattern) {
 }
 
 // Noise: remap the raw sums to [0,1] by the image's min and max (exact, so independent of the split).
-Image fill_normalised(int size, bool with_cells, const Noise& noise) {
-  Image out = fill(size, with_cells, noise);
+Image fill_normalised(int size, bool with_cells, const Noise& noise, Offset offset) {
+  Image out = fill(size, with_cells, noise, offset);
   const int c = out.channels;
   const std::size_t n = std::size_t(size) * size;
   using Range = std::pair<float, float>;
@@ -357,6 +369,68 @@ Image fill_normalised(int size, bool with_cells, const Noise& noise) {
   return out;
 }
 
+// Waves: h = sum_i a_i ((1 + sin theta_i) / 2)^s_i / sum_i a_i, theta_i = 2 pi (k_i . (uv - scroll t) - |k_i| c_i t)
+// with k_i whole cycles per repeat (so the pattern tiles). Each phase is separable, sin(alpha_u + beta_v) =
+// sin alpha_u cos beta_v + cos alpha_u sin beta_v: one table per column and per row for each wave (sin_2pi in
+// double), then two products and a sum per texel in float. Every texel is computed alone: the same bits on any
+// thread count.
+template <int Sharpness>
+void add_wave(float* row, int n, const float* su, const float* cu, float sv, float cv, float weight) {
+  for (int x = 0; x < n; ++x) {
+    const float w = 0.5f + 0.5f * (su[x] * cv + cu[x] * sv);
+    float p = w;
+    for (int k = 1; k < Sharpness; ++k) p = p * w;
+    row[x] = row[x] + weight * p;
+  }
+}
+
+using AddWave = void (*)(float*, int, const float*, const float*, float, float, float);
+constexpr AddWave kAddWave[] = {add_wave<1>, add_wave<2>, add_wave<3>, add_wave<4>,
+                                add_wave<5>, add_wave<6>, add_wave<7>, add_wave<8>};
+
+Image fill_waves(const ProceduralDesc& d, bool with_cells, Offset offset) {
+  const int n = d.size;
+  struct Tables {
+    std::vector<float> su, cu, sv, cv;
+    float weight;
+    int sharpness;
+  };
+  double total = 0.0;
+  for (const WaveDesc& w : d.waves) total += w.amplitude;
+  std::vector<Tables> tables;
+  for (const WaveDesc& w : d.waves) {
+    const double ku = w.cycles_u, kv = w.cycles_v, k = std::sqrt(ku * ku + kv * kv);
+    const double turns = fract(k * double(w.speed) * d.time) + ku * offset.u + kv * offset.v;
+    Tables t{std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)),
+             std::vector<float>(std::size_t(n)), float(total > 0.0 ? double(w.amplitude) / total : 0.0),
+             std::clamp(w.sharpness, 1, 8)};
+    for (int i = 0; i < n; ++i) {
+      const double c = (i + 0.5) / n;
+      const double a = fract(ku * c - turns), b = fract(kv * c);
+      t.su[std::size_t(i)] = float(sin_2pi(a));
+      t.cu[std::size_t(i)] = float(sin_2pi(a + 0.25));
+      t.sv[std::size_t(i)] = float(sin_2pi(b));
+      t.cv[std::size_t(i)] = float(sin_2pi(b + 0.25));
+    }
+    tables.push_back(std::move(t));
+  }
+  Image out(n, n, with_cells ? 2 : 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> row(static_cast<std::size_t>(n));
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      std::fill(row.begin(), row.end(), 0.0f);
+      for (const Tables& t : tables)
+        kAddWave[t.sharpness - 1](row.data(), n, t.su.data(), t.cu.data(), t.sv[std::size_t(y)], t.cv[std::size_t(y)],
+                                  t.weight);
+      for (int x = 0; x < n; ++x) {
+        out.at(x, y, 0) = std::min(1.0f, std::max(0.0f, row[std::size_t(x)]));
+        if (with_cells) out.at(x, y, 1) = 0.5f;
+      }
+    }
+  });
+  return out;
+}
+
 void validate(const ProceduralDesc& d) {
   const auto fail = [](const std::string& what) { return Error("procedural pattern", what); };
   if (d.size < 1 || d.size > limits::kMaxTextureSide || (d.size & (d.size - 1)) != 0)
@@ -367,6 +441,7 @@ void validate(const ProceduralDesc& d) {
   if (d.octaves < 1 || d.octaves > 16) throw fail("octaves " + std::to_string(d.octaves) + " is outside 1..16");
   if (!(d.gain >= 0.0f && d.gain <= 1.0f)) throw fail("gain must be in [0, 1]");
   if (!(d.mortar >= 0.0f && d.mortar < 1.0f)) throw fail("mortar must be in [0, 1)");
+  if (d.pattern == ProceduralPattern::Waves && d.waves.empty()) throw fail("waves needs at least one wave");
 }
 
 }  // namespace
@@ -375,15 +450,17 @@ namespace texture_detail {
 
 Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
   validate(d);
+  const Offset o = scroll_offset(d);
   switch (d.pattern) {
-    case ProceduralPattern::Bricks: return fill(d.size, with_cells, Bricks{d.cells, d.mortar, d.seed});
-    case ProceduralPattern::Cobbles: return fill(d.size, with_cells, Cobbles(d.cells, d.mortar, d.seed));
-    case ProceduralPattern::Sine: return fill(d.size, with_cells, Sine{d.cells});
-    case ProceduralPattern::Steps: return fill(d.size, with_cells, Steps{d.cells, d.seed});
-    case ProceduralPattern::Spikes: return fill(d.size, with_cells, Spikes{d.cells, d.seed});
-    case ProceduralPattern::Noise: return fill_normalised(d.size, with_cells, Noise(d));
-    case ProceduralPattern::Flat: return fill(d.size, with_cells, Flat{});
-    case ProceduralPattern::Checker: return fill(d.size, with_cells, Checker{d.cells, d.seed});
+    case ProceduralPattern::Bricks: return fill(d.size, with_cells, Bricks{d.cells, d.mortar, d.seed}, o);
+    case ProceduralPattern::Cobbles: return fill(d.size, with_cells, Cobbles(d.cells, d.mortar, d.seed), o);
+    case ProceduralPattern::Sine: return fill(d.size, with_cells, Sine{d.cells}, o);
+    case ProceduralPattern::Steps: return fill(d.size, with_cells, Steps{d.cells, d.seed}, o);
+    case ProceduralPattern::Spikes: return fill(d.size, with_cells, Spikes{d.cells, d.seed}, o);
+    case ProceduralPattern::Noise: return fill_normalised(d.size, with_cells, Noise(d), o);
+    case ProceduralPattern::Flat: return fill(d.size, with_cells, Flat{}, o);
+    case ProceduralPattern::Checker: return fill(d.size, with_cells, Checker{d.cells, d.seed}, o);
+    case ProceduralPattern::Waves: return fill_waves(d, with_cells, o);
   }
   throw Error("procedural pattern", "unknown pattern");
 }

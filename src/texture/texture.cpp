@@ -141,9 +141,10 @@ Image albedo_texture(const TextureDesc& desc, const std::string& where) {
       });
       return rgb;
     }
-    case TextureSource::FromHeight: break;
+    case TextureSource::FromHeight:
+    case TextureSource::Pixels: break;
   }
-  throw Error(where, "an albedo texture cannot be 'from_height'");
+  throw Error(where, "an albedo texture cannot be 'from_height' or handed-over heights");
 }
 
 // Normals of the surface z = h * kFromHeightDepth * strength (UV units), by central differences with wrap.
@@ -199,7 +200,8 @@ Image normal_texture(const TextureDesc& desc, const LayerDesc& layer, const Imag
     case TextureSource::FromHeight:
       if (!height) throw Error(where, "a 'from_height' normal map needs the layer's height");
       return normals_from_height(*height, strength);
-    case TextureSource::Procedural: break;
+    case TextureSource::Procedural:
+    case TextureSource::Pixels: break;
   }
   throw Error(where, "a normal map cannot be procedural; use 'from_height' with a procedural height");
 }
@@ -222,6 +224,13 @@ Image height_texture(const TextureDesc& desc, const LayerDesc& layer, const std:
       out = generate_procedural(desc.procedural);
       out.source_bits = 16;  // stored as R16 unless the scene asks otherwise
       break;
+    case TextureSource::Pixels: {
+      const Image& pixels = *desc.pixels;
+      out = Image(pixels.width, pixels.height, 1);
+      for (std::size_t i = 0; i < out.texels.size(); ++i) out.texels[i] = pixels.texels[i * std::size_t(pixels.channels)];
+      out.source_bits = pixels.source_bits;
+      break;
+    }
     case TextureSource::FromHeight: throw Error(where, "a height texture cannot be 'from_height'");
   }
   apply_height_transform(out, layer);
@@ -278,6 +287,7 @@ std::uint64_t make_texture_bytes(const TextureDesc& desc, TexturePurpose purpose
     case TextureSource::None:
     case TextureSource::Constant: return out_channels * sizeof(float);
     case TextureSource::FromHeight: return out;  // normals_from_height's result; the height is the caller's
+    case TextureSource::Pixels: return out;      // a copy of the handed-over channel
     case TextureSource::Procedural:
       // The albedo's colours are made from a pattern with its cell ids (2 channels), held until they are done.
       return purpose == TexturePurpose::Albedo ? texels * 2 * sizeof(float) + out : out;

@@ -539,6 +539,38 @@ case("gltf_unknown_node", render("--set", '/objects/0={"mesh": {"type": "gltf", 
      "the asset has no node named 'qaud'; did you mean 'quad'?")
 case("gltf_plan_points", ["plan", "{in}/gltf/points.gltf"], "points cannot be drawn")
 
+
+# Animation (issue #58): frame ranges and output names are checked before anything is rendered; time-dependent
+# patterns are checked when the scene loads.
+ANIMATED = ["--set", '/animation={"frames": 10}', "--set",
+            '/materials/m/layers/0/height={"procedural": "waves", "size": 64, "waves": [{"wavelength": 0.25, "speed": 0.1}]}']
+def frames(*extra, out="{out}/f_%04d.png"):
+    return ["render", "{in}/base.json", "-o", out, *ANIMATED, *extra]
+case("frames_reversed", frames("--frames", "5:2"), "--frames 5:2: the first frame is after the last")
+case("frames_past_the_end", frames("--frames", "0:10"), "--frames 0:10: the scene's animation has frames 0 to 9")
+case("frames_not_integers", frames("--frames", "0:x"), "--frames 0:x: 'x' is not an integer")
+case("frames_step_zero", frames("--frames", "0:4:0"), "--frames 0:4:0: the step must be at least 1")
+case("frames_one_number", frames("--frames", "3"), "--frames 3: expected FIRST:LAST or FIRST:LAST:STEP")
+case("frames_output_without_number", frames("--frames", "0:3", out="{out}/image.png"),
+     "-o {out}/image.png: names no frame number")
+case("frames_aov_without_number", frames("--frames", "0:3", "--aov", "depth={out}/depth.exr"),
+     "--aov {out}/depth.exr: names no frame number")
+case("frames_bad_percent", frames("--frames", "0:3", out="{out}/f_%s.png"), "a '%' starts a frame number")
+case("frames_two_numbers", frames("--frames", "0:3", out="{out}/f_%d_%d.png"), "holds more than one frame number")
+case("frame_past_the_end", frames("--frame", "10"), "--frame 10: the scene's animation has frames 0 to 9")
+case("frame_without_animation", render("--frame", "0"), "has no /animation (frames and fps) to take frames from")
+case("animation_zero_frames", render("--set", '/animation={"frames": 0}'), "/animation/frames")
+case("waves_wavelength_too_long", render("--set", '/materials/m/layers/0/height={"procedural": "waves", "waves": [{"wavelength": 3}]}'),
+     "/materials/m/layers/0/height/waves/0/wavelength: a wavelength of 3 along this direction has no whole cycle")
+case("waves_wavelength_below_two_texels", render("--set", '/materials/m/layers/0/height={"procedural": "waves", "size": 16, "waves": [{"wavelength": 0.01}]}'),
+     "is shorter than two texels of a 16-texel pattern")
+case("waves_on_another_pattern", render("--set", '/materials/m/layers/0/height={"procedural": "cobbles", "waves": [{}]}'),
+     "/materials/m/layers/0/height/waves: only the 'waves' pattern has waves")
+case("waves_without_waves", render("--set", '/materials/m/layers/0/height={"procedural": "waves"}'),
+     "/materials/m/layers/0/height: missing key 'waves'")
+case("cone_map_on_a_dynamic_height", frames("--frames", "0:1", "--set", "/materials/m/technique/name=csm"),
+     "/materials/m/technique/name: 'csm' marches a cone map baked from the heights, and this material's heights change every frame")
+
 with open(os.path.join(HERE, "cases.json"), "w") as f:
     json.dump({"comment": "Written by make_corpus.py; checked by tests/cli/bad_inputs_corpus_test.cpp.",
                "generated": generated, "cases": cases},

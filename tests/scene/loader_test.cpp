@@ -363,7 +363,7 @@ TEST(SceneLoader, HeightNormalDefaultsAndTextureForms) {
   EXPECT_EQ(
       load_error(document),
       "scene.json: /materials/rock/layers/0/height: unknown key 'color_low'; valid keys are: procedural, size, seed, "
-      "cells, octaves, gain, mortar, format, compression");
+      "cells, octaves, gain, mortar, waves, scroll, format, compression");
 }
 
 TEST(SceneLoader, ProceduralAndMeshRanges) {

@@ -19,6 +19,8 @@ inline constexpr int kGuardBandPixels = 16384;
 inline constexpr int kMaxLayers = 4;
 inline constexpr int kMaxDirectionalLights = 4;
 inline constexpr int kMaxThreads = 256;
+// Frames of a scene's animation (/animation/frames): a day at 24 fps, and frame numbers fit printf's %d.
+inline constexpr int kMaxAnimationFrames = 24 * 60 * 60 * 24;
 inline constexpr std::uint64_t kMaxTriangles = 1ull << 28;
 
 // Inputs (see docs/testing.md, "Bad input"): every file read is a regular file of at most this many bytes,

@@ -71,6 +71,10 @@ struct RenderStats {
   std::vector<TextureStat> textures;
   std::vector<MaterialStat> materials;
   TextureCacheStats texture_cache;
+  // The frame of the scene's animation this is (qdmr render --frames / --frame), and its time; -1: a still render.
+  // Its prepare_ms is then the frame's rebuild of the dynamic items (after the sequence's first frame).
+  int frame = -1;
+  double time_s = 0;
 
   nlohmann::json to_json() const;
 };

@@ -40,6 +40,12 @@ struct TextureRequest {
   // the heights behind from_height normals.
   std::uint64_t working_bytes = 0;
   std::vector<std::string> users;  // material names
+  // Its content changes from frame to frame (a time-dependent procedural, heights handed over by the program, or
+  // normals from such heights): rebuilt every frame of a sequence.
+  bool dynamic = false;
+  // Heights and from_height normals: the content key of the layer's heights they are made from, else empty.
+  // prepare makes a dynamic one's level 0 (and box chain) once for every texture made from it.
+  std::string height_key;
 };
 
 // prepare() builds at most this many textures at once (each of them with every thread), so that their working
@@ -74,6 +80,7 @@ struct DerivedPlan {
   // hierarchy (qdmr::cone_bake_bytes less the map); an AO bake, the map in floats and the max pyramid of coarse
   // taps (qdmr::ao_bake_bytes). 0 for the other kinds.
   std::uint64_t working_bytes = 0;
+  bool dynamic = false;  // made from a dynamic texture or item: rebuilt every frame of a sequence
 };
 
 // Indices into FramePlan::textures and FramePlan::derived of one layer (-1: not needed).
@@ -114,6 +121,7 @@ struct MeshPlan {
   std::vector<std::uint32_t> mtl_materials;  // obj with MTL materials: frame material per mesh-local material
   int vertex_weights = -1;   // per-vertex blend weights of this frame material are stored in the mesh, else -1
   std::vector<std::string> notes;  // gltf: what was derived or ignored (MeshData::notes), printed as warnings
+  bool dynamic = false;      // displaced by a time-dependent height map: rebuilt every frame of a sequence
 };
 
 // The private memory the image library (OpenImageIO and the ~260 libraries it brings) takes once a process has
@@ -148,6 +156,8 @@ struct FramePlan {
   // Everything prepare() builds, one line per item ("texture <key>", "mesh <key>", "<derived kind> <key>"),
   // in build order; Assets::built lists the same lines as they are made.
   std::vector<std::string> items() const;
+  // The items() lines of the dynamic items: what each frame of a sequence rebuilds. Empty for a still scene.
+  std::vector<std::string> dynamic_items() const;
   std::string describe() const;  // human-readable, for `qdmr plan`
   nlohmann::json to_json() const;
 };

@@ -18,6 +18,7 @@
 #include "qdmr/core/pixel_buffer.hpp"
 #include "qdmr/core/stats.hpp"
 #include "qdmr/scene/scene.hpp"
+#include "qdmr/texture/image.hpp"
 
 namespace qdmr {
 
@@ -71,6 +72,20 @@ public:
   void set_scene(const SceneDesc& scene) { set_scene(scene, options_aovs()); }
   const FramePlan& plan() const;  // of the current scene (throws if none)
 
+  // Frame `frame` of the current scene's animation (qdmr/scene/scene.hpp, scene_at_frame): what set_scene gets, so
+  // only the plan's dynamic items (made from time-dependent textures) are rebuilt. Throws qdmr::Error without a
+  // scene or for a frame outside the animation.
+  void set_frame(int frame);
+
+  // New heights for layer `layer` of material `material`, drawn from the next draw on: level 0 of the layer's
+  // height (one channel of `heights`, channel 0; row 0 at v = 0), through the storage the scene's height asks for
+  // (format, compression), scale and offset. Everything made from it — its mip chain and max-quadtree, normals
+  // from_height, height fields, AO maps — is rebuilt, nothing else. The heights stay the layer's for later
+  // set_frame calls, until the next set_scene. Throws qdmr::Error("update_height", ...) without a scene, for an
+  // unknown material or layer, an empty image, a value that is not finite, or a cone-stepping material (unless
+  // /animation/rebake_cones).
+  void update_height(const std::string& material, int layer, Image heights);
+
   // Draws one frame of the current scene. The frame's buffers belong to the renderer and are overwritten by the
   // next draw; its stats carry plan_ms and prepare_ms of the set_scene() before the first draw of a scene only.
   const Frame& draw();
@@ -84,6 +99,7 @@ public:
   int threads() const;
 
 private:
+  void prepare_scene(const SceneDesc& scene, const std::vector<Aov>& aovs);  // plan and prepare, the scene kept as is
   std::vector<Aov> options_aovs() const;
   struct State;
   std::unique_ptr<State> state_;

@@ -51,7 +51,19 @@ struct LightsDesc {
 };
 
 // A procedural pattern generated at load time; deterministic for (pattern, size, seed, parameters).
-enum class ProceduralPattern { Bricks, Cobbles, Sine, Steps, Spikes, Noise, Flat, Checker };
+enum class ProceduralPattern { Bricks, Cobbles, Sine, Steps, Spikes, Noise, Flat, Checker, Waves };
+
+// One directional wave of the `waves` pattern: crest-sharpened sine travelling along `direction_deg` (a
+// height-field stand-in for a Gerstner wave). Its wave vector is snapped to whole cycles per texture repeat, so
+// the pattern tiles: `cycles` is what the loader made of wavelength and direction.
+struct WaveDesc {
+  float amplitude = 1.0f;      // relative: the pattern divides the sum by the amplitudes' total
+  float wavelength = 0.25f;    // UV units of one repeat, before snapping
+  float direction_deg = 0.0f;  // travel direction in the UV plane, 0 = +u
+  float speed = 0.1f;          // UV units per second along the direction (phase speed)
+  int sharpness = 1;           // crest shape ((1 + sin) / 2)^sharpness, 1 .. 8
+  int cycles_u = 4, cycles_v = 0;  // the snapped wave vector, whole cycles per repeat
+};
 
 struct ProceduralDesc {
   ProceduralPattern pattern = ProceduralPattern::Noise;
@@ -61,9 +73,20 @@ struct ProceduralDesc {
   int octaves = 5;           // noise only
   float gain = 0.5f;         // noise only: amplitude ratio between octaves
   float mortar = 0.08f;      // bricks and cobbles: gap width as a fraction of a cell
+  std::vector<WaveDesc> waves;  // waves only
+  glm::vec2 scroll{0.0f, 0.0f};  // UV repeats per second the pattern moves by (any pattern)
+  // Seconds: the pattern is evaluated at this time (scene_at_frame sets it). Part of the content only when the
+  // pattern changes with time (time_dependent).
+  double time = 0.0;
 };
 
-enum class TextureSource { None, File, Procedural, Constant, FromHeight };
+// Whether the pattern changes with ProceduralDesc::time: a scroll, or a wave with a speed.
+bool time_dependent(const ProceduralDesc& procedural);
+
+// Pixels: heights handed over by a program (Renderer::update_height), not read from the scene file.
+enum class TextureSource { None, File, Procedural, Constant, FromHeight, Pixels };
+
+struct Image;  // qdmr/texture/image.hpp
 enum class Channel { Default, R, G, B, A, RGB, RGBA };
 
 // One texture slot. For albedo: colour from a file (sRGB decoded unless srgb=false), a constant,
@@ -86,7 +109,14 @@ struct TextureDesc {
   glm::vec3 color_low{0.25f, 0.22f, 0.2f};   // procedural albedo: colour at height 0
   glm::vec3 color_high{0.75f, 0.7f, 0.65f};  // procedural albedo: colour at height 1
   float variation = 0.15f;                    // procedural albedo: per-cell brightness jitter
+  // Pixels: one channel of heights and a number naming this version of them (content keys use it, not the
+  // pixels): two updates never share a number.
+  std::shared_ptr<const Image> pixels;
+  std::uint64_t pixels_version = 0;
 };
+
+// Whether the texture's content changes from frame to frame (a time-dependent procedural).
+bool time_dependent(const TextureDesc& texture);
 
 enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
 
@@ -293,8 +323,19 @@ struct ObjectDesc {
   std::vector<std::string> mtl_materials;
 };
 
+// Time in a scene: frame n is at time n / fps seconds.
+struct AnimationDesc {
+  bool present = false;    // the scene has an "animation" block
+  int frames = 1;          // frames 0 .. frames - 1
+  double fps = 24.0;
+  // csm and rcsm on a time-dependent height bake their cone map every frame (minutes at large sizes); without
+  // this they are refused.
+  bool rebake_cones = false;
+};
+
 struct SceneDesc {
   std::filesystem::path file;  // the scene file (for messages)
+  AnimationDesc animation;
   OutputDesc output;
   CameraDesc camera;
   LightsDesc lights;
@@ -302,11 +343,19 @@ struct SceneDesc {
   std::vector<ObjectDesc> objects;      // submission order
   TextureCacheDesc texture_cache;       // the emulated texture cache (off unless asked for)
 
+  // Whether any texture of the scene changes with time.
+  bool time_dependent() const;
+
   const MaterialDesc* find_material(const std::string& name) const {
     for (const auto& m : materials)
       if (m.name == name) return &m;
     return nullptr;
   }
 };
+
+// The scene at `seconds`: every time-dependent texture evaluated then. Still textures are left as they are.
+SceneDesc scene_at_time(const SceneDesc& scene, double seconds);
+// The scene at frame `frame` of its animation (time frame / fps); frame 0 of a scene without animation is itself.
+SceneDesc scene_at_frame(const SceneDesc& scene, int frame);
 
 }  // namespace qdmr
