@@ -47,9 +47,10 @@ struct Assets {
 
 // Builds what the plan lists, in parallel (in the caller's task arena); items whose key is in `previous` are
 // shared instead of rebuilt. The per-ISA work (max/min mip chains, a blend's box values) runs on `kernel`, the
-// Renderer's, so a forced ISA holds here too. Cone and AO maps go through the bake cache in default_cache_dir().
-// `progress`, when set, is called with the fraction of the plan's items done each time an item is built (from the
-// building thread, one call at a time). Throws qdmr::Error on bad input.
+// Renderer's, so a forced ISA holds here too: passed, not a process-wide choice, since renderers of different ISAs
+// share a process (tests, Python) and the builders run on TBB workers. Cone and AO maps go through the bake cache
+// in default_cache_dir(). `progress`, when set, is called with the fraction of the plan's items done each time an
+// item is built (from the building thread, one call at a time). Throws qdmr::Error on bad input.
 Assets prepare(const FramePlan& plan, const Kernel& kernel, const Assets* previous = nullptr,
                const FramePlan* previous_plan = nullptr, const std::function<void(double fraction)>& progress = {});
 
