@@ -4,7 +4,11 @@
 // the frame rendered alone, on any thread count.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <set>
 
 #include "cli/cli_test_util.hpp"
@@ -165,10 +169,30 @@ TEST(DynamicSurface, ConeSteppingOnADynamicHeightIsRefusedUnlessRebaked) {
         << e.what();
     EXPECT_NE(std::string(e.what()).find("use qdm or pom for dynamic surfaces"), std::string::npos) << e.what();
   }
-  const FramePlan rebaked =
-      plan_frame(water({{"/materials/water/technique/name", "csm"}, {"/animation/rebake_cones", "true"}}));
+  const FramePlan rebaked = plan_frame(water({{"/materials/water/technique/name", "csm"},
+                                              {"/animation/rebake_cones", "true"},
+                                              {"/materials/water/ao", R"({"mode": "baked"})"}}));
   EXPECT_EQ(described(rebaked, rebaked.dynamic_items()),
-            (std::set<std::string>{"height", "normal", "height_field", "cone_map"}));
+            (std::set<std::string>{"height", "height max", "normal", "height_field", "cone_map", "layer_ao_map"}));
+  // (coarse AO taps read the max-quadtree.) Baked every frame and kept out of the bake cache (it would fill with frames).
+  const std::filesystem::path cache = std::filesystem::temp_directory_path() / ("qdmr-dynamic-cache-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(cache);
+  const char* before = std::getenv("QDMR_CACHE_DIR");
+  const std::string saved = before ? before : "";
+  ::setenv("QDMR_CACHE_DIR", cache.c_str(), 1);
+  const Assets assets = prepare(rebaked, kernel_for(resolve_isa(Isa::Auto)));
+  before ? ::setenv("QDMR_CACHE_DIR", saved.c_str(), 1) : ::unsetenv("QDMR_CACHE_DIR");
+  EXPECT_TRUE(std::filesystem::is_empty(cache));
+  std::filesystem::remove_all(cache);
+  // While a still height's maps are kept there.
+  ::setenv("QDMR_CACHE_DIR", cache.c_str(), 1);
+  std::filesystem::create_directories(cache);
+  std::vector<SceneOverride> still_csm{{"/materials/water/technique/name", "csm"}, {"/materials/water/ao", R"({"mode": "baked"})"}};
+  for (int i = 0; i < 4; ++i) still_csm.push_back({"/materials/water/layers/0/height/waves/" + std::to_string(i) + "/speed", "0"});
+  prepare(plan_frame(water(still_csm)), kernel_for(resolve_isa(Isa::Auto)));
+  before ? ::setenv("QDMR_CACHE_DIR", saved.c_str(), 1) : ::unsetenv("QDMR_CACHE_DIR");
+  EXPECT_FALSE(std::filesystem::is_empty(cache));
+  std::filesystem::remove_all(cache);
 }
 
 }  // namespace
