@@ -21,19 +21,20 @@ def run(spec: Spec, out: Union[str, os.PathLike], *, resume: bool = True, thread
     once; shard=(I, N): the I-th of N shards only, balanced by estimated cost (`qdmr study --shard I/N`, merged
     by `qdmr study merge`).
 
-    client: a dask.distributed Client. The configurations are then split into one shard per worker (balanced by
-    estimated cost, `qdmr study --shard`), each drawn by one process on its worker with persistent renderers,
-    into OUT/shards/I-of-N, and merged into OUT (`qdmr study merge`). The folders must be on a file system the
-    workers share with the caller (a LocalCluster, or a cluster file system). threads then defaults to the
-    worker's thread count.
+    client: a dask.distributed Client. The configurations are then drawn one task each on its workers: every
+    worker process keeps one set of persistent renderers across its tasks and starts on its own run of
+    configurations that share asset sets, taking from the others' runs when its own is done; the rows come back to
+    this process, which writes OUT as a one-process run does (the same files; resume works across both). The
+    folder must be on a file system the workers share with the caller (kept images are written there). threads
+    then defaults to the worker's thread count.
 
-    Returns {"total", "rendered", "resumed", "asset_builds", "seconds"} (with a client: summed over the shards,
-    "seconds" the wall time, "shards" their number, "processes" the worker processes that drew them). Ctrl-C stops after the configurations being drawn, with the
+    Returns {"total", "rendered", "resumed", "asset_builds", "seconds"} (with a client also
+    "processes": the worker processes that drew configurations). Ctrl-C stops after the configurations being drawn, with the
     rows so far kept (resume continues), and raises KeyboardInterrupt. Raises SceneError for a bad spec before
     anything renders."""
     if client is not None:
         if shard is not None:
-            raise ValueError("study.run(): shard and client: the client makes the shards itself")
+            raise ValueError("study.run(): shard and client: the client spreads the configurations itself")
         from . import _dask
         return _dask.run(spec, out, client, resume=resume, threads=threads, force=force, base_dir=base_dir)
     return _qdmr.run_study(spec, out, resume=resume, threads=threads, jobs=jobs, shard=shard, force=force,

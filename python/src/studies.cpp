@@ -12,6 +12,7 @@
 #include "qdmr/check/check.hpp"
 #include "qdmr/check/manifest.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/isa.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/study/spec.hpp"
 #include "qdmr/study/study.hpp"
@@ -37,6 +38,14 @@ StudySpec spec_arg(py::handle spec, py::handle base_dir, const char* fn) {
   return read_study_spec(path);
 }
 
+int threads_arg(py::handle threads, const char* fn) {
+  if (threads.is_none()) return 0;
+  const int n = int_arg(threads, fn, "threads");
+  if (n < 1 || n > limits::kMaxThreads)
+    throw BadValue(std::string(fn) + "(): threads must be from 1 to " + std::to_string(limits::kMaxThreads) + " (or None)");
+  return n;
+}
+
 py::dict run_study_arg(py::handle spec_value, py::handle out_value, py::handle resume, py::handle threads,
                        py::handle jobs, py::handle shard, py::handle force, py::handle base_dir) {
   const char* fn = "study.run";
@@ -45,11 +54,7 @@ py::dict run_study_arg(py::handle spec_value, py::handle out_value, py::handle r
   StudyOptions options;
   options.resume = bool_arg(resume, fn, "resume");
   options.force = bool_arg(force, fn, "force");
-  if (!threads.is_none()) {
-    options.threads = int_arg(threads, fn, "threads");
-    if (options.threads < 1 || options.threads > limits::kMaxThreads)
-      throw BadValue("study.run(): threads must be from 1 to " + std::to_string(limits::kMaxThreads) + " (or None)");
-  }
+  options.threads = threads_arg(threads, fn);
   options.jobs = int_arg(jobs, fn, "jobs");
   if (options.jobs < 1 || options.jobs > 64) throw BadValue("study.run(): jobs must be from 1 to 64");
   if (!shard.is_none()) {
@@ -117,12 +122,95 @@ std::vector<py::dict> run_checks_arg(py::handle manifest_value, py::handle updat
   return results;
 }
 
+// The results folder of a study spread over workers (qdmr/_dask.py): the caller holds it (and its lock) while the
+// workers' rows come in; close() writes the results and lets the folder go.
+class StudyFolderHandle {
+public:
+  StudyFolderHandle(py::handle spec_value, py::handle out_value, py::handle resume, py::handle force,
+                    py::handle threads, py::handle base_dir) {
+    const char* fn = "study.run";
+    const StudySpec spec = spec_arg(spec_value, base_dir, fn);
+    const std::filesystem::path out = path_arg(out_value, fn, "out");
+    StudyFolderInfo info;
+    info.configurations = expand_study(spec, bool_arg(force, fn, "force")).size();
+    info.resume = bool_arg(resume, fn, "resume");
+    info.threads = threads_arg(threads, fn);
+    info.isa = isa_name(resolve_isa(Isa::Auto));
+    hash_ = spec.hash;
+    configurations_ = info.configurations;
+    py::gil_scoped_release release;
+    folder_ = std::make_unique<StudyFolder>(spec, out, info);
+  }
+
+  StudyFolder& folder() {
+    if (!folder_) throw BadValue("StudyFolder: closed");
+    return *folder_;
+  }
+  const std::string& spec_hash() const { return hash_; }
+  std::size_t configurations() const { return configurations_; }
+  void close() {
+    if (!folder_) return;
+    py::gil_scoped_release release;
+    folder_->finish();
+    folder_.reset();
+  }
+
+private:
+  std::string hash_;
+  std::size_t configurations_ = 0;
+  std::unique_ptr<StudyFolder> folder_;
+};
+
 }  // namespace
 
 void bind_studies(py::module_& m) {
   m.def("run_study", &run_study_arg, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume") = true,
         py::arg("threads") = py::none(), py::arg("jobs") = 1, py::arg("shard") = py::none(), py::arg("force") = false,
         py::arg("base_dir") = py::none(), "One process's study run (qdmr.study.run wraps it).");
+  py::class_<StudyMeasurer>(m, "StudyMeasurer",
+                            "One process's persistent renderers for a spec's configurations (a Dask worker keeps one).")
+      .def(py::init([](py::handle spec, py::handle threads, py::handle force, py::handle base_dir) {
+             const StudySpec s = spec_arg(spec, base_dir, "study.run");
+             const int n = threads_arg(threads, "study.run");
+             const bool f = bool_arg(force, "study.run", "force");
+             py::gil_scoped_release release;
+             return std::make_unique<StudyMeasurer>(s, n, f);
+           }),
+           py::arg("spec"), py::kw_only(), py::arg("threads") = py::none(), py::arg("force") = false,
+           py::arg("base_dir") = py::none())
+      .def("measure", [](StudyMeasurer& measurer, std::size_t index, py::handle out) {
+             const std::filesystem::path folder = path_arg(out, "study.run", "out");
+             std::string row;
+             {
+               py::gil_scoped_release release;
+               row = measurer.measure(index, folder).dump();
+             }
+             return row;
+           }, py::arg("index"), py::arg("out"),
+           "Configuration `index`'s row as JSON text (kept files into out/images).")
+      .def("reuse_order", &StudyMeasurer::reuse_order, py::arg("pending"),
+           "`pending` grouped by the asset sets their plans build, the order that re-prepares least.")
+      .def("baseline_key", &StudyMeasurer::baseline_key, py::arg("index"),
+           "What configuration `index` is compared with: equal keys share a baseline ('' without one).")
+      .def_property_readonly("spec_hash", &StudyMeasurer::spec_hash)
+      .def_property_readonly("asset_builds", &StudyMeasurer::asset_builds);
+  py::class_<StudyFolderHandle>(m, "StudyFolder", "A study's results folder, locked while a run writes it.")
+      .def(py::init<py::handle, py::handle, py::handle, py::handle, py::handle, py::handle>(), py::arg("spec"),
+           py::arg("out"), py::kw_only(), py::arg("resume") = true, py::arg("force") = false,
+           py::arg("threads") = py::none(), py::arg("base_dir") = py::none())
+      .def_property_readonly("done", [](StudyFolderHandle& h) {
+             const std::set<std::size_t>& done = h.folder().done();
+             return std::vector<std::size_t>(done.begin(), done.end());
+           }, "Indices that have a row, ascending.")
+      .def_property_readonly("resumed", [](StudyFolderHandle& h) { return h.folder().resumed(); })
+      .def_property_readonly("spec_hash", &StudyFolderHandle::spec_hash)
+      .def_property_readonly("configurations", &StudyFolderHandle::configurations)
+      .def("append", [](StudyFolderHandle& h, const std::string& row) {
+             StudyFolder& folder = h.folder();
+             py::gil_scoped_release release;
+             folder.append(StudyRow::parse(row));
+           }, py::arg("row"), "Appends a row (JSON text, as StudyMeasurer.measure returns it).")
+      .def("close", &StudyFolderHandle::close, "Writes results.json, results.csv and pareto.csv; unlocks the folder.");
   m.def("study_size", [](py::handle spec, py::handle force, py::handle base_dir) {
     const StudySpec s = spec_arg(spec, base_dir, "study.run");
     return expand_study(s, bool_arg(force, "study.run", "force")).size();

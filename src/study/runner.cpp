@@ -70,6 +70,16 @@ double estimated_cost(const StudySpec& spec, const StudyConfig& config) {
   return cost;
 }
 
+// The baseline configuration of `config`: its values with the spec's baseline values put in.
+StudyConfig baseline_config(const StudySpec& spec, const StudyConfig& config) {
+  StudyConfig base = config;
+  for (std::size_t i = 0; i < spec.axes.size(); ++i) {
+    const auto it = spec.baseline.find(spec.axes[i].name);
+    if (it != spec.baseline.end()) base.values[i] = it->second;
+  }
+  return base;
+}
+
 // The base scene's document, read once; each configuration is its overrides applied in memory.
 class SceneSource {
 public:
@@ -95,11 +105,7 @@ public:
   // The colour of the baseline configuration for `config`: its values with the spec's baseline values put in
   // (the other axes stay, so each row is compared at its own angle, depth, ...). Rendered once per distinct one.
   const Image& baseline_for(const StudyConfig& config, const std::array<double, 9>& camera) {
-    StudyConfig base = config;
-    for (std::size_t i = 0; i < spec_.axes.size(); ++i) {
-      const auto it = spec_.baseline.find(spec_.axes[i].name);
-      if (it != spec_.baseline.end()) base.values[i] = it->second;
-    }
+    const StudyConfig base = baseline_config(spec_, config);
     const std::string key = nlohmann::json(base.values).dump();
     auto found = baselines_.find(key);
     if (found != baselines_.end()) return found->second;
@@ -351,35 +357,89 @@ std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::
   return mine;
 }
 
-StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, const StudyOptions& options) {
-  const auto start = Clock::now();
-  if (options.shard.count < 1 || options.shard.index < 1 || options.shard.index > options.shard.count)
-    throw Error("--shard", "expected I/N with 1 <= I <= N");
-  const std::vector<StudyConfig> configs = expand_study(spec, options.force);
-  const std::vector<std::size_t> mine = shard_configurations(spec, configs, options.shard);
-  const SceneSource source(spec.scene);
-  const std::array<double, 9> camera = base_camera(spec, source);
+struct StudyMeasurer::State {
+  State(const StudySpec& s, int threads, bool force)
+      : spec(s), configs(expand_study(spec, force)), source(spec.scene), camera(base_camera(spec, source)),
+        measurer(spec, source, threads) {}
+  StudySpec spec;
+  std::vector<StudyConfig> configs;
+  SceneSource source;
+  std::array<double, 9> camera;
+  Measurer measurer;  // refers to spec and source above
+};
 
-  // --jobs: that many configurations at once, each measured by its own renderers with threads / jobs workers
-  // (every core / jobs by default). Rows are the same; the timing columns then include the contention.
-  const int jobs = std::max(1, options.jobs);
-  int threads_per_job = options.threads;
-  if (jobs > 1 && threads_per_job == 0)
-    threads_per_job = std::max(1, int(std::thread::hardware_concurrency()) / jobs);
-  std::vector<std::unique_ptr<Measurer>> measurers;
-  for (int j = 0; j < jobs; ++j) measurers.push_back(std::make_unique<Measurer>(spec, source, threads_per_job));
-  nlohmann::ordered_json header = make_header(spec, configs.size(), options.shard,
-                                              measurers[0]->renderer().threads(), isa_name(measurers[0]->renderer().isa()));
-  header["machine"]["jobs"] = jobs;
+StudyMeasurer::StudyMeasurer(const StudySpec& spec, int threads, bool force)
+    : state_(std::make_unique<State>(spec, threads, force)) {}
+StudyMeasurer::~StudyMeasurer() = default;
 
-  std::error_code made;
-  const bool created = std::filesystem::create_directories(out, made);
-  if (made) throw Error(out.string(), "cannot create the results folder: " + made.message());
-  const FolderLock lock_folder(out, "study", created);  // two runs on one folder would interleave their rows
-  const std::filesystem::path rows_file = out / "rows.jsonl", header_file = out / "study.json";
+std::size_t StudyMeasurer::configurations() const { return state_->configs.size(); }
+const std::string& StudyMeasurer::spec_hash() const { return state_->spec.hash; }
+std::size_t StudyMeasurer::asset_builds() const { return state_->measurer.asset_builds(); }
+int StudyMeasurer::threads() const { return state_->measurer.renderer().threads(); }
+const char* StudyMeasurer::isa() const { return isa_name(state_->measurer.renderer().isa()); }
+
+StudyRow StudyMeasurer::measure(std::size_t index, const std::filesystem::path& out) {
+  State& s = *state_;
+  if (index >= s.configs.size())
+    throw Error("study", "configuration " + std::to_string(index) + " does not exist (the spec has " +
+                             std::to_string(s.configs.size()) + ")");
+  const StudyConfig& config = s.configs[index];
+  const SceneDesc scene = s.source.load(study_overrides(s.spec, config, s.camera));
+  try {
+    return s.measurer.measure(config, scene, out / "images", s.camera);
+  } catch (const Error& e) {
+    throw Error(study_label(s.spec, config), e.what());
+  }
+}
+
+std::string StudyMeasurer::baseline_key(std::size_t index) const {
+  const State& s = *state_;
+  if (index >= s.configs.size() || !s.spec.wants(StudyMetric::ImageDiff) || s.spec.baseline.empty()) return {};
+  return nlohmann::json(baseline_config(s.spec, s.configs[index]).values).dump();
+}
+
+std::vector<std::size_t> StudyMeasurer::reuse_order(const std::vector<std::size_t>& pending) const {
+  try {
+    return order_for_reuse(state_->spec, state_->configs, pending, state_->source, state_->camera);
+  } catch (const Error&) {
+    // A configuration that cannot be planned keeps the index order: its own error is reported when it is drawn.
+    return pending;
+  }
+}
+
+struct StudyFolder::State {
+  State(const std::filesystem::path& folder, bool made) : out(folder), created(made), lock(folder, "study", made) {}
+  std::filesystem::path out;
+  bool created;
+  FolderLock lock;  // two runs on one folder would interleave their rows
+  nlohmann::ordered_json header;
   std::vector<StudyRow> rows;
+  std::set<std::size_t> done;
+  std::size_t resumed = 0;
+  double earlier_seconds = 0;  // the wall time of the earlier runs of a resumed study
+  Clock::time_point start = Clock::now(), last_write = Clock::now();
+
+  nlohmann::ordered_json results_header() const {
+    nlohmann::ordered_json h = header;
+    h["run"] = {{"wall_seconds", earlier_seconds + std::chrono::duration<double>(Clock::now() - start).count()},
+                {"shards", 1}};
+    return h;
+  }
+};
+
+StudyFolder::StudyFolder(const StudySpec& spec, const std::filesystem::path& out, const StudyFolderInfo& info)
+    : state_([&] {
+        std::error_code made;
+        const bool created = std::filesystem::create_directories(out, made);
+        if (made) throw Error(out.string(), "cannot create the results folder: " + made.message());
+        return std::make_unique<State>(out, created);
+      }()) {
+  State& s = *state_;
+  s.header = make_header(spec, info.configurations, info.shard, info.threads, info.isa.c_str());
+  s.header["machine"]["jobs"] = info.jobs;
+  const std::filesystem::path rows_file = out / "rows.jsonl", header_file = out / "study.json";
   if (std::filesystem::exists(rows_file) || std::filesystem::exists(header_file)) {
-    if (!options.resume)
+    if (!info.resume)
       throw Error(out.string(), "holds the results of a study already: add --resume to continue it, or choose another -o");
     nlohmann::ordered_json old;
     try {
@@ -390,50 +450,81 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
     if (old.value("spec_hash", "") != spec.hash)
       throw Error(out.string(), "holds results of another spec (" + old.value("spec_hash", std::string("?")) + ", this one is " +
                                     spec.hash + "): --resume continues the same spec only");
-    if (old["shard"] != header["shard"])
-      throw Error(out.string(), "holds shard " + old["shard"].dump() + ", not " + header["shard"].dump());
-    rows = rows_to_resume(rows_file);
+    if (old["shard"] != s.header["shard"])
+      throw Error(out.string(), "holds shard " + old["shard"].dump() + ", not " + s.header["shard"].dump());
+    s.rows = rows_to_resume(rows_file);
   }
-  write_text_file(header_file, header.dump(2) + "\n");
-  const bool keep = !spec.keep.empty();
-  if (keep) std::filesystem::create_directories(out / "images");
-
-  std::set<std::size_t> done;
-  for (const StudyRow& r : rows) done.insert(r["index"].get<std::size_t>());
-  StudyRun run;
-  run.total = mine.size();
-  run.resumed = done.size();
-
-  // The wall time of the study so far (earlier runs of a resumed one included), in results.json.
-  double earlier_seconds = 0;
-  if (!rows.empty()) {
+  write_text_file(header_file, s.header.dump(2) + "\n");
+  if (!spec.keep.empty()) std::filesystem::create_directories(out / "images");
+  for (const StudyRow& r : s.rows) s.done.insert(r["index"].get<std::size_t>());
+  s.resumed = s.done.size();
+  if (!s.rows.empty()) {
     try {
-      earlier_seconds = nlohmann::json::parse(std::ifstream(out / "results.json"))["run"].value("wall_seconds", 0.0);
+      s.earlier_seconds = nlohmann::json::parse(std::ifstream(out / "results.json"))["run"].value("wall_seconds", 0.0);
     } catch (const nlohmann::json::exception&) {
     }
   }
-  const auto results_header = [&] {
-    nlohmann::ordered_json h = header;
-    h["run"] = {{"wall_seconds", earlier_seconds + std::chrono::duration<double>(Clock::now() - start).count()},
-                {"shards", 1}};
-    return h;
-  };
-  auto last_write = Clock::now();
-  std::size_t finished = done.size();
+}
+
+StudyFolder::~StudyFolder() = default;
+
+const std::set<std::size_t>& StudyFolder::done() const { return state_->done; }
+std::size_t StudyFolder::resumed() const { return state_->resumed; }
+
+void StudyFolder::append(StudyRow row) {
+  State& s = *state_;
+  const std::size_t index = row["index"].get<std::size_t>();
+  if (s.done.count(index)) throw Error(s.out.string(), "configuration " + std::to_string(index) + " has a row already");
+  append_line(s.out / "rows.jsonl", row.dump());
+  s.done.insert(index);
+  s.rows.push_back(std::move(row));
+  if (Clock::now() - s.last_write > std::chrono::seconds(2)) {
+    write_study_results(s.results_header(), s.rows, s.out);
+    s.last_write = Clock::now();
+  }
+}
+
+void StudyFolder::finish() { write_study_results(state_->results_header(), state_->rows, state_->out); }
+
+StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, const StudyOptions& options) {
+  const auto start = Clock::now();
+  if (options.shard.count < 1 || options.shard.index < 1 || options.shard.index > options.shard.count)
+    throw Error("--shard", "expected I/N with 1 <= I <= N");
+  const std::vector<StudyConfig> configs = expand_study(spec, options.force);
+  const std::vector<std::size_t> mine = shard_configurations(spec, configs, options.shard);
+
+  // --jobs: that many configurations at once, each measured by its own renderers with threads / jobs workers
+  // (every core / jobs by default). Rows are the same; the timing columns then include the contention.
+  const int jobs = std::max(1, options.jobs);
+  int threads_per_job = options.threads;
+  if (jobs > 1 && threads_per_job == 0)
+    threads_per_job = std::max(1, int(std::thread::hardware_concurrency()) / jobs);
+  std::vector<std::unique_ptr<StudyMeasurer>> measurers;
+  for (int j = 0; j < jobs; ++j)
+    measurers.push_back(std::make_unique<StudyMeasurer>(spec, threads_per_job, options.force));
+  StudyFolderInfo info;
+  info.configurations = configs.size();
+  info.shard = options.shard;
+  info.resume = options.resume;
+  info.threads = measurers[0]->threads();
+  info.isa = measurers[0]->isa();
+  info.jobs = jobs;
+  StudyFolder folder(spec, out, info);
+
+  StudyRun run;
+  run.total = mine.size();
+  run.resumed = folder.resumed();
+  std::size_t finished = folder.resumed();
   // Workers take the next pending configuration in order; everything shared (rows, files, progress) is updated
   // under the lock, the drawing is not. The first error stops every worker and is thrown after they finish.
   std::vector<std::size_t> pending;
   for (std::size_t index : mine)
-    if (!done.count(index)) pending.push_back(index);
-  try {
-    pending = order_for_reuse(spec, configs, pending, source, camera);
-  } catch (const Error&) {
-    // A configuration that cannot be planned keeps the index order: its own error is reported when it is drawn.
-  }
+    if (!folder.done().count(index)) pending.push_back(index);
+  pending = measurers[0]->reuse_order(pending);
   std::mutex lock;
   std::size_t next = 0;
   std::exception_ptr failure;
-  const auto work = [&](Measurer& measurer) {
+  const auto work = [&](StudyMeasurer& measurer) {
     for (;;) {
       std::size_t index = 0;
       {
@@ -445,25 +536,13 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
         }
         index = pending[next++];
       }
-      const StudyConfig& config = configs[index];
-      StudyRow row;
       try {
-        const SceneDesc scene = source.load(study_overrides(spec, config, camera));
-        try {
-          row = measurer.measure(config, scene, out / "images", camera);
-        } catch (const Error& e) {
-          throw Error(study_label(spec, config), e.what());
-        }
+        StudyRow row = measurer.measure(index, out);
         const std::lock_guard<std::mutex> guard(lock);
-        append_line(rows_file, row.dump());
-        rows.push_back(std::move(row));
+        folder.append(std::move(row));
         ++run.rendered;
         ++finished;
-        if (options.progress) options.progress(finished, mine.size(), study_label(spec, config));
-        if (Clock::now() - last_write > std::chrono::seconds(2)) {
-          write_study_results(results_header(), rows, out);
-          last_write = Clock::now();
-        }
+        if (options.progress) options.progress(finished, mine.size(), study_label(spec, configs[index]));
       } catch (const Interrupted&) {  // a long bake stopped by Ctrl-C: the rows so far are the result
         const std::lock_guard<std::mutex> guard(lock);
         run.stopped = true;
@@ -484,7 +563,7 @@ StudyRun run_study(const StudySpec& spec, const std::filesystem::path& out, cons
   }
   if (failure) std::rethrow_exception(failure);
   for (const auto& m : measurers) run.asset_builds += m->asset_builds();
-  write_study_results(results_header(), rows, out);
+  folder.finish();
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }

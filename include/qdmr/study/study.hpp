@@ -5,7 +5,9 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,63 @@ struct StudyRun {
 // techniques, grazing angles), not by index; every configuration is in exactly one shard. Indices, ascending.
 std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::vector<StudyConfig>& configs,
                                               StudyShard shard);
+
+// One process's measuring of a spec's configurations, one at a time, by persistent renderers (the timed frames,
+// the error AOVs and the reference, the baselines): consecutive configurations that share an asset set prepare it
+// once, and each baseline is drawn once per measurer. A Dask worker keeps one across tasks (python/qdmr/_dask.py).
+class StudyMeasurer {
+public:
+  StudyMeasurer(const StudySpec& spec, int threads, bool force = false);  // threads 0: every core
+  ~StudyMeasurer();
+  StudyMeasurer(const StudyMeasurer&) = delete;
+  StudyMeasurer& operator=(const StudyMeasurer&) = delete;
+
+  std::size_t configurations() const;
+  const std::string& spec_hash() const;
+  // Configuration `index`'s row, its kept files written into out/images. Throws qdmr::Error naming it.
+  StudyRow measure(std::size_t index, const std::filesystem::path& out);
+  // `pending` in the order that re-prepares least: grouped by the items their plans build (asset sets), groups in
+  // the order of their first configuration, indices ascending within a group.
+  std::vector<std::size_t> reuse_order(const std::vector<std::size_t>& pending) const;
+  // What configuration `index` is compared with (the image difference's baseline, drawn once per measurer):
+  // configurations with equal keys share it. Empty when the spec has no baseline.
+  std::string baseline_key(std::size_t index) const;
+  std::size_t asset_builds() const;  // configurations measured so far whose timed scene built anything
+  int threads() const;
+  const char* isa() const;
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+struct StudyFolderInfo {
+  std::size_t configurations = 0;  // of the whole spec
+  StudyShard shard;
+  bool resume = false;
+  int threads = 1, jobs = 1;  // of the machine section of study.json
+  std::string isa;
+};
+
+// A results folder while a study writes it, locked for the object's life (FOLDER/.qdmr-lock): study.json written,
+// the rows of an earlier run of the same spec and shard kept (resume; another spec's or shard's are refused),
+// rows appended one line each as they come, results.json/csv and pareto.csv rewritten every 2 s and by finish().
+class StudyFolder {
+public:
+  StudyFolder(const StudySpec& spec, const std::filesystem::path& out, const StudyFolderInfo& info);
+  ~StudyFolder();
+  StudyFolder(const StudyFolder&) = delete;
+  StudyFolder& operator=(const StudyFolder&) = delete;
+
+  const std::set<std::size_t>& done() const;  // indices with a row
+  std::size_t resumed() const;                // rows kept from earlier runs
+  void append(StudyRow row);                  // throws qdmr::Error for an index that has a row
+  void finish();
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // Runs the spec into `out` (created): study.json (what the rows belong to), rows.jsonl (a row per line, appended
 // as each finishes), results.json, results.csv and pareto.csv (rewritten from the rows), images/ (keep).
