@@ -1,7 +1,8 @@
 // Cone-map bake time (bake_cone_map, both kinds) on procedural and real height maps, 1 and 2 threads.
 // A plain timing program: each case runs once per repetition and the fastest run is printed as a markdown row.
-//   qdmr_cone_bench [--sizes 256,512,1024,2048] [--threads 1,2] [--reps N] [--real]
-// --real adds ambientcg_rocks007 (1024² and 2048²) from the data folder when present.
+//   qdmr_cone_bench [--sizes 256,512,1024,2048] [--threads 1,2] [--reps N] [--real] [--map FILE]...
+// --real adds ambientcg_rocks007 (1024² and 2048²) from the data folder when present; --map adds a height image
+// (a path relative to the data folder, QDMR_DATA_DIR, e.g. terrain/puget_sound_4k.jpg, or any path).
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
   std::vector<int> sizes{256, 512, 1024, 2048}, threads{1, 2};
   int reps = 1;
   bool real = false;
+  std::vector<std::string> maps;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
     if (arg == "--sizes" && k + 1 < argc)
@@ -74,8 +76,11 @@ int main(int argc, char** argv) {
       reps = std::max(1, std::atoi(argv[++k]));
     else if (arg == "--real")
       real = true;
+    else if (arg == "--map" && k + 1 < argc)
+      maps.push_back(argv[++k]);
     else {
-      std::fprintf(stderr, "usage: %s [--sizes 256,512,...] [--threads 1,2] [--reps N] [--real]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--sizes 256,512,...] [--threads 1,2] [--reps N] [--real] [--map FILE]...\n",
+                   argv[0]);
       return 2;
     }
   }
@@ -93,5 +98,10 @@ int main(int argc, char** argv) {
     for (const char* file : {"height.jpg", "height_2k.jpg"})
       if (std::filesystem::exists(rocks / file))
         run_case(std::string("rocks007 ") + file, field_of(qdmr::read_image(rocks / file, file)), threads, reps);
+  for (const std::string& map : maps) {
+    const std::filesystem::path in_data = std::filesystem::path(QDMR_DATA_DIR) / map;
+    const std::filesystem::path file = std::filesystem::exists(in_data) ? in_data : std::filesystem::path(map);
+    run_case(map, field_of(qdmr::read_image(file, map)), threads, reps);
+  }
   return 0;
 }

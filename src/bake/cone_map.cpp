@@ -1,6 +1,6 @@
 // Cone-map bakers: the exact definitions of include/qdmr/bake/cone_map.hpp, by brute force and by a pruned walk
-// of a max hierarchy. Both evaluate every candidate with the same expression (candidate_ratio), so they agree
-// bit for bit; the hierarchy only skips candidates it can prove are not below the current minimum.
+// of a max hierarchy. Both evaluate every candidate with the same expression (Grid::ratio), so they agree bit for
+// bit; the hierarchy only skips candidates it can prove are not below the current minimum.
 #include "qdmr/bake/cone_map.hpp"
 
 #include <tbb/blocked_range.h>
@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/progress.hpp"
@@ -37,35 +38,23 @@ int positive_mod(int a, int n) {
   return m < 0 ? m + n : m;
 }
 
-// Whole texels between p (index i) and the constraint of texel x along an axis of n texels; -1: no constraint.
-int texel_gap(Gap gap, int i, int x, int n, bool wrap) {
-  switch (gap) {
-    case Gap::Cell: {
-      int c = std::abs(x - i);
-      if (wrap) c = std::min(c, n - c);
-      return std::max(0, c - 1);
-    }
-    case Gap::Plus:
-      return wrap ? positive_mod(x - i, n) : (x >= i ? x - i : -1);
-    case Gap::Minus:
-      return wrap ? positive_mod(i - x, n) : (i >= x ? i - x : -1);
-  }
-  return -1;
-}
+// a mod n for a in (-n, n), without a division.
+int wrap_once(int a, int n) { return a < 0 ? a + n : a; }
 
-// The least texel_gap over texels x0..x1 (a lower bound the hierarchy prunes with); -1: none of them binds.
-int range_gap(Gap gap, int i, int x0, int x1, int n, bool wrap) {
-  if (i >= x0 && i <= x1) return 0;
-  switch (gap) {
-    case Gap::Cell:
-      if (wrap) return std::min(positive_mod(x0 - i, n), positive_mod(i - x1, n)) - 1;
-      return (x0 > i ? x0 - i : i - x1) - 1;
-    case Gap::Plus:
-      return wrap ? positive_mod(x0 - i, n) : (x0 > i ? x0 - i : -1);
-    case Gap::Minus:
-      return wrap ? positive_mod(i - x1, n) : (x1 < i ? i - x1 : -1);
+// Whole texels between texel ranges [i0, i1] (of p: one texel, or a block of them) and [x0, x1] (of q: one texel,
+// or a hierarchy cell) along an axis of n texels, for a constraint of kind G: the least over pairs (p, q); -1 when
+// no pair binds. Every index is in [0, n).
+template <Gap G>
+int gap(int i0, int i1, int x0, int x1, int n, bool wrap) {
+  if (x0 <= i1 && i0 <= x1) return 0;
+  if constexpr (G == Gap::Cell) {
+    if (wrap) return std::min(wrap_once(x0 - i1, n), wrap_once(i0 - x1, n)) - 1;
+    return (x0 > i1 ? x0 - i1 : i0 - x1) - 1;
+  } else if constexpr (G == Gap::Plus) {
+    return wrap ? wrap_once(x0 - i1, n) : (x0 > i1 ? x0 - i1 : -1);
+  } else {
+    return wrap ? wrap_once(i0 - x1, n) : (i0 > x1 ? i0 - x1 : -1);
   }
-  return -1;
 }
 
 // The field as the bakers see it: mirror is unfolded into its 2W x 2H period and treated as wrap. Channel values
@@ -75,7 +64,6 @@ struct Grid {
   int out_width = 0, out_height = 0;  // of the map: texels (0..out_width-1, 0..out_height-1) are baked
   bool wrap = true;
   int channels = 1;
-  std::vector<Channel> layout;
   std::vector<double> heights;   // y * width + x
   std::vector<double> value;     // (y * width + x) * channels + c
   std::vector<double> sqx, sqy;  // squared UV length of g whole texels, g = 0..width (height)
@@ -125,12 +113,10 @@ Grid make_grid(const HeightField& field, ConeKind kind) {
 
   if (kind == ConeKind::Conservative) {
     g.channels = 1;
-    g.layout = {{Gap::Cell, Gap::Cell}};
     g.value = g.heights;
     return g;
   }
   g.channels = int(kWallChannels.size());
-  g.layout.assign(kWallChannels.begin(), kWallChannels.end());
   g.value.assign(g.heights.size() * kWallChannels.size(), -1.0);
   // The neighbour across a wall; clamp's extension repeats the edge texel (no wall at the border).
   auto neighbour = [&](int x, int y, int dx, int dy) -> double {
@@ -153,20 +139,6 @@ Grid make_grid(const HeightField& field, ConeKind kind) {
           g.value[(std::size_t(y) * std::size_t(g.width) + std::size_t(x)) * kStep.size() + c] = hq;
       }
   return g;
-}
-
-// The exact constraint of texel (x, y) on p = (i, j): the least candidate ratio over its channels, or `best`.
-double visit_texel(const Grid& g, int i, int j, double hp, int x, int y, double best) {
-  const double* v = &g.value[(std::size_t(y) * std::size_t(g.width) + std::size_t(x)) * std::size_t(g.channels)];
-  for (int c = 0; c < g.channels; ++c) {
-    if (!(v[c] > hp)) continue;
-    const int gx = texel_gap(g.layout[std::size_t(c)].gx, i, x, g.width, g.wrap);
-    if (gx < 0) continue;
-    const int gy = texel_gap(g.layout[std::size_t(c)].gy, j, y, g.height, g.wrap);
-    if (gy < 0) continue;
-    best = std::min(best, g.ratio(gx, gy, v[c], hp));
-  }
-  return best;
 }
 
 float round_toward_zero(double r) {
@@ -217,86 +189,231 @@ std::vector<Level> build_hierarchy(const Grid& g) {
   return levels;
 }
 
-struct Baker {
-  const Grid& g;
-  const std::vector<Level>& levels;
+template <int C>
+constexpr std::array<Channel, std::size_t(C)> channel_layout() {
+  if constexpr (C == 1)
+    return {{{Gap::Cell, Gap::Cell}}};  // conservative: the height of the texel's square
+  else
+    return kWallChannels;
+}
 
-  // Lower bound of the ratio over cell (cx, cy) of level k; +inf when no texel in it can bind.
-  double cell_bound(int k, int cx, int cy, int i, int j, double hp) const {
-    const Level& level = levels[std::size_t(k)];
-    const float* m =
-        &level.max[(std::size_t(cy) * std::size_t(level.width) + std::size_t(cx)) * std::size_t(g.channels)];
-    const int x0 = cx << k, x1 = std::min((cx + 1) << k, g.width) - 1;
-    const int y0 = cy << k, y1 = std::min((cy + 1) << k, g.height) - 1;
-    double bound = std::numeric_limits<double>::infinity();
-    for (int c = 0; c < g.channels; ++c) {
-      const double top = m[c];
-      if (!(top > hp)) continue;
-      const int gx = range_gap(g.layout[std::size_t(c)].gx, i, x0, x1, g.width, g.wrap);
-      if (gx < 0) continue;
-      const int gy = range_gap(g.layout[std::size_t(c)].gy, j, y0, y1, g.height, g.wrap);
-      if (gy < 0) continue;
-      bound = std::min(bound, g.ratio(gx, gy, top, hp));
+// Calls f(top, gx, gy) for each channel c of texel or cell (x0..x1, y0..y1) that may constrain texels
+// (i0..i1, j0..j1) at height hp or above: its top (`tops[c]`) is above hp and the pair binds along both axes.
+template <int C, class F>
+void for_each_binding(const Grid& g, int i0, int i1, int j0, int j1, double hp, int x0, int x1, int y0, int y1,
+                      const auto* tops, F&& f) {
+  static constexpr std::array<Channel, std::size_t(C)> kLayout = channel_layout<C>();
+  [&]<std::size_t... c>(std::index_sequence<c...>) {
+    (
+        [&] {
+          const double top = double(tops[c]);
+          if (!(top > hp)) return;
+          const int gx = gap<kLayout[c].gx>(i0, i1, x0, x1, g.width, g.wrap);
+          if (gx < 0) return;
+          const int gy = gap<kLayout[c].gy>(j0, j1, y0, y1, g.height, g.wrap);
+          if (gy < 0) return;
+          f(top, gx, gy);
+        }(),
+        ...);
+  }(std::make_index_sequence<std::size_t(C)>{});
+}
+
+// The least ratio found so far for one texel p, and the threshold that prunes against it without a square root.
+// A candidate of ratio sqrt(s) / t (s the squared distance, t the height difference, as in Grid::ratio) with
+// s > prune2 * t^2 has a computed ratio of at least `ratio`: the margin of 1e-12 covers the few ulps of the
+// products, the square root and the quotient. (When prune2 * t^2 underflows, t < 1e-144 and any s > 0 gives a
+// ratio far above kMaxConeRatio; s = 0 is never pruned.)
+struct Best {
+  double ratio = kMaxConeRatio;
+  double prune2 = double(kMaxConeRatio) * double(kMaxConeRatio) * (1.0 + 1e-12);
+  int x = -1, y = -1;  // the texel that gave `ratio`; -1: none yet
+
+  bool prunes(double s, double t) const { return s > prune2 * (t * t); }
+  void offer(double r, int qx, int qy) {
+    if (!(r < ratio)) return;
+    ratio = r;
+    prune2 = r * r * (1.0 + 1e-12);
+    x = qx;
+    y = qy;
+  }
+};
+
+// Texels are baked in blocks of kBlock x kBlock. The texels of a block that no 8-neighbour settles walk the
+// hierarchy together: a cell is opened when it may narrow the widest cone among them (its distance to the block's
+// texels, its top over their lowest height), and each of its texels is then tried on each of them. One walk thus
+// serves up to kBlock^2 texels whose searches overlap almost entirely.
+constexpr int kBlock = 4;
+
+template <int C>
+class Baker {
+public:
+  Baker(const Grid& g, const std::vector<Level>& levels) : g_(g), levels_(levels) {}
+
+  // The texels of the block whose top-left texel is (bx, by); `hints` (one per row of the block, x < 0: none) are
+  // where the previous block of the same rows found its minima, tried first so the walk starts with narrow cones.
+  void bake_block(int bx, int by, std::array<std::array<int, 2>, kBlock>& hints, ConeMap& map) const {
+    std::array<Texel, kBlock * kBlock> walking;
+    int n = 0;
+    const int bx1 = std::min(bx + kBlock, g_.out_width), by1 = std::min(by + kBlock, g_.out_height);
+    for (int j = by; j < by1; ++j)
+      for (int i = bx; i < bx1; ++i) {
+        Texel p{i, j, g_.h(i, j), {}};
+        for (const auto& [hx, hy] : hints)
+          if (hx >= 0) visit(p, hx, hy);
+        // The 8-neighbours: on rough maps they usually settle the texel (ratio 0) without a walk.
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            int x = i + dx, y = j + dy;
+            if (g_.wrap) {
+              x = x < 0 ? x + g_.width : x >= g_.width ? x - g_.width : x;
+              y = y < 0 ? y + g_.height : y >= g_.height ? y - g_.height : y;
+            } else if (x < 0 || y < 0 || x >= g_.width || y >= g_.height) {
+              continue;
+            }
+            visit(p, x, y);
+          }
+        if (p.best.ratio > 0.0)
+          walking[std::size_t(n++)] = p;
+        else
+          map.ratio[std::size_t(j) * std::size_t(g_.out_width) + std::size_t(i)] = 0.0f;
+      }
+    if (n == 0) return;
+    walk(walking.data(), n);
+    for (int k = 0; k < n; ++k) {
+      const Texel& p = walking[std::size_t(k)];
+      map.ratio[std::size_t(p.j) * std::size_t(g_.out_width) + std::size_t(p.i)] = round_toward_zero(p.best.ratio);
+      if (p.best.x >= 0) hints[std::size_t(p.j - by)] = {p.best.x, p.best.y};
     }
-    return bound;
   }
 
-  double bake_texel(int i, int j) const {
-    const double hp = g.h(i, j);
-    double best = kMaxConeRatio;
-    // The 3x3 neighbourhood first: on rough maps it usually settles the texel (ratio 0) without a walk.
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        int x = i + dx, y = j + dy;
-        if (g.wrap) {
-          x = positive_mod(x, g.width);
-          y = positive_mod(y, g.height);
-        } else if (x < 0 || y < 0 || x >= g.width || y >= g.height) {
-          continue;
-        }
-        best = visit_texel(g, i, j, hp, x, y, best);
-      }
+private:
+  struct Texel {
+    int i, j;
+    double hp;
+    Best best;
+  };
+
+  // Texel q = (x, y) tried on p.
+  void visit(Texel& p, int x, int y) const {
+    const double* tops = &g_.value[(std::size_t(y) * std::size_t(g_.width) + std::size_t(x)) * std::size_t(C)];
+    for_each_binding<C>(g_, p.i, p.i, p.j, p.j, p.hp, x, x, y, y, tops, [&](double top, int gx, int gy) {
+      const double s = g_.sqx[std::size_t(gx)] + g_.sqy[std::size_t(gy)];
+      if (!p.best.prunes(s, top - p.hp)) p.best.offer(g_.ratio(gx, gy, top, p.hp), x, y);
+    });
+  }
+
+  // The texels walking together: their bounding box, lowest height and widest cone.
+  struct Group {
+    int i0, i1, j0, j1;
+    double hp;
+    double prune2;  // the largest Best::prune2 among them: a cell pruned with it is pruned for every one
+  };
+
+  // s / t^2 of the least bound of hierarchy cell (cx, cy) of level k >= 1 on the group; +inf when the cell cannot
+  // narrow any of its cones. The bound is monotone: every texel of the cell and of the group is at least as far
+  // apart and differs at most as much in height, and the float tops are rounded up.
+  double cell_key(int k, int cx, int cy, const Group& group) const {
+    const Level& level = levels_[std::size_t(k)];
+    const float* tops = &level.max[(std::size_t(cy) * std::size_t(level.width) + std::size_t(cx)) * std::size_t(C)];
+    const int x0 = cx << k, x1 = std::min((cx + 1) << k, g_.width) - 1;
+    const int y0 = cy << k, y1 = std::min((cy + 1) << k, g_.height) - 1;
+    double key = std::numeric_limits<double>::infinity();
+    for_each_binding<C>(g_, group.i0, group.i1, group.j0, group.j1, group.hp, x0, x1, y0, y1, tops,
+                        [&](double top, int gx, int gy) {
+                          const double s = g_.sqx[std::size_t(gx)] + g_.sqy[std::size_t(gy)], t = top - group.hp;
+                          if (s > group.prune2 * (t * t)) return;
+                          key = std::min(key, s == 0.0 ? 0.0 : s / (t * t));
+                        });
+    return key;
+  }
+
+  // Depth first from the root, the nearest-bound child first, over cells that may narrow some texel's cone.
+  void walk(Texel* texels, int n) const {
+    Group group{texels[0].i, texels[0].i, texels[0].j, texels[0].j, texels[0].hp, 0.0};
+    for (int k = 0; k < n; ++k) {
+      const Texel& p = texels[k];
+      group.i0 = std::min(group.i0, p.i), group.i1 = std::max(group.i1, p.i);
+      group.j0 = std::min(group.j0, p.j), group.j1 = std::max(group.j1, p.j);
+      group.hp = std::min(group.hp, p.hp);
+      group.prune2 = std::max(group.prune2, p.best.prune2);
+    }
     struct Entry {
       int k, cx, cy;
-      double bound;
+      double key;
     };
     std::array<Entry, 4 * 32> stack;
     int top = 0;
-    const int root = int(levels.size()) - 1;
-    if (root == 0) {  // a 1x1 map
-      return best;
-    }
-    stack[std::size_t(top++)] = {root, 0, 0, 0.0};
-    while (top > 0 && best > 0.0) {
+    const int root = int(levels_.size()) - 1;
+    if (root > 0) stack[std::size_t(top++)] = {root, 0, 0, 0.0};  // else a 1x1 map: its neighbourhood was all
+    while (top > 0 && group.prune2 > 0.0) {
       const Entry e = stack[std::size_t(--top)];
-      if (e.bound >= best) continue;
+      if (e.key > group.prune2) continue;
       const int k = e.k - 1;
-      const int w = k == 0 ? g.width : levels[std::size_t(k)].width;
-      const int h = k == 0 ? g.height : levels[std::size_t(k)].height;
       if (k == 0) {
-        for (int y = 2 * e.cy; y < std::min(2 * e.cy + 2, h); ++y)
-          for (int x = 2 * e.cx; x < std::min(2 * e.cx + 2, w); ++x) best = visit_texel(g, i, j, hp, x, y, best);
+        for (int m = 0; m < n; ++m) {  // the cell's own bound on each texel first: it often spares 4 visits
+          Texel& p = texels[m];
+          if (cell_key(1, e.cx, e.cy, Group{p.i, p.i, p.j, p.j, p.hp, p.best.prune2}) > p.best.prune2) continue;
+          for (int y = 2 * e.cy; y < std::min(2 * e.cy + 2, g_.height); ++y)
+            for (int x = 2 * e.cx; x < std::min(2 * e.cx + 2, g_.width); ++x) visit(p, x, y);
+        }
+        group.prune2 = 0.0;
+        for (int m = 0; m < n; ++m) group.prune2 = std::max(group.prune2, texels[m].best.prune2);
         continue;
       }
-      // Children nearest-bound first: pushed in descending order of bound.
+      const Level& level = levels_[std::size_t(k)];
       std::array<Entry, 4> children;
-      int n = 0;
-      for (int y = 2 * e.cy; y < std::min(2 * e.cy + 2, h); ++y)
-        for (int x = 2 * e.cx; x < std::min(2 * e.cx + 2, w); ++x) {
-          const double b = cell_bound(k, x, y, i, j, hp);
-          if (b >= best) continue;
-          int at = n++;
-          while (at > 0 && children[std::size_t(at - 1)].bound < b) {
+      int count = 0;
+      for (int y = 2 * e.cy; y < std::min(2 * e.cy + 2, level.height); ++y)
+        for (int x = 2 * e.cx; x < std::min(2 * e.cx + 2, level.width); ++x) {
+          const double key = cell_key(k, x, y, group);
+          if (key > group.prune2) continue;
+          int at = count++;  // kept in descending order of key: the nearest is pushed last, popped first
+          while (at > 0 && children[std::size_t(at - 1)].key < key) {
             children[std::size_t(at)] = children[std::size_t(at - 1)];
             --at;
           }
-          children[std::size_t(at)] = {k, x, y, b};
+          children[std::size_t(at)] = {k, x, y, key};
         }
-      for (int c = 0; c < n; ++c) stack[std::size_t(top++)] = children[std::size_t(c)];
+      for (int c = 0; c < count; ++c) stack[std::size_t(top++)] = children[std::size_t(c)];
     }
-    return best;
   }
+
+  const Grid& g_;
+  const std::vector<Level>& levels_;
 };
+
+template <int C>
+void bake_blocks(const Grid& g, ConeMap& map, ConeKind kind) {
+  const std::vector<Level> levels = build_hierarchy(g);
+  const Baker<C> baker(g, levels);
+  ProgressStep step(std::string(cone_kind_name(kind)) + " cone map " + std::to_string(g.out_width) + "x" +
+                        std::to_string(g.out_height),
+                    g.out_height);
+  const int rows_of_blocks = (g.out_height + kBlock - 1) / kBlock;
+  tbb::parallel_for(0, rows_of_blocks, [&](int row) {
+    step.advance();  // stops here when asked to (Ctrl-C): within kBlock rows
+    std::array<std::array<int, 2>, kBlock> hints;
+    hints.fill({-1, -1});
+    for (int bx = 0; bx < g.out_width; bx += kBlock) baker.bake_block(bx, row * kBlock, hints, map);
+    step.advance(std::min(kBlock, g.out_height - row * kBlock));
+  });
+}
+
+template <int C>
+void bake_brute_force(const Grid& g, ConeMap& map) {
+  for (int j = 0; j < g.out_height; ++j)
+    for (int i = 0; i < g.out_width; ++i) {
+      const double hp = g.h(i, j);
+      double best = kMaxConeRatio;
+      for (int y = 0; y < g.height; ++y)
+        for (int x = 0; x < g.width; ++x) {
+          const double* tops = &g.value[(std::size_t(y) * std::size_t(g.width) + std::size_t(x)) * std::size_t(C)];
+          for_each_binding<C>(g, i, i, j, j, hp, x, x, y, y, tops,
+                              [&](double top, int gx, int gy) { best = std::min(best, g.ratio(gx, gy, top, hp)); });
+        }
+      map.ratio[std::size_t(j) * std::size_t(g.out_width) + std::size_t(i)] = round_toward_zero(best);
+    }
+}
 
 ConeMap empty_map(const Grid& g, ConeKind kind) {
   ConeMap map;
@@ -331,34 +448,21 @@ std::uint64_t cone_bake_bytes(int width, int height, ConeKind kind, AddressMode 
 
 ConeMap bake_cone_map(const HeightField& field, ConeKind kind) {
   const Grid g = make_grid(field, kind);
-  const std::vector<Level> levels = build_hierarchy(g);
   ConeMap map = empty_map(g, kind);
-  const Baker baker{g, levels};
-  ProgressStep step(std::string(cone_kind_name(kind)) + " cone map " + std::to_string(g.out_width) + "x" +
-                        std::to_string(g.out_height),
-                    g.out_height);
-  tbb::parallel_for(tbb::blocked_range<int>(0, g.out_height, 2), [&](const tbb::blocked_range<int>& rows) {
-    step.advance();  // stops here when asked to (Ctrl-C): within two rows
-    for (int j = rows.begin(); j < rows.end(); ++j)
-      for (int i = 0; i < g.out_width; ++i)
-        map.ratio[std::size_t(j) * std::size_t(g.out_width) + std::size_t(i)] =
-            round_toward_zero(baker.bake_texel(i, j));
-    step.advance(rows.size());
-  });
+  if (kind == ConeKind::Conservative)
+    bake_blocks<1>(g, map, kind);
+  else
+    bake_blocks<4>(g, map, kind);
   return map;
 }
 
 ConeMap bake_cone_map_brute_force(const HeightField& field, ConeKind kind) {
   const Grid g = make_grid(field, kind);
   ConeMap map = empty_map(g, kind);
-  for (int j = 0; j < g.out_height; ++j)
-    for (int i = 0; i < g.out_width; ++i) {
-      const double hp = g.h(i, j);
-      double best = kMaxConeRatio;
-      for (int y = 0; y < g.height; ++y)
-        for (int x = 0; x < g.width; ++x) best = visit_texel(g, i, j, hp, x, y, best);
-      map.ratio[std::size_t(j) * std::size_t(g.out_width) + std::size_t(i)] = round_toward_zero(best);
-    }
+  if (kind == ConeKind::Conservative)
+    bake_brute_force<1>(g, map);
+  else
+    bake_brute_force<4>(g, map);
   return map;
 }
 

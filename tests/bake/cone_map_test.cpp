@@ -71,6 +71,16 @@ std::vector<NamedField> test_fields(int max_size) {
       if (n <= max_size)
         fields.push_back({"random " + std::to_string(n) + suffix, random_field(n, n, mode, 7u + unsigned(n))});
     if (max_size >= 13) fields.push_back({"random 13x7" + suffix, random_field(13, 7, mode, 3)});
+    if (max_size >= 32) {
+      // Smooth bumps cut into four levels: wide plateaus whose texels walk the hierarchy together (the fast
+      // baker's blocks of 4x4 texels; 37 and 21 are not multiples of 4).
+      HeightField terraces = random_field(37, 21, mode, 11);
+      for (int y = 0; y < 21; ++y)
+        for (int x = 0; x < 37; ++x)
+          terraces.h[std::size_t(y * 37 + x)] =
+              std::floor(3.999 * (0.5 + 0.25 * std::sin(0.7 * x) + 0.25 * std::cos(0.45 * y))) / 3.0;
+      fields.push_back({"terraces 37x21" + suffix, terraces});
+    }
     fields.push_back({"high random 8" + suffix, random_field(8, 8, mode, 5, 0.9)});
     fields.push_back({"steps" + suffix, procedural_field(ProceduralPattern::Steps, std::min(16, max_size), 2, mode)});
     fields.push_back({"spikes" + suffix, procedural_field(ProceduralPattern::Spikes, std::min(16, max_size), 2, mode)});

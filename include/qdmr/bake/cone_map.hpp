@@ -61,8 +61,10 @@ const char* cone_kind_name(ConeKind kind);  // "conservative", "relaxed"
 
 // The fast baker: a depth-first walk of a max hierarchy over the heights (for relaxed: over the wall tops, per
 // direction of the step), nearest cells first, pruning every cell whose lower bound on the ratio (distance to the
-// cell / (cell max - h_p)) cannot narrow the current cone. Parallel over rows with oneTBB; the same bits for any
-// thread count. Throws qdmr::Error on empty fields and heights outside [0,1].
+// cell / (cell max - h_p)) cannot narrow the current cone. The texels of a 4x4 block that their 8-neighbours do
+// not settle walk together (one walk, each reached texel tried on each of them), starting from the minima the
+// previous block found. Parallel over rows of blocks with oneTBB; the same bits for any thread count. Throws
+// qdmr::Error on empty fields and heights outside [0,1].
 ConeMap bake_cone_map(const HeightField& field, ConeKind kind);
 
 // The most memory bake_cone_map allocates at once for a width x height field (its working grid of doubles, per
