@@ -9,6 +9,7 @@
 #include "io/input_file.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/core/error.hpp"
+#include "qdmr/core/warning.hpp"
 
 namespace qdmr {
 namespace {
@@ -59,9 +60,11 @@ bool read_float_cache(const std::filesystem::path& file, const FloatCacheId& id,
 void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id, std::span<const float> values) {
   const std::uint64_t limit = bake_cache_limit_bytes();
   if (sizeof(Header) + values.size_bytes() > limit) return;  // larger than the whole cache may be
+  // "FILE: cannot write bake cache: REASON", as an output's error would say, but a warning: the map was baked.
+  const auto not_written = [](const std::string& message) { warn(message + " (the map is baked again next time)"); };
   std::error_code ec;
   std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) return;
+  if (ec) return not_written(file.string() + ": cannot write bake cache: cannot create its folder: " + ec.message());
   Header header{};
   std::memcpy(header.magic, id.magic.data(), sizeof header.magic);
   header.version = id.version;
@@ -77,8 +80,8 @@ void write_float_cache(const std::filesystem::path& file, const FloatCacheId& id
       out.write(reinterpret_cast<const char*>(values.data()), std::streamsize(values.size() * sizeof(float)));
       return out.flush() ? "" : "write failed";
     });
-  } catch (const Error&) {
-    return;
+  } catch (const Error& e) {
+    return not_written(e.what());
   }
   trim_bake_cache(file.parent_path(), limit, file);
 }

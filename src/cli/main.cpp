@@ -535,6 +535,7 @@ int main(int argc, char** argv) {
   }
   qdmr::cli::stop_on_signals();
   qdmr::set_progress_sink(&steps);  // lines on a terminal only (logs and CI stay quiet)
+  qdmr::set_warning_sink(&steps);   // "qdmr: warning: ..." lines on stderr, terminal or not
   try {
     if (render_cmd->parsed()) return run_render(render_scene, render);
     if (plan_cmd->parsed()) return run_plan(plan_scene, plan_json);

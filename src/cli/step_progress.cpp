@@ -33,6 +33,14 @@ void StepProgress::finished(const void* step, const std::string& name, double se
   std::fflush(stderr);
 }
 
+void StepProgress::warn(const std::string& message) {
+  const std::lock_guard<std::mutex> guard(mutex_);
+  if (!warned_.insert(message).second) return;
+  // Over the progress line, if one is shown: the tick redraws it.
+  std::fprintf(stderr, "%sqdmr: warning: %s\n", shown_ ? "\r\033[K" : "", message.c_str());
+  std::fflush(stderr);
+}
+
 void StepProgress::tick() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!ending_) {

@@ -6,14 +6,17 @@
 
 #include <tbb/task_arena.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
 #include "bake/ao_pattern.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
+#include "support/captured_warnings.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -259,12 +262,19 @@ TEST(AoMap, KeyCoversWhatChangesTheMap) {
   EXPECT_NE(ao_map_key(f, 0.05, jittered), ao_map_key(f, 0.05, reseeded));
 }
 
-TEST(AoMap, UnwritableCacheStillBakes) {
+// As ConeMapCache.UnwritableCacheStillBakesAndSaysWhy: the map, and one warning naming the entry and the reason.
+TEST(AoMap, UnwritableCacheStillBakesAndSaysWhy) {
   TempDir dir;
   write_file(dir / "not-a-folder", "x");
   const HeightField f = random_field(8, 8, AddressMode::Wrap, 2);
   const AoDesc d = baked_desc(true);
+  CapturedWarnings warnings;
   EXPECT_EQ(load_or_bake_ao_map(f, 0.05, d, dir / "not-a-folder").texels, bake_ao_map(f, 0.05, d).texels);
+  const std::vector<std::string> lines = warnings.lines();
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].rfind((dir / "not-a-folder" / "ao-").string(), 0), 0u) << lines[0];
+  EXPECT_NE(lines[0].find(".bin: cannot write bake cache: cannot create its folder: " + std::string(std::strerror(ENOTDIR))),
+            std::string::npos) << lines[0];
 }
 
 }  // namespace

@@ -8,8 +8,10 @@
 #include <sys/stat.h>
 #include <tbb/task_arena.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <functional>
 #include <numbers>
@@ -22,6 +24,7 @@
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/image.hpp"
 #include "qdmr/texture/texture.hpp"
+#include "support/captured_warnings.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -481,12 +484,22 @@ TEST(ConeMapCache, MissThenHitThenCorruptFilesAreRebuilt) {
   EXPECT_EQ(count, 4u);
 }
 
-TEST(ConeMapCache, UnwritableCacheStillBakes) {
+// The cache is an optimisation: a folder that cannot be made still gives the map, and one warning names the entry
+// and the OS reason (the command prints it as "qdmr: warning: ..."; full and read-only mounts: faults.injection).
+TEST(ConeMapCache, UnwritableCacheStillBakesAndSaysWhy) {
   TempDir dir;
   write_file(dir / "not-a-folder", "x");
   const HeightField f = random_field(8, 8, AddressMode::Wrap, 2);
+  CapturedWarnings warnings;
   EXPECT_EQ(load_or_bake_cone_map(f, ConeKind::Conservative, dir / "not-a-folder").ratio,
             bake_cone_map(f, ConeKind::Conservative).ratio);
+  const std::vector<std::string> lines = warnings.lines();
+  ASSERT_EQ(lines.size(), 1u);
+  const std::string entry = (dir / "not-a-folder" / "cone-conservative-").string();  // then the key, ".bin"
+  EXPECT_EQ(lines[0].substr(0, entry.size()), entry) << lines[0];
+  const std::string why = std::string(".bin: cannot write bake cache: cannot create its folder: ") +
+                          std::strerror(ENOTDIR) + " (the map is baked again next time)";
+  EXPECT_TRUE(lines[0].ends_with(why)) << lines[0];
 }
 
 TEST(ConeMapCache, DefaultFolderFromTheEnvironment) {

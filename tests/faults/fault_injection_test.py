@@ -454,3 +454,21 @@ def test_every_writer_on_a_full_or_read_only_file_system(work, study, mounts, ki
         assert path in lines[-1] and reason in lines[-1], f"{name}: {lines[-1]}"
         assert "filesystem error" not in r.stderr and "Traceback" not in r.stderr, f"{name}: {r.stderr}"
         assert tree(folder) == before, f"{name}: the file system changed"
+
+
+@pytest.mark.parametrize("kind", ["full", "readonly"])
+def test_a_bake_cache_that_cannot_be_written_is_reported_and_the_render_succeeds(work, mounts, kind):
+    """The cache is an optimisation: the render succeeds (exit 0, its image written), and one warning line names
+    the entry and the OS reason; nothing on the mount changes."""
+    folder, reason = mounts[kind]
+    before = tree(folder)
+    out = os.path.join(work, f"cached-on-{kind}.png")
+    r = run(["render", cone_scene(work, 6), "--width", "64", "--height", "36", "-o", out], env=env(QDMR_CACHE_DIR=folder))
+    assert r.returncode == 0, r.stderr
+    assert os.path.isfile(out)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    assert lines[0].startswith("qdmr: warning: " + os.path.join(folder, "cone-relaxed-")), lines[0]
+    assert ".bin: cannot write bake cache: " in lines[0] and reason in lines[0], lines[0]
+    assert lines[0].endswith(" (the map is baked again next time)"), lines[0]
+    assert tree(folder) == before and not temporaries(folder)

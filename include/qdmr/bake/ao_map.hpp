@@ -44,7 +44,8 @@ std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoD
 // The cached map of (field, depth_scale, desc) from cache_dir (e.g. default_cache_dir() of cone_map.hpp), or
 // the bake, stored there through a temporary file and a rename. A cached file is used only if its header
 // (magic, version, key, size) and payload checksum match and every value lies in [0, 1]; anything else is
-// rebuilt and overwritten. A cache that cannot be written is skipped, not an error.
+// rebuilt and overwritten. A cache that cannot be written is not an error: a
+// warning (qdmr/core/warning.hpp) names the entry and the OS reason.
 Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
                           const std::filesystem::path& cache_dir);
 

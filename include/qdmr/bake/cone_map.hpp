@@ -84,7 +84,8 @@ std::uint64_t cone_map_key(const HeightField& field, ConeKind kind);
 
 // Returns the cached map of (field, kind) from cache_dir, or bakes it and stores it there (temporary file and
 // rename). A cached file is used only if its header (magic, version, key, size, kind) and payload checksum
-// match; anything else is rebuilt and overwritten. A cache that cannot be written is skipped, not an error.
+// match; anything else is rebuilt and overwritten. A cache that cannot be written is not an error: a
+// warning (qdmr/core/warning.hpp) names the entry and the OS reason.
 ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std::filesystem::path& cache_dir);
 
 // Writes the ratios as a one-channel 32-bit float EXR (row 0 at v = 0, i.e. the last row of the file) through a
