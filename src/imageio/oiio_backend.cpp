@@ -164,54 +164,77 @@ bool read(Reader* reader, PixelType type, void* first_row, std::ptrdiff_t row_st
 
 void close(Reader* reader) { delete reader; }
 
-// `bytes` into the existing file `path` (truncated), every write() and the close() checked: a full disk is an
-// error with its reason, never a short file.
-bool write_bytes(const std::string& path, const std::vector<unsigned char>& bytes, std::string& error) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
-  if (fd < 0) {
-    error = std::strerror(errno);
-    return false;
+// OpenEXR's bytes straight into the existing file `path` (truncated), every write checked: OpenEXR's own buffered
+// stream loses a failed final flush (a full disk gave a 0-byte "written" file), so writes go out unbuffered with
+// pwrite() and the first failure is kept with its OS reason (OpenEXR then fails the image too). No copy of the
+// encoded file is held in memory.
+class CheckedFileOutput final : public OIIO::Filesystem::IOProxy {
+public:
+  explicit CheckedFileOutput(const std::string& path)
+      : IOProxy(path, Write), fd_(::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC)) {
+    if (fd_ < 0) failure_ = errno;
   }
-  for (std::size_t done = 0; done < bytes.size();) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      error = n < 0 ? std::strerror(errno) : "short write";
-      ::close(fd);
-      return false;
+  ~CheckedFileOutput() override { close(); }
+  const char* proxytype() const override { return "qdmr_checked_file"; }
+  bool opened() const override { return fd_ >= 0; }
+  void close() override {
+    if (fd_ >= 0 && ::close(fd_) != 0 && failure_ == 0) failure_ = errno;
+    fd_ = -1;
+  }
+  size_t size() const override { return std::size_t(end_); }
+  size_t write(const void* buf, size_t size) override {
+    const std::size_t done = pwrite(buf, size, m_pos);
+    m_pos += std::int64_t(done);
+    return done;
+  }
+  size_t pwrite(const void* buf, size_t size, int64_t offset) override {
+    std::size_t done = 0;
+    while (fd_ >= 0 && failure_ == 0 && done < size) {
+      const ssize_t n = ::pwrite(fd_, static_cast<const char*>(buf) + done, size - done, offset + std::int64_t(done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) failure_ = n < 0 ? errno : ENOSPC;  // a write of 0 bytes: no room
+      if (n > 0) done += std::size_t(n);
     }
-    done += std::size_t(n);
+    end_ = std::max(end_, offset + std::int64_t(done));
+    return done;
   }
-  if (::close(fd) != 0) {
-    error = std::strerror(errno);
-    return false;
-  }
-  return true;
-}
+  int failure() const { return failure_; }  // the first OS error (errno), 0 for none
+
+private:
+  int fd_;
+  int failure_ = 0;
+  std::int64_t end_ = 0;
+};
 
 bool write(const std::string& path, const WriteSpec& spec, const void* data, std::string& error) {
   OIIO::ImageSpec s(spec.width, spec.height, spec.channels, type_desc(spec.type));
   if (!spec.channel_names.empty()) s.channelnames = spec.channel_names;
   for (const auto& [name, value] : spec.strings) s.attribute(name, value);
   for (const auto& [name, value] : spec.ints) s.attribute(name, value);
+  std::unique_ptr<CheckedFileOutput> checked;  // declared first: outlives `output`, which may use it to the end
   auto output = OIIO::ImageOutput::create(path);
   if (!output) {
     error = OIIO::geterror();
     return false;
   }
-  // OpenEXR files are encoded into memory and the bytes go to the file here: OpenEXR's buffered stream loses a
-  // failed final flush (a full disk gave a 0-byte "written" file). The TIFF and PNG writers report a full disk
-  // themselves (and TIFF through a memory proxy wrote unreadable files).
-  std::vector<unsigned char> encoded;
-  OIIO::Filesystem::IOVecOutput memory(encoded);
-  const bool in_memory = std::string_view(output->format_name()) == "openexr" && output->supports("ioproxy") &&
-                         output->set_ioproxy(&memory);
-  if (!(output->open(path, s) && output->write_image(type_desc(spec.type), data) && output->close())) {
+  // OpenEXR files go through CheckedFileOutput. The TIFF and PNG writers report a full disk themselves (and TIFF
+  // through a memory proxy wrote unreadable files).
+  if (std::string_view(output->format_name()) == "openexr" && output->supports("ioproxy")) {
+    checked = std::make_unique<CheckedFileOutput>(path);
+    if (!output->set_ioproxy(checked.get())) checked.reset();
+  }
+  const bool written = output->open(path, s) && output->write_image(type_desc(spec.type), data) && output->close();
+  if (checked) checked->close();
+  if (checked && checked->failure() != 0) {  // the OS's reason first: OpenEXR's own message does not say why
+    error = std::strerror(checked->failure());
+    return false;
+  }
+  if (!written) {
     error = output->geterror();
     if (error.empty()) error = "unknown error";
     return false;
   }
-  return !in_memory || write_bytes(path, encoded, error);
+  return true;
 }
 
 void color_map(const float* values, int width, int height, const char* map, float* rgb) {
