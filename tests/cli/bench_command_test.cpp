@@ -49,5 +49,30 @@ TEST(BenchCommand, ReportsTheTracesCostPerLaneIteration) {
   EXPECT_EQ(output.find("lane-iteration"), std::string::npos) << output;
 }
 
+// A dynamic scene's timed frames are warm frames of its sequence: each after set_frame's rebuild (frames 1, 2, ...
+// after the warm-up ones), with the rebuild and rebuild + draw reported; a still scene reports neither.
+TEST(BenchCommand, TimesWarmFramesOfADynamicScene) {
+  TempDir dir;
+  const std::string json = (dir / "water.json").string();
+  const CommandResult r =
+      run(cli(), {"bench", (source_dir() / "scenes" / "water.json").string(), "--width", "64", "--height", "36",
+                  "--frames", "3", "--warmup", "1", "--threads", "2", "--set",
+                  "/materials/water/layers/0/height/size=64", "--json", json, "--image",
+                  (dir / "water.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("sequence_frames"), nlohmann::json::array({2, 3, 4}));
+  EXPECT_EQ(j.at("rebuild_ms").at("frames").get<int>(), 3);
+  EXPECT_EQ(j.at("frame_ms").at("frames").get<int>(), 3);
+  EXPECT_GE(j.at("frame_ms").at("min").get<double>(), j.at("draw_ms").at("min").get<double>());
+  EXPECT_NE(r.output.find("frames of the animation (rebuild + draw)"), std::string::npos) << r.output;
+
+  std::string output;
+  const nlohmann::json still = bench(dir, "qdm", output);
+  EXPECT_FALSE(still.contains("rebuild_ms"));
+  EXPECT_FALSE(still.contains("sequence_frames"));
+}
+
 }  // namespace
 }  // namespace qdmr::test
