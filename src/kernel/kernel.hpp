@@ -1,7 +1,7 @@
 #pragma once
 // A kernel: the code of a frame that is compiled once per ISA (everything in src/kernel/, with that ISA's flags)
 // and chosen at run time. Everything else is baseline x86-64 and reaches a kernel only through this table: the
-// draw (programs, tiles) and preparation (the blend's box values, max/min mip chains), both with the Renderer's
+// draw (programs, tiles) and preparation (the blend's box values, max/min mip chains, baked AO), both with the Renderer's
 // kernel, so `--isa` holds for every stage of a frame.
 #include <atomic>
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include "program/inputs.hpp"
 #include "program/light_rig.hpp"
 #include "program/program.hpp"
+#include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
@@ -23,7 +24,7 @@ namespace qdmr {
 // so a call that reaches a kernel some other way still counts under the ISA that ran. Once per material, tile,
 // mip level or box-value table: relaxed atomics, no cost worth measuring.
 struct KernelCalls {
-  std::atomic<std::uint64_t> programs{0}, tiles{0}, mip_levels{0}, box_values{0};
+  std::atomic<std::uint64_t> programs{0}, tiles{0}, mip_levels{0}, box_values{0}, ao_rows{0};
 };
 
 class Kernel {
@@ -42,6 +43,8 @@ public:
   virtual void blend_box_values(const BlendBoxSource& source, float* out) const = 0;
   // Preparation: the max/min reduction of one mip level (MipReduce::Max / Min), for make_mip_texture.
   virtual MipExtremum mip_extremum() const = 0;
+  // Preparation: one row of a baked AO map (qdmr/bake/ao_map.hpp), for bake_ao_map.
+  virtual AoMapRow ao_map_row() const = 0;
   virtual const KernelCalls& calls() const = 0;
 };
 

@@ -6,6 +6,7 @@
 #include "kernel/normal_mapping.hpp"
 #include "kernel/preparation.hpp"
 #include "kernel/tile_raster.hpp"
+#include "kernel/ao_rows.hpp"
 #include "program/variant.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
@@ -38,6 +39,8 @@ public:
   }
 
   MipExtremum mip_extremum() const override { return &qdmr::QDMR_ISA::mip_extremum; }
+
+  AoMapRow ao_map_row() const override { return &qdmr::QDMR_ISA::ao_map_row; }
 
   const KernelCalls& calls() const override { return kernel_calls; }
 };

@@ -94,8 +94,9 @@ HeightField height_field(const Texture& h, AddressMode address) {
 }
 
 // An AO map from the bake cache, or baked every frame (and not kept) for a dynamic surface.
-Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic) {
-  return dynamic ? bake_ao_map(field, depth_scale, ao) : load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir());
+Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic, AoMapRow row) {
+  return dynamic ? bake_ao_map(field, depth_scale, ao, row)
+                 : load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir(), row);
 }
 
 // Items of the previous assets by key, to share instead of rebuild.
@@ -305,8 +306,8 @@ private:
         AoDesc ao = desc.ao;
         ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats
         ao.resolution = d.side;
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic), TexelFormat::R16,
-                          MipReduce::Box);
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic, kernel_.ao_map_row()),
+                          TexelFormat::R16, MipReduce::Box);
         break;
       }
       case DerivedKind::TwinTexels:
@@ -319,8 +320,8 @@ private:
         break;
       case DerivedKind::LayerAoMap:
         // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic), TexelFormat::R16,
-                          MipReduce::Box);
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic, kernel_.ao_map_row()),
+                          TexelFormat::R16, MipReduce::Box);
         break;
       case DerivedKind::ConeMap:
         // A dynamic surface's maps are baked every frame and never kept: the cache would fill with frames.

@@ -16,6 +16,8 @@
 #include "bake/ao_pattern.hpp"
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
+#include "kernel/kernel.hpp"
+#include "qdmr/core/isa.hpp"
 #include "support/captured_warnings.hpp"
 #include "support/test_support.hpp"
 
@@ -161,26 +163,34 @@ double defined_texel_ao(const HeightField& f, double ds, const AoDesc& d, int i,
 }
 
 TEST(AoMap, BakeIsTheDefinitionBitForBit) {
-  // Odd sizes (leftover pyramid cells), every address mode, jitter, a map of another size than the field, and
-  // depth scales from shallow to steep (most directions open, most closed); coarse with radii of 1 to 5 taps.
-  int cases = 0;
-  for (AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
-    for (bool coarse : {true, false})
-      for (double ds : {0.002, 0.05, 2.0})
-        for (float radius : {0.03f, 0.2f, 0.6f}) {
-          const HeightField f = random_field(37, 23, address, std::uint32_t(7 + cases));
-          AoDesc d = baked_desc(coarse);
-          d.radius = radius;
-          d.jitter = cases % 2 == 1;
-          d.resolution = cases % 3 == 0 ? 29 : 0;
-          const Image map = bake_ao_map(f, ds, d);
-          for (int j = 0; j < map.height; ++j)
-            for (int i = 0; i < map.width; ++i)
-              ASSERT_EQ(map.at(i, j, 0), float(defined_texel_ao(f, ds, d, i, j, map.width, map.height)))
-                  << "texel " << i << "," << j << " address " << int(address) << " coarse " << coarse << " ds " << ds
-                  << " radius " << radius;
-          ++cases;
-        }
+  // Odd sizes (leftover pyramid cells, rows that end in a part of a vector), every address mode, jitter, a map of
+  // another size than the field, and depth scales from shallow to steep (most directions open, most closed);
+  // coarse with radii of 1 to 5 taps. Then the lanes the vector bakes hand to the scalar definition: rises so
+  // small that they are compared tap by tap (depth scale 1e-300), taps a billion texels away (fine, radius 1e7).
+  // The scalar bake (no row function) and every kernel of this binary that this CPU runs bake them.
+  std::vector<std::pair<std::string, AoMapRow>> bakes = {{"scalar", nullptr}};
+  for (Isa isa : usable_isas()) bakes.emplace_back(isa_name(isa), kernel_for(isa).ao_map_row());
+  for (const auto& [name, row] : bakes) {
+    int cases = 0;
+    for (AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
+      for (bool coarse : {true, false})
+        for (double ds : {0.002, 0.05, 2.0, 1e-300})
+          for (float radius : {0.03f, 0.2f, 0.6f, 1e7f}) {
+            if (radius > 1.0f && coarse) continue;  // coarse taps stop at 2^30 texels
+            const HeightField f = random_field(37, 23, address, std::uint32_t(7 + cases));
+            AoDesc d = baked_desc(coarse);
+            d.radius = radius;
+            d.jitter = cases % 2 == 1;
+            d.resolution = cases % 3 == 0 ? 29 : 0;
+            const Image map = bake_ao_map(f, ds, d, row);
+            for (int j = 0; j < map.height; ++j)
+              for (int i = 0; i < map.width; ++i)
+                ASSERT_EQ(map.at(i, j, 0), float(defined_texel_ao(f, ds, d, i, j, map.width, map.height)))
+                    << name << " texel " << i << "," << j << " address " << int(address) << " coarse " << coarse
+                    << " ds " << ds << " radius " << radius;
+            ++cases;
+          }
+  }
 }
 
 fs::path only_file(const fs::path& dir) {

@@ -23,9 +23,17 @@
 
 namespace qdmr {
 
+namespace ao {
+struct Bake;  // what one texel reads (bake/ao_texel.hpp)
+}
+// Row j of a map (map width floats into row) by a kernel's vectors (Kernel::ao_map_row, which preparation passes
+// so that `--isa` holds there too). Every row function gives the definition's bits.
+using AoMapRow = void (*)(const ao::Bake& bake, int j, float* row);
+
 // A one-channel fp32 image, row 0 at v = 0. Parallel over rows with oneTBB; the same bits for any thread count.
-// Throws qdmr::Error on an empty field.
-Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc);
+// Rows run `row`; null: the definition texel by texel (scalar, baseline x86-64). Throws qdmr::Error on an empty
+// field.
+Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row = nullptr);
 
 struct AoMapSize {
   int width, height;
@@ -47,6 +55,6 @@ std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoD
 // rebuilt and overwritten. A cache that cannot be written is not an error: a
 // warning (qdmr/core/warning.hpp) names the entry and the OS reason.
 Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
-                          const std::filesystem::path& cache_dir);
+                          const std::filesystem::path& cache_dir, AoMapRow row = nullptr);
 
 }  // namespace qdmr

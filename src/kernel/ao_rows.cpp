@@ -1,0 +1,201 @@
+// One row of a baked AO map with this ISA's vectors: fp64 lanes across the row's texels (2, 4 or 8), every
+// operation the one the scalar definition (bake/ao_texel.hpp) performs on each lane, in its order, so each texel
+// gets the definition's bits. A batch falls back to the scalar definition, lane by lane, where the vector form
+// would differ: a tap texel index beyond +-2^31 (the definition converts to int64), a largest scaled rise below
+// ao::kSmallestScaledRise.
+#include "kernel/ao_rows.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "bake/ao_texel.hpp"
+#include "core/simd.hpp"
+#include "kernel/kernel_calls.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+namespace {
+
+using Double = xsimd::batch<double, simd::Arch>;
+using Int64 = xsimd::batch<std::int64_t, simd::Arch>;
+using DoubleMask = xsimd::batch_bool<double, simd::Arch>;
+constexpr int kWidth = int(Double::size);
+
+// The largest integer magnitude a tap's texel index takes in the vector form.
+constexpr double kIndexLimit = 0x1p31;
+
+// An exact non-negative integer below 2^52 as int64 lanes: its bits above 2^52's mantissa.
+Int64 to_index(const Double& x) {
+  return xsimd::bitwise_cast<Int64>(x + Double(0x1p52)) - xsimd::bitwise_cast<Int64>(Double(0x1p52));
+}
+
+// 2^-k, k = 0 .. 31: the scale of a max pyramid level's cells.
+constexpr std::array<double, 32> kCellScale = [] {
+  std::array<double, 32> scale{};
+  double s = 1.0;
+  for (double& e : scale) e = s, s *= 0.5;
+  return scale;
+}();
+
+// HeightField::texel_index on integer-valued lanes (|i| < 2^31): i - floor(i / n) n is i mod n exactly, since a
+// quotient i / n of magnitude below 2^31 rounds by less than its distance 1/n to the next integer.
+[[gnu::always_inline]] inline Double texel_index(const Double& i, double n, AddressMode mode) {
+  const DoubleMask inside = (i >= Double(0.0)) & (i < Double(n));
+  if (xsimd::all(inside)) return i;
+  Double wrapped;
+  switch (mode) {
+    case AddressMode::Wrap: wrapped = i - xsimd::floor(i / Double(n)) * Double(n); break;
+    case AddressMode::Clamp: wrapped = xsimd::min(xsimd::max(i, Double(0.0)), Double(n - 1.0)); break;
+    case AddressMode::Mirror: {
+      const Double m = i - xsimd::floor(i / Double(2.0 * n)) * Double(2.0 * n);
+      wrapped = xsimd::select(m < Double(n), m, Double(2.0 * n - 1.0) - m);
+      break;
+    }
+  }
+  return xsimd::select(inside, i, wrapped);
+}
+
+// std::max(a, b) lane by lane: b where a < b, else a.
+Double std_max(const Double& a, const Double& b) { return xsimd::select(a < b, b, a); }
+
+struct Lanes {
+  Double u, v;  // the texels' UV (v the same in every lane)
+  Double s;     // their surface depth
+};
+
+// bilinear_surface_depth on lanes; ok turns false when an index leaves the vector form's range.
+Double bilinear_depth(const ao::Bake& b, const Double& u, const Double& v, bool& ok) {
+  const HeightField& f = *b.field;
+  const Double x = u * Double(double(f.width)) - Double(0.5), y = v * Double(double(f.height)) - Double(0.5);
+  const Double fi = xsimd::floor(x), fj = xsimd::floor(y);
+  const Double fx = x - fi, fy = y - fj;
+  ok = ok && xsimd::all(xsimd::abs(fi) < Double(kIndexLimit - 1.0)) && xsimd::all(xsimd::abs(fj) < Double(kIndexLimit - 1.0));
+  if (!ok) return Double(0.0);
+  const double w = f.width, h = f.height;
+  const Double i0 = texel_index(fi, w, f.address), i1 = texel_index(fi + Double(1.0), w, f.address);
+  const Double r0 = texel_index(fj, h, f.address) * Double(w), r1 = texel_index(fj + Double(1.0), h, f.address) * Double(w);
+  const double* texels = f.h.data();
+  const Double h00 = Double::gather(texels, to_index(r0 + i0)), h10 = Double::gather(texels, to_index(r0 + i1));
+  const Double h01 = Double::gather(texels, to_index(r1 + i0)), h11 = Double::gather(texels, to_index(r1 + i1));
+  const Double height = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
+  return Double(b.depth_scale) * (Double(1.0) - height);
+}
+
+// The largest scaled rise of the coarse taps along (dx, dy) per lane (coarse_slope before its division). Without
+// jitter every lane of a row looks along the same direction from the same v: the taps' rows are found once
+// (dy_uniform), in scalar, by the definition's own code.
+Double coarse_rise(const ao::Bake& b, const Lanes& l, const Double& dx, const Double& dy, double v, const double* dy_uniform,
+                   bool& ok) {
+  const HeightField& f = *b.field;
+  const ao::MaxPyramid& p = *b.pyramid;
+  Double rise(0.0);
+  double scale = 1.0;
+  for (int k = 0; k < b.taps.count; ++k, scale *= 0.5) {
+    const ao::Tap& tap = b.taps.tap[std::size_t(k)];
+    const Double tu = l.u + dx * Double(double(tap.distance));
+    const Double fx = xsimd::floor(tu * Double(double(f.width)));
+    if (!xsimd::all(xsimd::abs(fx) < Double(kIndexLimit))) {
+      ok = false;
+      return rise;
+    }
+    const Double x = texel_index(fx, f.width, f.address);
+    const int level = std::min(tap.level, p.top());
+    const double cell = kCellScale[std::size_t(level)];  // x >> level on non-negative integers: floor(x 2^-level)
+    const double w = p.width[std::size_t(level)], h = p.height[std::size_t(level)];
+    const Double cx = xsimd::min(xsimd::floor(x * Double(cell)), Double(w - 1.0));
+    Double row_start;
+    if (dy_uniform) {
+      const double tv = v + *dy_uniform * double(tap.distance);
+      const auto y = HeightField::texel_index(std::int64_t(std::floor(tv * f.height)), f.height, f.address);
+      row_start = Double(double(std::min<std::int64_t>(y >> level, p.height[std::size_t(level)] - 1)) * w);
+    } else {
+      const Double fy = xsimd::floor((l.v + dy * Double(double(tap.distance))) * Double(double(f.height)));
+      if (!xsimd::all(xsimd::abs(fy) < Double(kIndexLimit))) {
+        ok = false;
+        return rise;
+      }
+      const Double y = texel_index(fy, f.height, f.address);
+      row_start = xsimd::min(xsimd::floor(y * Double(cell)), Double(h - 1.0)) * Double(w);
+    }
+    const Double max = Double::gather(p.level[std::size_t(level)], to_index(row_start + cx));
+    rise = std_max(rise, (l.s - Double(b.depth_scale) * (Double(1.0) - max)) * Double(scale));
+  }
+  return rise;
+}
+
+Double fine_slope(const ao::Bake& b, const Lanes& l, const Double& dx, const Double& dy, bool& ok) {
+  Double slope(0.0);
+  for (int k = 0; k < b.taps.count && ok; ++k) {
+    const ao::Tap& tap = b.taps.tap[std::size_t(k)];
+    const double distance = tap.distance;
+    const Double depth = bilinear_depth(b, l.u + dx * Double(distance), l.v + dy * Double(distance), ok);
+    slope = std_max(slope, (l.s - depth) / Double(distance));
+  }
+  return slope;
+}
+
+// The raw AO of kWidth texels from i0 on row j; false where the vector form does not hold (nothing written).
+bool batch_ao(const ao::Bake& b, int i0, int j, std::array<double, kWidth>& out) {
+  const int n = ao::direction_count(b.desc);
+  std::array<double, kWidth> u{};
+  std::array<int, kWidth> rotation{};
+  for (int lane = 0; lane < kWidth; ++lane) {
+    u[std::size_t(lane)] = ao::texel_u(b, i0 + lane);
+    rotation[std::size_t(lane)] =
+        b.desc.jitter ? ao::rotation(std::uint32_t(i0 + lane), std::uint32_t(j), b.desc.seed) : 0;
+  }
+  bool ok = true;
+  Lanes l{Double::load_unaligned(u.data()), Double(ao::texel_v(b, j)), Double(0.0)};
+  l.s = bilinear_depth(b, l.u, l.v, ok);
+  if (!ok) return false;
+  Double visible(0.0);
+  for (int d = 0; d < n; ++d) {
+    std::array<double, kWidth> dx{}, dy{};
+    for (int lane = 0; lane < kWidth; ++lane) {
+      const int index = ao::direction_index(n, d, rotation[std::size_t(lane)]);
+      dx[std::size_t(lane)] = ao::kDirections.cos[std::size_t(index)];
+      dy[std::size_t(lane)] = ao::kDirections.sin[std::size_t(index)];
+    }
+    const Double vdx = Double::load_unaligned(dx.data()), vdy = Double::load_unaligned(dy.data());
+    Double slope;
+    if (b.pyramid) {
+      const Double rise = coarse_rise(b, l, vdx, vdy, ao::texel_v(b, j), b.desc.jitter ? nullptr : &dy[0], ok);
+      if (!ok) return false;
+      slope = rise / Double(double(b.taps.tap[0].distance));
+      const DoubleMask by_tap = (rise != Double(0.0)) & (rise < Double(ao::kSmallestScaledRise));
+      if (xsimd::any(by_tap)) {  // tiny rises: the definition tap by tap, in those lanes
+        std::array<double, kWidth> s{}, slopes{};
+        l.s.store_unaligned(s.data());
+        slope.store_unaligned(slopes.data());
+        for (int lane = 0; lane < kWidth; ++lane)
+          if (by_tap.get(std::size_t(lane)))
+            slopes[std::size_t(lane)] = ao::coarse_slope_by_tap(b, s[std::size_t(lane)], u[std::size_t(lane)], ao::texel_v(b, j),
+                                                                dx[std::size_t(lane)], dy[std::size_t(lane)]);
+        slope = Double::load_unaligned(slopes.data());
+      }
+    } else {
+      slope = fine_slope(b, l, vdx, vdy, ok);
+      if (!ok) return false;
+    }
+    visible += Double(1.0) - slope / xsimd::sqrt(Double(1.0) + slope * slope);
+  }
+  (visible / Double(double(n))).store_unaligned(out.data());
+  return true;
+}
+
+}  // namespace
+
+void ao_map_row(const ao::Bake& bake, int j, float* row) {
+  kernel_calls.ao_rows.fetch_add(1, std::memory_order_relaxed);
+  int i = 0;
+  std::array<double, kWidth> ao{};
+  for (; i + kWidth <= bake.map_width; i += kWidth) {
+    if (batch_ao(bake, i, j, ao))
+      for (int lane = 0; lane < kWidth; ++lane) row[i + lane] = float(ao[std::size_t(lane)]);
+    else
+      for (int lane = 0; lane < kWidth; ++lane) row[i + lane] = float(ao::texel_ao(bake, i + lane, j));
+  }
+  for (; i < bake.map_width; ++i) row[i] = float(ao::texel_ao(bake, i, j));
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

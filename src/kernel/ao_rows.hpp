@@ -1,0 +1,12 @@
+#pragma once
+// A row of a baked AO map with this ISA's vectors (qdmr/bake/ao_map.hpp's definition, the same bits as
+// bake/ao_texel.hpp's scalar form): Kernel::ao_map_row.
+#include "bake/ao_texel.hpp"
+#include "core/isa_namespace.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+
+// Texels 0 .. bake.map_width - 1 of row j into row.
+void ao_map_row(const ao::Bake& bake, int j, float* row);
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE
