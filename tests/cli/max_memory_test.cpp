@@ -152,23 +152,13 @@ TEST(MaxMemory, ConeBakeEstimate) {
   EXPECT_EQ(cone_bake_bytes(16384, 16384, ConeKind::Conservative, AddressMode::Clamp), conservative);
 }
 
-// prepare() bakes through the cache: a fresh one while this lives, so bakes run and the user's cache is left alone.
-struct CacheDir {
-  std::optional<std::string> saved;
-  explicit CacheDir(const std::filesystem::path& dir) {
-    if (const char* old = std::getenv("QDMR_CACHE_DIR")) saved = old;
-    ::setenv("QDMR_CACHE_DIR", dir.c_str(), 1);
-  }
-  ~CacheDir() { saved ? ::setenv("QDMR_CACHE_DIR", saved->c_str(), 1) : ::unsetenv("QDMR_CACHE_DIR"); }
-};
-
 // The render's plan counts the cone baker's working memory: for every cone kind and address mode, the cone map item
 // keeps its map and needs cone_bake_bytes less the map on top while it is baked, computed from the field prepare
 // really hands the baker (its size and address mode); the plan's total adds it. Before, the plan counted only the
 // map: a relaxed mirror bake peaked about 7 times above the estimate --max-memory was checked against.
 TEST(MaxMemory, ThePlanCountsTheConeBakersWorkingMemory) {
   TempDir dir;
-  const CacheDir cache(dir / "cache");
+  const ScopedCacheDir cache(dir / "cache");
   std::string pgm = "P5\n48 32\n255\n";  // not square, so width and height cannot be swapped unnoticed
   for (int k = 0; k < 48 * 32; ++k) pgm += char(k * 37 % 251);
   write_file(dir / "h.pgm", pgm);
@@ -351,7 +341,7 @@ TEST(MaxMemory, ConeBakeEstimateCoversTheBakersPeak) {
 // as the baker does (the resolution wide, the heights' aspect kept: 64x32 heights at resolution 32 give 32x16).
 TEST(MaxMemory, ThePlanCountsTheAoBakersWorkingMemory) {
   TempDir dir;
-  const CacheDir cache(dir / "cache");
+  const ScopedCacheDir cache(dir / "cache");
   std::string pgm = "P5\n64 32\n255\n";
   for (int k = 0; k < 64 * 32; ++k) pgm += char(k * 37 % 251);
   write_file(dir / "h.pgm", pgm);

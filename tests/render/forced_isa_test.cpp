@@ -10,6 +10,7 @@
 #include "kernel/kernel.hpp"
 #include "qdmr/render/render.hpp"
 #include "support/frames.hpp"
+#include "support/test_support.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -42,6 +43,8 @@ TEST(ForcedIsa, Sse42RunsNoWiderKernelInAnyStage) {
       overrides.push_back({"/materials/blend/layers/" + std::to_string(layer) + "/" + map + "/size", "64"});
   const SceneDesc scene = small_scene("surface_blend_4layers", overrides, 64, 36);
 
+  const TempDir dir;
+  const ScopedCacheDir cache(dir / "cache");  // the AO map is baked, not read from an earlier run's cache
   const std::map<Isa, Counts> before = counts();
   RenderOptions options;
   options.isa = Isa::Sse42;

@@ -11,6 +11,7 @@
 #include <chrono>
 
 #include <array>
+#include <cstdlib>
 #include <atomic>
 #include <cstdio>
 #include <fstream>
@@ -36,6 +37,13 @@ TempDir::~TempDir() {
   std::error_code ec;
   std::filesystem::remove_all(path_, ec);
 }
+
+ScopedCacheDir::ScopedCacheDir(const std::filesystem::path& dir) {
+  if (const char* old = std::getenv("QDMR_CACHE_DIR")) saved_ = old;
+  ::setenv("QDMR_CACHE_DIR", dir.c_str(), 1);
+}
+
+ScopedCacheDir::~ScopedCacheDir() { saved_ ? ::setenv("QDMR_CACHE_DIR", saved_->c_str(), 1) : ::unsetenv("QDMR_CACHE_DIR"); }
 
 CommandResult run(const std::filesystem::path& program, const std::vector<std::string>& args) {
   int fds[2];

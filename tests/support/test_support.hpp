@@ -2,6 +2,7 @@
 // Helpers shared by the tests: paths of the repo, the data folder and the built command, and running it.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,19 @@ public:
 
 private:
   std::filesystem::path path_;
+};
+
+// Points the bake cache (QDMR_CACHE_DIR) at `dir` while it lives, then restores the variable: bakes run, and the
+// user's cache is left alone.
+class ScopedCacheDir {
+public:
+  explicit ScopedCacheDir(const std::filesystem::path& dir);
+  ~ScopedCacheDir();
+  ScopedCacheDir(const ScopedCacheDir&) = delete;
+  ScopedCacheDir& operator=(const ScopedCacheDir&) = delete;
+
+private:
+  std::optional<std::string> saved_;
 };
 
 struct CommandResult {
