@@ -1,6 +1,6 @@
 // Ambient occlusion cost: the per-frame horizon AO (kernel/ambient_occlusion.hpp) per pixel for each mode, and the
-// baked map (bake_ao_map) per texel, 1 and 2 threads. A plain timing program: every case runs --reps times and
-// the median is printed as a markdown row.
+// baked map (bake_ao_map) per texel, 1 and 2 threads, its rows by the scalar definition and by each kernel. A plain
+// timing program: every case runs --reps times and the median is printed as a markdown row.
 //   qdmr_ao_bench [--size 512] [--pixels 512] [--reps 5] [--no-bake]
 // Frame: a pixels x pixels grid of points over one repeat of a --size noise height map (R16, bilinear fetch),
 // one thread. The point depth s is the surface depth at the point (as after a converged intersection).
@@ -11,9 +11,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "kernel/kernel.hpp"
 #include "qdmr/bake/ao_map.hpp"
+#include "qdmr/core/isa.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture.hpp"
 #include "kernel/ambient_occlusion.hpp"
@@ -118,19 +121,24 @@ int main(int argc, char** argv) {
   field.width = heights.width;
   field.height = heights.height;
   field.h.assign(heights.texels.begin(), heights.texels.end());
-  std::printf("\nbaked AO map, %d² noise, depth scale %g, 8 directions, median of %d\n\n", size, double(ds), reps);
-  std::printf("| mode | radius (texels) | threads | seconds | ns / texel |\n|---|---|---|---|---|\n");
+  std::printf("\nbaked AO map, %d² noise, depth scale %g, 8 directions, median of %d; rows by the scalar definition "
+              "and by each kernel this CPU runs (the same bits)\n\n",
+              size, double(ds), reps);
+  std::printf("| rows | mode | radius (texels) | threads | seconds | ns / texel |\n|---|---|---|---|---|---|\n");
+  std::vector<std::pair<std::string, qdmr::AoMapRow>> bakes = {{"scalar", nullptr}};
+  for (qdmr::Isa isa : qdmr::usable_isas()) bakes.emplace_back(qdmr::isa_name(isa), qdmr::kernel_for(isa).ao_map_row());
   for (bool coarse : {true, false})
-    for (int threads : {1, 2}) {
-      qdmr::AoDesc d;
-      d.mode = qdmr::AoMode::Baked;
-      d.coarse = coarse;
-      d.radius = 64.0f / float(size);
-      const double seconds =
-          time_median(reps, [&] { tbb::task_arena(threads).execute([&] { (void)qdmr::bake_ao_map(field, ds, d); }); });
-      std::printf("| %s | 64 | %d | %.3f | %.1f |\n", coarse ? "coarse" : "fine", threads, seconds,
-                  1e9 * seconds / double(field.h.size()));
-      std::fflush(stdout);
-    }
+    for (const auto& [name, row] : bakes)
+      for (int threads : {1, 2}) {
+        qdmr::AoDesc d;
+        d.mode = qdmr::AoMode::Baked;
+        d.coarse = coarse;
+        d.radius = 64.0f / float(size);
+        const double seconds = time_median(
+            reps, [&] { tbb::task_arena(threads).execute([&] { (void)qdmr::bake_ao_map(field, ds, d, row); }); });
+        std::printf("| %s | %s | 64 | %d | %.3f | %.1f |\n", name.c_str(), coarse ? "coarse" : "fine", threads, seconds,
+                    1e9 * seconds / double(field.h.size()));
+        std::fflush(stdout);
+      }
   return 0;
 }
