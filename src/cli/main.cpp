@@ -177,7 +177,15 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   qdmr::check_outputs(all_outputs({animated ? 0 : -1}));
 
   auto start = Clock::now();
-  const qdmr::SceneDesc scene = qdmr::load_scene(args.scene, overrides(args, &render));
+  const qdmr::SceneDesc scene = [&] {
+    try {  // a glTF mesh's drawn copies are held to the limit before they are read
+      return qdmr::load_scene(args.scene, overrides(args, &render), options.max_memory_bytes);
+    } catch (const qdmr::Error& e) {
+      const std::string what = e.what();
+      if (what.find("MiB, more than the limit of") == std::string::npos) throw;
+      throw qdmr::Error(what + max_memory_source(render.max_memory_mib));
+    }
+  }();
   const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   const std::vector<int> frames = frames_to_render(render, scene);
   const std::vector<qdmr::OutputPath> paths = all_outputs(frames);

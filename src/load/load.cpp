@@ -23,7 +23,7 @@ namespace {
 // the entry of the object's `mtl` (OBJ) or `materials` (glTF) block named after it applied (`document`: the scene
 // after --set). `standalone`: the scene was made for a glTF file rendered on its own, whose messages name it.
 void resolve_file_meshes(SceneDesc& scene, const nlohmann::json& document, const scene_detail::Context& context,
-                         bool standalone = false) {
+                         std::uint64_t max_memory_bytes, bool standalone = false) {
   const std::string file = scene.file.string();
   const scene_detail::Value objects(context, document.at("objects"), "/objects");
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
@@ -31,7 +31,7 @@ void resolve_file_meshes(SceneDesc& scene, const nlohmann::json& document, const
     if (object.mesh.kind != MeshKind::Obj && object.mesh.kind != MeshKind::Gltf) continue;
     const bool gltf = object.mesh.kind == MeshKind::Gltf;
     const std::string where = standalone ? std::string() : file + ": /objects/" + std::to_string(i) + "/mesh";
-    auto mesh = std::make_shared<MeshData>(build_mesh(object.mesh, where));
+    auto mesh = std::make_shared<MeshData>(build_mesh(object.mesh, where, max_memory_bytes));
     if (object.material.empty()) {
       if (mesh->materials.empty())
         throw Error(file + ": /objects/" + std::to_string(i) + "/material", "required (the mesh has no MTL materials)");
@@ -94,13 +94,14 @@ bool is_gltf_file(const std::filesystem::path& file) {
 
 // A glTF asset rendered without a scene file: one object drawing its default scene, the default lights, and the
 // asset's first camera or one framing it (unless --set gives a camera). Overrides reach /objects/0/materials.
-SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
+SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides,
+                          std::uint64_t max_memory_bytes) {
   nlohmann::json document = {
       {"objects", {{{"name", file.stem().string()}, {"mesh", {{"type", "gltf"}, {"file", file.filename().string()}}}}}}};
   const scene_detail::Context context{file.string(), file.parent_path()};
   if (!overrides.empty()) scene_detail::apply_overrides(document, overrides, context.file);
   SceneDesc scene = scene_detail::validate_scene(document, context);
-  resolve_file_meshes(scene, document, context, true);
+  resolve_file_meshes(scene, document, context, max_memory_bytes, true);
   if (!document.contains("camera") && !scene.objects.empty() && scene.objects[0].obj_mesh) {
     const MeshData& mesh = *scene.objects[0].obj_mesh;
     scene.camera = mesh.cameras.empty() ? framing_camera(mesh) : mesh.cameras.front();
@@ -110,24 +111,26 @@ SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<S
 
 }  // namespace
 
-SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
-  if (is_gltf_file(file)) return load_gltf_asset(file, overrides);
+SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides,
+                     std::uint64_t max_memory_bytes) {
+  if (is_gltf_file(file)) return load_gltf_asset(file, overrides, max_memory_bytes);
   const nlohmann::json document = scene_detail::parse_json_file(file, InputKind::Scene);
-  return load_scene_json(document, file, file.parent_path(), overrides);
+  return load_scene_json(document, file, file.parent_path(), overrides, max_memory_bytes);
 }
 
 SceneDesc load_scene_json(const nlohmann::json& document, const std::filesystem::path& name,
-                          const std::filesystem::path& base_dir, const std::vector<SceneOverride>& overrides) {
+                          const std::filesystem::path& base_dir, const std::vector<SceneOverride>& overrides,
+                          std::uint64_t max_memory_bytes) {
   const scene_detail::Context context{name.string(), base_dir};
   if (overrides.empty()) {
     SceneDesc scene = scene_detail::validate_scene(document, context);
-    resolve_file_meshes(scene, document, context);
+    resolve_file_meshes(scene, document, context, max_memory_bytes);
     return scene;
   }
   nlohmann::json overridden = document;
   scene_detail::apply_overrides(overridden, overrides, context.file);
   SceneDesc scene = scene_detail::validate_scene(overridden, context);
-  resolve_file_meshes(scene, overridden, context);
+  resolve_file_meshes(scene, overridden, context, max_memory_bytes);
   return scene;
 }
 

@@ -17,7 +17,7 @@ MeshData make_grid(const MeshDesc& desc, const std::string& where);
 MeshData load_obj(const MeshDesc& desc, const std::string& where);
 // A glTF 2.0 asset (mesh/gltf.cpp); `where` names the field as for load_obj, empty when the asset is the job's
 // input itself (`qdmr render model.glb`): messages then start with the asset's file.
-MeshData load_gltf(const MeshDesc& desc, const std::string& where);
+MeshData load_gltf(const MeshDesc& desc, const std::string& where, std::uint64_t max_memory_bytes = 0);
 
 // Throws when `triangles` exceeds limits::kMaxTriangles.
 void check_triangle_count(std::uint64_t triangles, const std::string& where);

@@ -22,6 +22,7 @@
 #include "io/input_file.hpp"
 #include "mesh/builders.hpp"
 #include "mesh/gltf_files.hpp"
+#include "mesh/mikktspace.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/error.hpp"
@@ -342,8 +343,10 @@ AddressMode address_of(int wrap) {
 // Turns the asset into one MeshData: every primitive of the drawn nodes, in qdmr's frame.
 class Builder {
 public:
-  Builder(const tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where)
-      : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, where_) {}
+  Builder(const tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where,
+          std::uint64_t max_memory_bytes)
+      : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, where_),
+        max_memory_bytes_(max_memory_bytes) {}
 
   MeshData build(const MeshDesc& desc) {
     check_nodes();
@@ -405,7 +408,7 @@ private:
 
   // A mesh drawn by several nodes is copied for each: the copies' size, from the accessors' counts (each at most
   // the bytes of its buffer view: a count that lies is refused later, by name), is bounded before anything is read,
-  // by the triangle limit and by the machine's memory.
+  // by the triangle limit, by the memory limit (--max-memory) and by the machine's memory.
   void check_drawn_size(const std::vector<int>& roots) const {
     const auto count = [&](int accessor) -> std::uint64_t {
       if (accessor < 0 || std::size_t(accessor) >= model_.accessors.size()) return 0;
@@ -431,9 +434,14 @@ private:
         throw Error(where_, "the drawn nodes hold more than " + std::to_string(limits::kMaxTriangles) +
                                 " triangles (a mesh drawn by several nodes counts for each)");
     }
-    // position, normal, tangent, uv per vertex; an index per corner and a material per triangle, doubled for the
-    // copies made while reading
-    const std::uint64_t bytes = 2 * (vertices * (3 + 3 + 4 + 2) * sizeof(float) + corners * 2 * sizeof(std::uint32_t));
+    // As the plan counts a mesh: position, normal, tangent, uv per vertex; three indices and a material per triangle.
+    const std::uint64_t mesh_bytes = vertices * (3 + 3 + 4 + 2) * sizeof(float) + corners / 3 * 4 * sizeof(std::uint32_t);
+    const auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
+    if (max_memory_bytes_ > 0 && mesh_bytes > max_memory_bytes_)
+      throw Error(where_, "the drawn meshes (a mesh drawn by several nodes once per node) take " + mib(mesh_bytes) +
+                              " MiB, more than the limit of " + std::to_string(max_memory_bytes_ >> 20) + " MiB");
+    // Doubled for the copies made while reading.
+    const std::uint64_t bytes = 2 * mesh_bytes;
     const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
     if (pages > 0 && page > 0 && bytes > std::uint64_t(pages) * std::uint64_t(page))
       throw Error(where_, "the drawn meshes need " + std::to_string(bytes >> 20) +
@@ -571,7 +579,7 @@ private:
       };
       const int position_accessor = attribute("POSITION");
       if (position_accessor < 0) asset_.fail(at + "/attributes", "no POSITION");
-      const std::vector<float> positions = asset_.floats(position_accessor, at + "/attributes/POSITION", TINYGLTF_TYPE_VEC3, false);
+      std::vector<float> positions = asset_.floats(position_accessor, at + "/attributes/POSITION", TINYGLTF_TYPE_VEC3, false);
       const std::size_t count = positions.size() / 3;
       const auto same_count = [&](const std::vector<float>& values, int components, const char* name) {
         if (values.size() / std::size_t(components) != count)
@@ -610,8 +618,8 @@ private:
       }
       std::vector<std::uint32_t> triangles = triangle_list(std::move(corners), prim.mode, at);
       check_triangle_count(mesh_.indices.size() / 3 + triangles.size() / 3, where_);
-      append(positions, normals, tangents, uvs, uv_choice, std::move(triangles), world, normal_matrix, mirrored,
-             std::uint32_t(slot));
+      append(std::move(positions), std::move(normals), std::move(tangents), std::move(uvs), uv_choice, std::move(triangles),
+             world, normal_matrix, mirrored, std::uint32_t(slot));
     }
   }
 
@@ -635,15 +643,17 @@ private:
     return out;
   }
 
-  void append(const std::vector<float>& positions, const std::vector<float>& normals, const std::vector<float>& tangents,
-              const std::vector<float>& uvs, const TextureChoice& uv_choice, std::vector<std::uint32_t> triangles,
-              const glm::dmat4& world, const glm::dmat3& normal_matrix, bool mirrored, std::uint32_t material) {
+  // The attributes as read, each freed once it is converted, so that a large primitive is not held twice.
+  void append(std::vector<float> positions, std::vector<float> normals, std::vector<float> tangents, std::vector<float> uvs,
+              const TextureChoice& uv_choice, std::vector<std::uint32_t> triangles, const glm::dmat4& world,
+              const glm::dmat3& normal_matrix, bool mirrored, std::uint32_t material) {
     // Without normals each triangle gets its own corners, flat-shaded (glTF 2.0, "Meshes").
     const bool flat = normals.empty();
     MeshData part;
     const std::size_t count = positions.size() / 3;
-    const auto vertex = [&](std::size_t v) {
-      part.positions.emplace_back(world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0));
+    // qdmr's UVs: the texture transform, then v up.
+    std::vector<glm::vec2> uv_of(count);
+    for (std::size_t v = 0; v < count; ++v) {
       glm::dvec2 uv(0.0);
       if (!uvs.empty()) uv = glm::dvec2(uvs[2 * v], uvs[2 * v + 1]);
       uv *= uv_choice.scale;
@@ -652,25 +662,16 @@ private:
         uv = glm::dvec2(c * uv.x - s * uv.y, s * uv.x + c * uv.y);
       }
       uv += uv_choice.offset;
-      part.uvs.emplace_back(float(uv.x), float(1.0 - uv.y));  // glTF's v runs down the image, qdmr's up
-      if (flat) return;
-      glm::dvec3 n = normal_matrix * glm::dvec3(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
-      const double len = glm::length(n);
-      part.normals.emplace_back(len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1));
-      if (tangents.empty()) return;
-      const glm::dvec3 t = glm::dmat3(world) * glm::dvec3(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2]);
-      const double tl = glm::length(t);
-      const float w = (tangents[4 * v + 3] < 0.0f) != mirrored ? -1.0f : 1.0f;
-      part.tangents.emplace_back(tl > 0.0 && std::isfinite(tl) ? glm::vec3(t / tl) : any_orthogonal(part.normals.back()), w);
+      uv_of[v] = glm::vec2(float(uv.x), float(1.0 - uv.y));  // glTF's v runs down the image, qdmr's up
+    }
+    std::vector<float>().swap(uvs);
+    const auto position = [&](std::size_t v) {
+      return glm::vec3(world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0));
     };
-    const std::size_t vertices = flat ? triangles.size() : count;
-    part.positions.reserve(vertices);
-    part.normals.reserve(vertices);
-    part.uvs.reserve(vertices);
-    if (!tangents.empty()) part.tangents.reserve(vertices);
     if (flat) {
       for (std::size_t k = 0; k < triangles.size(); ++k) {
-        vertex(triangles[k]);
+        part.positions.push_back(position(triangles[k]));
+        part.uvs.push_back(uv_of[triangles[k]]);
         part.indices.push_back(std::uint32_t(k));
       }
       for (std::size_t k = 0; k < triangles.size(); k += 3) {
@@ -680,14 +681,44 @@ private:
         const glm::vec3 n = len > 0.0 && std::isfinite(len) ? glm::vec3(face / len) : glm::vec3(0, 0, 1);
         part.normals.insert(part.normals.end(), {n, n, n});
       }
-    } else {
-      for (std::size_t v = 0; v < count; ++v) vertex(v);
-      part.indices = std::move(triangles);
-    }
-    if (part.tangents.size() != part.positions.size()) {
-      part.tangents.clear();
+      // Each corner its own vertex: the per-triangle tangent (what MikkTSpace gives a corner alone), from qdmr's
+      // generator.
       compute_tangents(part);
-      if (has_textures_) note("tangents generated (a primitive has no TANGENT; not MikkTSpace: see docs/scene-format.md)");
+      if (has_textures_) note("tangents generated per flat triangle (a primitive has no NORMAL nor TANGENT)");
+    } else {
+      // Missing tangents: MikkTSpace's, in the mesh's own space as glTF defines them, then transformed as given ones
+      // are. A vertex on a mirrored UV seam is split: copies_of[k] is vertex count + k.
+      MikkTSpaceTangents made;
+      if (tangents.empty()) {
+        made = mikktspace_tangents(positions, normals, uv_of, triangles);
+        if (has_textures_) note("tangents generated (a primitive has no TANGENT; MikkTSpace's essentials: see docs/scene-format.md)");
+      }
+      const std::vector<std::uint32_t>& copies = made.copies_of;
+      const std::size_t vertices = count + copies.size();
+      const auto source = [&](std::size_t v) { return v < count ? v : copies[v - count]; };
+      part.positions.reserve(vertices);
+      for (std::size_t v = 0; v < vertices; ++v) part.positions.push_back(position(source(v)));
+      std::vector<float>().swap(positions);
+      part.normals.reserve(vertices);
+      for (std::size_t v = 0; v < vertices; ++v) {
+        const std::size_t s = source(v);
+        const glm::dvec3 n = normal_matrix * glm::dvec3(normals[3 * s], normals[3 * s + 1], normals[3 * s + 2]);
+        const double len = glm::length(n);
+        part.normals.push_back(len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1));
+      }
+      std::vector<float>().swap(normals);
+      for (const std::uint32_t s : copies) uv_of.push_back(uv_of[s]);
+      part.uvs = std::move(uv_of);
+      part.tangents.reserve(vertices);
+      for (std::size_t v = 0; v < vertices; ++v) {
+        const glm::vec4 t = made.tangents.empty() ? glm::vec4(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2], tangents[4 * v + 3])
+                                                  : made.tangents[v];
+        const glm::dvec3 tw = glm::dmat3(world) * glm::dvec3(t);
+        const double tl = glm::length(tw);
+        const float w = (t.w < 0.0f) != mirrored ? -1.0f : 1.0f;
+        part.tangents.emplace_back(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(part.normals[v]), w);
+      }
+      part.indices = std::move(triangles);
     }
     if (mesh_.positions.empty()) {  // the first primitive (often the only one): moved, not copied
       mesh_.positions = std::move(part.positions);
@@ -802,10 +833,10 @@ private:
     m.lighting.roughness = float(std::clamp(roughness, 0.02, 1.0));
     m.lighting.specular = float(f0);
     if (pbr.baseColorTexture.index >= 0) {
+      // The diffuse colour: the texture times baseColorFactor, less what the metal reflects specularly.
       layer.albedo = texture(pbr.baseColorTexture.index, at + "/pbrMetallicRoughness/baseColorTexture", true);
-      if (color != std::vector<double>{1, 1, 1, 1})
-        note("material '" + m.name + "': baseColorFactor not applied over its baseColorTexture");
-      if (metallic > 0.0) note("material '" + m.name + "': metallic surfaces with a baseColorTexture keep their diffuse colour");
+      layer.albedo.factor = glm::vec3(float(color[0] * (1.0 - metallic)), float(color[1] * (1.0 - metallic)),
+                                      float(color[2] * (1.0 - metallic)));
       const int sampler = model_.textures[std::size_t(pbr.baseColorTexture.index)].sampler;
       if (sampler >= 0) {
         if (std::size_t(sampler) >= model_.samplers.size())
@@ -852,6 +883,7 @@ private:
   std::vector<MaterialDesc> materials_;
   std::vector<TextureChoice> uv_choices_;
   std::map<int, fs::path> image_files_;
+  std::uint64_t max_memory_bytes_ = 0;
   int default_material_ = -1;
   bool has_textures_ = false;
   std::vector<std::pair<std::string, int>> notes_;
@@ -900,7 +932,7 @@ std::vector<std::string> prescan(const std::string& json_text, Reading& reading)
 
 }  // namespace
 
-MeshData load_gltf(const MeshDesc& desc, const std::string& where) {
+MeshData load_gltf(const MeshDesc& desc, const std::string& where, std::uint64_t max_memory_bytes) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
   std::string bytes = read_input_file(file, where, InputKind::Gltf);
   Reading reading;
@@ -930,7 +962,7 @@ MeshData load_gltf(const MeshDesc& desc, const std::string& where) {
     if (first.empty()) first = "tinygltf could not read the asset";
     throw Error(reading.where, first);
   }
-  MeshData mesh = Builder(model, reading, file, reading.where).build(desc);
+  MeshData mesh = Builder(model, reading, file, reading.where, max_memory_bytes).build(desc);
   notes.insert(notes.end(), mesh.notes.begin(), mesh.notes.end());
   mesh.notes = std::move(notes);
   return mesh;

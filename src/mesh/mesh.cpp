@@ -46,7 +46,7 @@ void check_size(const MeshDesc& desc, bool both, const std::string& where) {
 
 }  // namespace
 
-MeshData build_mesh(const MeshDesc& desc, const std::string& where) {
+MeshData build_mesh(const MeshDesc& desc, const std::string& where, std::uint64_t max_memory_bytes) {
   if (!std::isfinite(desc.uv_scale.x) || !std::isfinite(desc.uv_scale.y) || desc.uv_scale.x == 0.0f ||
       desc.uv_scale.y == 0.0f)
     throw Error(where + "/uv_scale", "both components must be finite and non-zero");
@@ -76,7 +76,7 @@ MeshData build_mesh(const MeshDesc& desc, const std::string& where) {
     case MeshKind::Obj:
       return mesh_detail::load_obj(desc, where + "/file");
     case MeshKind::Gltf:
-      return mesh_detail::load_gltf(desc, where.empty() ? where : where + "/file");
+      return mesh_detail::load_gltf(desc, where.empty() ? where : where + "/file", max_memory_bytes);
   }
   throw Error(where, "unknown mesh kind");
 }

@@ -63,6 +63,9 @@ std::string request_key(const TextureDesc& d, TexturePurpose purpose, const Laye
   if (purpose == TexturePurpose::Albedo && d.source == TextureSource::Procedural)
     k << ":low" << d.color_low.x << "," << d.color_low.y << "," << d.color_low.z << ":high" << d.color_high.x << ","
       << d.color_high.y << "," << d.color_high.z << ":var" << d.variation;
+  // Only a factor other than 1 is in the key: the keys of untinted files stay as they were.
+  if (purpose == TexturePurpose::Albedo && d.source == TextureSource::File && d.factor != glm::vec3(1.0f))
+    k << ":factor" << d.factor.x << "," << d.factor.y << "," << d.factor.z;
   if (purpose == TexturePurpose::Normal)
     k << ":conv" << int(layer.normal_convention) << ":strength" << layer.normal_strength;
   // What is made from the layer's heights (a procedural albedo is coloured by its own pattern, not by them).

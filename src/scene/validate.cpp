@@ -1,6 +1,7 @@
 #include "scene/validate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -181,7 +182,7 @@ void read_height_storage(const Object& object, TextureDesc& texture) {
 }
 
 void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
-  const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb"})
+  const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb", "factor"})
                         : slot == Slot::Height ? Object(value, {"file", "channel", "format", "compression"})
                                                : Object(value, {"file"});
   texture.source = TextureSource::File;
@@ -197,6 +198,7 @@ void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
                "a height reads one channel: r, g, b or a");
   }
   if (auto v = object.find("srgb")) texture.srgb = v->boolean();
+  if (auto v = object.find("factor")) texture.factor = v->color();
   if (slot == Slot::Height) read_height_storage(object, texture);
 }
 
@@ -682,15 +684,17 @@ ObjectDesc read_object(const Value& value, std::size_t index, const std::vector<
 
 namespace {
 
-// The keys an override of an MTL or a glTF material shares, applied after the kind's own keys; `no_height` is
-// the message when a displacement technique is asked of a material without a height.
-void read_material_override(const Object& object, MaterialDesc& material, const std::string& no_height) {
+// The keys an override of an MTL or a glTF material shares, applied after the kind's own keys: the layer's from
+// `layer_keys` (the override itself, or a glTF override's layers[0]), the rest from `object`; `no_height` is the
+// message when a displacement technique is asked of a material without a height.
+void read_material_override(const Object& object, const Object& layer_keys, MaterialDesc& material,
+                            const std::string& no_height) {
   LayerDesc& layer = material.layers.front();
-  if (auto v = object.find("normal_convention"))
+  if (auto v = layer_keys.find("normal_convention"))
     layer.normal_convention = v->choice<NormalConvention>({{"gl", NormalConvention::GL}, {"dx", NormalConvention::DX}});
-  if (auto v = object.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
-  if (auto v = object.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
-  if (auto v = object.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
+  if (auto v = layer_keys.find("normal_strength")) layer.normal_strength = static_cast<float>(v->non_negative());
+  if (auto v = layer_keys.find("height_scale")) layer.height_scale = static_cast<float>(v->number());
+  if (auto v = layer_keys.find("height_offset")) layer.height_offset = static_cast<float>(v->number());
   if (auto v = object.find("technique")) read_technique(*v, material.technique);
   if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);
   if (auto v = object.find("lighting")) read_lighting(*v, material.lighting);
@@ -703,16 +707,33 @@ void read_material_override(const Object& object, MaterialDesc& material, const 
 
 }  // namespace
 
+// A glTF material's override has the form of a scene material: its one layer's keys in `layers[0]`. The same
+// keys beside `technique` are a shorthand for them (one form or the other, not both).
 void read_gltf_override(const Value& value, MaterialDesc& material) {
-  const Object object(value, {"technique", "sampling", "lighting", "shadow", "ao", "height", "normal_strength",
+  const std::array<std::string_view, 5> layer_key_names = {"height", "height_scale", "height_offset",
+                                                            "normal_strength", "normal_convention"};
+  const Object object(value, {"technique", "sampling", "lighting", "shadow", "ao", "layers", "height", "normal_strength",
                               "normal_convention", "height_scale", "height_offset"});
+  std::vector<Value> layers;
+  if (auto v = object.find("layers")) {
+    v->expect_type(json::value_t::array, "an array of one layer (a glTF material has one)");
+    layers = v->array();
+    v->require(layers.size() == 1, "a glTF material has one layer: 'layers' takes one element, not " +
+                                       std::to_string(layers.size()));
+    for (const std::string_view key : layer_key_names)
+      if (auto flat = object.find(key))
+        flat->fail("give '" + std::string(key) + "' in 'layers'[0] or beside 'technique', not both");
+  }
+  const Object layer_keys =
+      layers.empty() ? object
+                     : Object(layers.front(), {"height", "height_scale", "height_offset", "normal_strength", "normal_convention"});
   LayerDesc& layer = material.layers.front();
-  if (auto v = object.find("height")) {
+  if (auto v = layer_keys.find("height")) {
     layer.height = read_texture(*v, Slot::Height);
     if (layer.normal.source == TextureSource::None) layer.normal.source = TextureSource::FromHeight;  // a normalTexture wins
   }
-  read_material_override(object, material,
-                         "a displacement technique needs a height: give this glTF material one with 'height'");
+  read_material_override(object, layer_keys, material,
+                         "a displacement technique needs a height: give this glTF material one in 'layers'[0].height");
 }
 
 void read_mtl_override(const Value& value, MaterialDesc& material, const std::filesystem::path& bump) {
@@ -730,7 +751,7 @@ void read_mtl_override(const Value& value, MaterialDesc& material, const std::fi
       }
     }
   }
-  read_material_override(object, material,
+  read_material_override(object, object, material,
                          "a displacement technique needs a height: this MTL material has no disp map, and no bump map "
                          "read as a height");
 }

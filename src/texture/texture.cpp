@@ -123,6 +123,11 @@ Image albedo_texture(const TextureDesc& desc, const std::string& where) {
           }
         });
       }
+      if (desc.factor != glm::vec3(1.0f))
+        for_rows(rgb.height, [&](int y) {
+          float* row = &rgb.at(0, y, 0);
+          for (int i = 0; i < rgb.width * 3; ++i) row[i] *= desc.factor[i % 3];
+        });
       return rgb;
     }
     case TextureSource::Procedural: {

@@ -534,7 +534,11 @@ shutil.copy(os.path.join(GLTF_ASSETS, "quad.glb"), os.path.join(FILES, "gltf/qua
 case("gltf_unknown_material", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"chekcer": {}}}'),
      "/objects/0/materials/chekcer: unknown glTF material 'chekcer'; did you mean 'checker'?")
 case("gltf_displaced_without_height", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"technique": {"name": "qdm"}}}}'),
-     "a displacement technique needs a height: give this glTF material one with 'height'")
+     "a displacement technique needs a height: give this glTF material one in 'layers'[0].height")
+case("gltf_override_both_forms", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"height": "gltf/quad.glb", "layers": [{}]}}}'),
+     "/objects/0/materials/checker/height: give 'height' in 'layers'[0] or beside 'technique', not both")
+case("gltf_override_two_layers", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"layers": [{}, {}]}}}'),
+     "/objects/0/materials/checker/layers: a glTF material has one layer: 'layers' takes one element, not 2")
 case("gltf_unknown_node", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb", "node": "qaud"}}'),
      "the asset has no node named 'qaud'; did you mean 'quad'?")
 case("gltf_plan_points", ["plan", "{in}/gltf/points.gltf"], "points cannot be drawn")

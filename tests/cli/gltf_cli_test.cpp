@@ -4,6 +4,7 @@
 // mesh, materials and the warnings of what is ignored.
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -17,21 +18,46 @@ std::filesystem::path gltf_dir() { return source_dir() / "tests/gltf"; }
 
 CommandResult qdmr(std::vector<std::string> args) { return run(cli(), args); }
 
+// The quad as OBJ + MTL and as glTF; and a glTF material with baseColorFactor over its texture and metal
+// (quad_tinted_gltf) against the OBJ quad with the qdmr material it maps to (quad_tinted_obj: albedo factor,
+// Cook-Torrance F0 and roughness, written by make_assets.py).
 TEST(CliGltf, TheSameQuadAsObjAndAsGltfRendersTheSameBits) {
   TempDir dir;
-  for (const char* name : {"quad_obj", "quad_gltf"}) {
-    const CommandResult r = qdmr({"render", (gltf_dir() / (std::string(name) + ".json")).string(), "-o",
-                                  (dir / (std::string(name) + ".exr")).string(), "--aov",
-                                  "normal=" + (dir / (std::string(name) + "_n.exr")).string(), "--aov",
-                                  "uv=" + (dir / (std::string(name) + "_uv.exr")).string()});
-    ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const auto& [obj_scene, gltf_scene] : {std::pair{"quad_obj", "quad_gltf"}, std::pair{"quad_tinted_obj", "quad_tinted_gltf"}}) {
+    for (const std::string name : {obj_scene, gltf_scene}) {
+      const CommandResult r = qdmr({"render", (gltf_dir() / (name + ".json")).string(), "-o", (dir / (name + ".exr")).string(),
+                                    "--aov", "normal=" + (dir / (name + "_n.exr")).string(), "--aov",
+                                    "uv=" + (dir / (name + "_uv.exr")).string()});
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    for (const char* suffix : {".exr", "_n.exr", "_uv.exr"}) {
+      const std::string obj = read_file(dir / (obj_scene + std::string(suffix)));
+      const std::string gltf = read_file(dir / (gltf_scene + std::string(suffix)));
+      EXPECT_FALSE(obj.empty());
+      EXPECT_TRUE(obj == gltf) << gltf_scene << suffix << ": the OBJ and the glTF quad differ";
+    }
   }
-  for (const char* suffix : {".exr", "_n.exr", "_uv.exr"}) {
-    const std::string obj = read_file(dir / ("quad_obj" + std::string(suffix)));
-    const std::string gltf = read_file(dir / ("quad_gltf" + std::string(suffix)));
-    EXPECT_FALSE(obj.empty());
-    EXPECT_TRUE(obj == gltf) << suffix << ": the OBJ and the glTF quad differ";
+  // The tint shows: the tinted quad is not the plain one.
+  EXPECT_NE(read_file(dir / "quad_gltf.exr"), read_file(dir / "quad_tinted_gltf.exr"));
+}
+
+// golden.gltf_assets checks what its name says: every asset make_assets.py writes that qdmr draws (sparse.gltf
+// is refused: Gltf.SparseAccessorsAreRefused), on its own, and every scene of tests/gltf, is one of its checks;
+// and its checks render under every draw kernel ("isa": "all").
+TEST(CliGltf, TheGoldenManifestChecksEveryAssetAndScene) {
+  const nlohmann::json manifest = nlohmann::json::parse(read_file(source_dir() / "tests/golden/gltf_assets.json"));
+  std::set<std::string> checked;
+  for (const auto& check : manifest["checks"]) checked.insert(check["scene"].get<std::string>());
+  EXPECT_EQ(manifest["defaults"]["variants"], nlohmann::json::parse(R"([{"isa": "all"}])"));
+  std::vector<std::string> expected;
+  for (const auto& entry : std::filesystem::directory_iterator(gltf_dir() / "assets")) {
+    const std::string name = entry.path().filename().string(), ext = entry.path().extension().string();
+    if ((ext == ".gltf" || ext == ".glb") && name != "sparse.gltf") expected.push_back("../gltf/assets/" + name);
   }
+  for (const auto& entry : std::filesystem::directory_iterator(gltf_dir()))
+    if (entry.path().extension() == ".json") expected.push_back("../gltf/" + entry.path().filename().string());
+  EXPECT_GE(expected.size(), 12u);
+  for (const std::string& scene : expected) EXPECT_TRUE(checked.count(scene)) << scene << " is not checked";
 }
 
 TEST(CliGltf, AGltfMaterialDisplacedFromTheSceneMarches) {
@@ -50,6 +76,57 @@ TEST(CliGltf, AGltfMaterialDisplacedFromTheSceneMarches) {
                                    "/objects/0/materials/bricks/technique/name=normal"});
   ASSERT_EQ(flat.exit_code, 0) << flat.output;
   EXPECT_EQ(nlohmann::json::parse(read_file(dir / "stats_flat.json"))["iterations"]["max"].get<double>(), 0.0);
+}
+
+// The override in the documented form (layers[0].height, displaced_layers.json) renders the bits of the shorthand
+// (displaced.json: golden.gltf_assets gives both one hash); --set reaches layers[0]; mixing the forms, a second
+// layer or a key a glTF override has not is one error line naming it, exit 2, nothing written.
+TEST(CliGltf, TheOverridesLayerIsSetAndItsMistakesAreNamed) {
+  TempDir dir;
+  const std::string scene = (gltf_dir() / "displaced_layers.json").string();
+  const auto render = [&](const std::string& out, std::vector<std::string> sets) {
+    std::vector<std::string> args = {"render", scene, "-o", (dir / out).string()};
+    for (const std::string& s : sets) args.insert(args.end(), {"--set", s});
+    return qdmr(args);
+  };
+  ASSERT_EQ(render("a.png", {}).exit_code, 0);
+  const CommandResult halved = render("b.png", {"/objects/0/materials/bricks/layers/0/height_scale=0.5"});
+  ASSERT_EQ(halved.exit_code, 0) << halved.output;
+  EXPECT_NE(read_file(dir / "a.png"), read_file(dir / "b.png"));  // half the relief: another image
+  const std::string at = scene + ": /objects/0/materials/bricks";
+  const std::vector<std::pair<std::string, std::string>> mistakes = {
+      {"/objects/0/materials/bricks/height=assets/wall_height.png",
+       at + "/height: give 'height' in 'layers'[0] or beside 'technique', not both"},
+      {"/objects/0/materials/bricks/layers/-={}", at + "/layers: a glTF material has one layer: 'layers' takes one element, not 2"},
+      {"/objects/0/materials/bricks/layers/0/albedo=a.png", at + "/layers/0: unknown key 'albedo'"},
+  };
+  for (const auto& [set, error] : mistakes) {
+    const CommandResult r = render("c.png", {set});
+    EXPECT_EQ(r.exit_code, 2) << set;
+    EXPECT_NE(r.output.find(error), std::string::npos) << set << "\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "c.png")) << set;
+  }
+}
+
+// --max-memory reaches the glTF reader: 5000 nodes drawing the quad (1.07 MiB of drawn copies) are refused under
+// 1 MiB when the scene is loaded, before they are read (tests/mesh/gltf_test.cpp counts them).
+TEST(CliGltf, MaxMemoryBoundsTheDrawnCopies) {
+  TempDir dir;
+  for (const char* f : {"quad.bin", "checker.png"}) std::filesystem::copy_file(gltf_dir() / "assets" / f, dir / f);
+  nlohmann::json doc = nlohmann::json::parse(read_file(gltf_dir() / "assets/quad.gltf"));
+  doc["nodes"] = nlohmann::json::array({{{"children", nlohmann::json::array()}}});
+  for (int n = 1; n <= 5000; ++n) {
+    doc["nodes"].push_back({{"mesh", 0}});
+    doc["nodes"][0]["children"].push_back(n);
+  }
+  write_file(dir / "many.gltf", doc.dump());
+  const CommandResult r = qdmr({"render", (dir / "many.gltf").string(), "-o", (dir / "x.png").string(), "--max-memory", "1"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("the drawn meshes (a mesh drawn by several nodes once per node) take 2 MiB, more than the "
+                          "limit of 1 MiB (--max-memory)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
 }
 
 TEST(CliGltf, AnAssetRendersWithoutASceneFile) {

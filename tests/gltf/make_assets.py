@@ -5,6 +5,9 @@ tests/golden/gltf_assets.json and the expectations of tests/mesh/gltf_test.cpp a
 
   quad.gltf + quad.bin + checker.png   a textured quad (external buffer and image), the same quad as quad.obj + quad.mtl
   quad_embedded.gltf                   the same asset with its buffer and image as data: URIs
+  quad_tinted.gltf                     the quad with a baseColorFactor over its texture, and metal; ../quad_tinted_gltf.json
+                                       draws it, ../quad_tinted_obj.json the OBJ quad with the qdmr material it maps to
+                                       (albedo file x factor, Cook-Torrance F0 and roughness): the same bits
   quad.glb                             the same asset as one .glb: the buffer in the BIN chunk, the image in a buffer view
   hierarchy.gltf                       a node hierarchy (TRS with a quaternion, a matrix, a scale) and a camera node
   indices.gltf                         four quads: 8-, 16-, 32-bit indices and none; normals left out of the last (flat)
@@ -185,6 +188,33 @@ def quad_assets():
     write("quad.mtl", "newmtl checker\nKd 1 1 1\nmap_Kd checker.png\n")
 
 
+def tinted_assets():
+    """The quad's material with baseColorFactor over the texture and metallicFactor 0.5, and the same quad as OBJ
+    with the scene material glTF's maps to: albedo factor = baseColorFactor x (1 - metallic), F0 = 0.04 +
+    (luminance(baseColorFactor) - 0.04) x metallic (the double Python and C++ both compute, printed exactly)."""
+    factor, metallic, roughness = [0.8, 0.6, 0.4], 0.5, 0.6
+    buf = Buffer()
+    prim = quad_primitive(buf)
+    material = {"name": "tinted", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "baseColorFactor": factor + [1.0],
+                                                           "metallicFactor": metallic, "roughnessFactor": roughness}}
+    extra = {"scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "quad"}],
+             "meshes": [{"name": "quad", "primitives": [prim]}], "materials": [material],
+             "textures": [{"source": 0}], "images": [{"uri": "checker.png"}]}
+    write("quad_tinted.gltf", text(document(buf, extra, "quad.bin")))
+    f0 = 0.04 + (0.2126 * factor[0] + 0.7152 * factor[1] + 0.0722 * factor[2] - 0.04) * metallic
+    view = {"output": {"width": 160, "height": 90},
+            "camera": {"position": [0.4, -2.2, 1.4], "target": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 50}}
+    gltf_scene = dict(view, comment="assets/quad_tinted.gltf; quad_tinted_obj.json gives the same bits (make_assets.py)",
+                      objects=[{"name": "quad", "mesh": {"type": "gltf", "file": "assets/quad_tinted.gltf"}}])
+    obj_scene = dict(view, comment="The OBJ quad with the material quad_tinted.gltf's maps to (make_assets.py)",
+                     materials={"tinted": {"layers": [{"albedo": {"file": "assets/checker.png",
+                                                                  "factor": [c * (1 - metallic) for c in factor]}}],
+                                           "lighting": {"model": "cook_torrance", "specular": f0, "roughness": roughness}}},
+                     objects=[{"name": "quad", "mesh": {"type": "obj", "file": "assets/quad.obj"}, "material": "tinted"}])
+    write("quad_tinted_gltf.json", text(gltf_scene), HERE)
+    write("quad_tinted_obj.json", text(obj_scene), HERE)
+
+
 def colour(name, rgb):
     return {"name": name, "pbrMetallicRoughness": {"baseColorFactor": rgb + [1.0], "metallicFactor": 0.0,
                                                    "roughnessFactor": 0.5}}
@@ -274,6 +304,7 @@ def fuzz_seeds():
 
 
 quad_assets()
+tinted_assets()
 hierarchy_asset()
 indices_asset()
 sparse_asset()

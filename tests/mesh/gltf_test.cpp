@@ -204,6 +204,22 @@ TEST(Gltf, TextureTransformSamplerAndFactors) {
   EXPECT_TRUE(has_note(metal, "emission not drawn"));
 }
 
+// Over a base colour texture, baseColorFactor x (1 - metallic) multiplies the texture's linear colour (the
+// texture build applies it: TextureImage.AlbedoFactorMultipliesTheLinearColour), and nothing is left unapplied.
+TEST(Gltf, BaseColorFactorTintsTheTexture) {
+  using J = nlohmann::json;
+  const MeshData tinted = edited([](J& d) {
+    d["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.25, 1.0, 1.0};
+    d["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 0.5;
+  });
+  const TextureDesc& albedo = tinted.materials[0].layers[0].albedo;
+  EXPECT_EQ(albedo.source, TextureSource::File);
+  EXPECT_EQ(albedo.factor, glm::vec3(0.25f, 0.125f, 0.5f));  // exact: halves of exact binary fractions
+  EXPECT_FALSE(has_note(tinted, "baseColorFactor"));
+  EXPECT_FALSE(has_note(tinted, "metallic"));
+  EXPECT_EQ(load(asset("quad.gltf")).materials[0].layers[0].albedo.factor, glm::vec3(1.0f));
+}
+
 TEST(Gltf, EachBadElementIsNamed) {
   using J = nlohmann::json;
   const auto has = [](const std::string& error, const std::string& part) {
@@ -269,6 +285,35 @@ TEST(Gltf, EachBadElementIsNamed) {
                   "the drawn nodes hold more than 268435456 triangles"));
   // An image that is not one.
   EXPECT_TRUE(has(edited_error([](J& d) { d["images"][0]["uri"] = "quad.bin"; }), "quad.bin"));
+}
+
+// --max-memory bounds a mesh's drawn copies, counted per drawing node before anything is read: the quad (4
+// vertices, 2 triangles: 4 x 48 + 2 x 16 = 224 bytes as the plan counts a mesh) drawn by 5000 nodes takes 1.07 MiB.
+TEST(Gltf, InstancesAreCountedAgainstTheMemoryLimit) {
+  using J = nlohmann::json;
+  test::TempDir dir;
+  fs::copy_file(asset("quad.bin"), dir / "quad.bin");
+  fs::copy_file(asset("checker.png"), dir / "checker.png");
+  J doc = J::parse(test::read_file(asset("quad.gltf")));
+  J root = {{"children", J::array()}}, nodes = J::array({root});
+  for (int n = 1; n <= 5000; ++n) {
+    nodes.push_back({{"mesh", 0}, {"translation", {3.0 * n, 0.0, 0.0}}});
+    nodes[0]["children"].push_back(n);
+  }
+  doc["nodes"] = nodes;
+  test::write_file(dir / "quad.gltf", doc.dump());
+  MeshDesc desc;
+  desc.kind = MeshKind::Gltf;
+  desc.file = dir / "quad.gltf";
+  try {
+    mesh_detail::load_gltf(desc, "s.json: /objects/0/mesh/file", std::uint64_t(1) << 20);
+    ADD_FAILURE() << "5000 quads were read under 1 MiB";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("take 2 MiB, more than the limit of 1 MiB"), std::string::npos) << e.what();
+  }
+  const MeshData fits = mesh_detail::load_gltf(desc, "s.json: /objects/0/mesh/file", std::uint64_t(2) << 20);
+  EXPECT_EQ(fits.triangle_count(), 10000u);
+  EXPECT_EQ(fits.vertex_count(), 20000u);
 }
 
 std::string glb_error(std::string bytes) {

@@ -308,6 +308,20 @@ TEST(TextureImage, AlbedoFromFileDecodesAndSelects) {
   EXPECT_THROW(make_texture(d, TexturePurpose::Albedo, layer, nullptr, "t"), Error);
 }
 
+// An albedo file's factor (glTF's baseColorFactor) multiplies each decoded linear channel.
+TEST(TextureImage, AlbedoFactorMultipliesTheLinearColour) {
+  test::TempDir dir;
+  write_png(dir / "a.png", 16, 16, 3, ramp8());
+  TextureDesc d;
+  d.source = TextureSource::File;
+  d.file = dir / "a.png";
+  const Image plain = make_texture(d, TexturePurpose::Albedo, LayerDesc{}, nullptr, "t");
+  d.factor = glm::vec3(0.5f, 0.25f, 0.8f);
+  const Image tinted = make_texture(d, TexturePurpose::Albedo, LayerDesc{}, nullptr, "t");
+  ASSERT_EQ(tinted.texels.size(), plain.texels.size());
+  for (std::size_t i = 0; i < plain.texels.size(); ++i) ASSERT_EQ(tinted.texels[i], plain.texels[i] * d.factor[int(i % 3)]);
+}
+
 TEST(TextureImage, HeightChannelScaleOffset) {
   test::TempDir dir;
   write_png(dir / "a.png", 16, 16, 3, ramp8());

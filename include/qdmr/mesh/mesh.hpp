@@ -42,7 +42,8 @@ struct MeshData {
 // norm -> normal map (else normals from the height), paths made absolute against the MTL file's folder; faces
 // without a material use an appended constant white "default" material. glTF: see mesh/gltf.cpp and
 // docs/scene-format.md ("glTF 2.0 assets").
-MeshData build_mesh(const MeshDesc& desc, const std::string& where);
+// max_memory_bytes (0: none) bounds a glTF mesh's drawn copies before they are read (load_scene).
+MeshData build_mesh(const MeshDesc& desc, const std::string& where, std::uint64_t max_memory_bytes = 0);
 
 // Per-vertex tangent frames from positions, normals and UVs (accumulated per triangle, Gram-Schmidt
 // orthogonalised). Vertices whose UVs give no direction get any tangent orthogonal to the normal.

@@ -104,6 +104,7 @@ struct TextureDesc {
   std::filesystem::path file;        // absolute after loading (resolved against the scene file)
   Channel channel = Channel::Default;
   bool srgb = true;                  // albedo files only
+  glm::vec3 factor{1.0f, 1.0f, 1.0f}; // albedo files only: multiplies the linear colour (glTF's baseColorFactor)
   ProceduralDesc procedural;
   glm::vec4 constant{1.0f, 1.0f, 1.0f, 1.0f};
   glm::vec3 color_low{0.25f, 0.22f, 0.2f};   // procedural albedo: colour at height 0

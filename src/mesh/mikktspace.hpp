@@ -1,0 +1,37 @@
+#pragma once
+// Tangents the way glTF 2.0 asks for them when an asset has none: MikkTSpace (Morten Mikkelsen's reference
+// implementation, mikktspace.c, as Blender and the glTF tools use it). Debian packages no MikkTSpace library, so
+// its essentials are written here (a packaged library should do this; docs/scene-format.md says what differs):
+//   - per triangle, the direction of +u (dP/du) from its UV derivatives, and its UV orientation (the sign of the
+//     UV area); triangles whose UV area is zero are degenerate and take their vertices' result;
+//   - per corner, that direction projected onto the plane of the corner's normal and normalised, weighted by the
+//     corner's angle (between its two edges projected onto that plane);
+//   - vertices identified by their attributes (position, normal, UV equal), not by their index, as mikktspace.c
+//     does, and their corners grouped by UV orientation: the corners of one vertex and one orientation share one
+//     tangent (the normalised sum), w = +1 where the UV orientation is preserved, -1 where it is mirrored;
+//   - a vertex used by corners of both orientations (a mirrored UV seam) is split: the mirrored corners get a copy.
+// Not done: mikktspace.c's grouping by edge-connected fans (corners of one vertex and orientation that are not
+// connected through shared edges share a tangent here) and its angular split threshold (off by default there too).
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace qdmr::mesh_detail {
+
+struct MikkTSpaceTangents {
+  std::vector<glm::vec4> tangents;        // per vertex, then per appended copy: xyz unit, w = +-1
+  std::vector<std::uint32_t> copies_of;   // per appended copy, the vertex it copies
+};
+
+// positions and normals: 3 floats per vertex (normals need not be unit length), uvs one per vertex (qdmr's: v up),
+// `indices` 3 per triangle, rewritten where a corner moves to a copy of its vertex.
+MikkTSpaceTangents mikktspace_tangents(const std::vector<float>& positions, const std::vector<float>& normals,
+                                       const std::vector<glm::vec2>& uvs, std::vector<std::uint32_t>& indices);
+
+// acos from +, *, / and sqrt only (Cephes' asinf polynomial, in double): the same bits on every machine, where
+// libm's acos may take an FMA variant on some CPUs. Accurate to about 1e-7; x is clamped to [-1, 1].
+double deterministic_acos(double x);
+
+}  // namespace qdmr::mesh_detail
