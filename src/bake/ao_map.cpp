@@ -81,17 +81,29 @@ std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& des
 }
 
 Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row) {
+  if (field.width <= 0 || field.height <= 0) throw Error("ao map", "empty or inconsistent height field");
+  const AoMapSize size = map_size(field, desc);
+  Image map(size.width, size.height, 1);
+  bake_ao_rows(field, depth_scale, desc, map, 0, 1, row);
+  return map;
+}
+
+void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
+                  AoMapRow row) {
   if (field.width <= 0 || field.height <= 0 || field.h.size() != std::size_t(field.width) * std::size_t(field.height))
     throw Error("ao map", "empty or inconsistent height field");
   const AoMapSize size = map_size(field, desc);
+  if (map.width != size.width || map.height != size.height || map.channels != 1 || step < 1 || first < 0)
+    throw Error("ao map", "bake_ao_rows: the map or the rows do not fit the bake");
   const std::optional<ao::MaxPyramid> pyramid = desc.coarse ? std::optional<ao::MaxPyramid>(field) : std::nullopt;
   const ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, desc, ao::make_taps(desc, field.width, field.height),
                       size.width, size.height};
-  Image map(size.width, size.height, 1);
-  ProgressStep step("AO map " + std::to_string(size.width) + "x" + std::to_string(size.height), size.height);
-  tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& rows) {
-    step.advance();  // stops here when asked to (Ctrl-C)
-    for (int j = rows.begin(); j < rows.end(); ++j) {
+  const int count = first < size.height ? (size.height - first + step - 1) / step : 0;
+  ProgressStep progress("AO map " + std::to_string(size.width) + "x" + std::to_string(size.height), count);
+  tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& rows) {
+    progress.advance();  // stops here when asked to (Ctrl-C)
+    for (int r = rows.begin(); r < rows.end(); ++r) {
+      const int j = first + r * step;
       float* out = &map.texels[std::size_t(j) * std::size_t(size.width)];
       if (row) {
         row(bake, j, out);
@@ -99,9 +111,8 @@ Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& de
         for (int i = 0; i < size.width; ++i) out[i] = float(ao::texel_ao(bake, i, j));
       }
     }
-    step.advance(rows.size());
+    progress.advance(rows.size());
   });
-  return map;
 }
 
 std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {

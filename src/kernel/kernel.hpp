@@ -15,6 +15,7 @@
 #include "qdmr/core/isa.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
+#include "qdmr/texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "raster/raster_context.hpp"
 
@@ -45,6 +46,8 @@ public:
   virtual MipExtremum mip_extremum() const = 0;
   // Preparation: one row of a baked AO map (qdmr/bake/ao_map.hpp), for bake_ao_map.
   virtual AoMapRow ao_map_row() const = 0;
+  // Preparation: the rows of a dynamic height's rebuild (texture/height_family.hpp).
+  virtual const HeightRows& height_rows() const = 0;
   virtual const KernelCalls& calls() const = 0;
 };
 

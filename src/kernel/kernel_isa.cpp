@@ -42,6 +42,8 @@ public:
 
   AoMapRow ao_map_row() const override { return &qdmr::QDMR_ISA::ao_map_row; }
 
+  const HeightRows& height_rows() const override { return qdmr::QDMR_ISA::height_rows(); }
+
   const KernelCalls& calls() const override { return kernel_calls; }
 };
 

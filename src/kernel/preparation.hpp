@@ -1,10 +1,11 @@
 #pragma once
-// The per-ISA work of preparation, behind Kernel::blend_box_values and Kernel::mip_extremum.
+// The per-ISA work of preparation, behind Kernel::blend_box_values, Kernel::mip_extremum and Kernel::height_rows.
 #include <cstdint>
 
 #include "core/isa_namespace.hpp"
 #include "qdmr/texture/blend_box_values.hpp"
 #include "qdmr/texture/format.hpp"
+#include "qdmr/texture/height_rows.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -15,5 +16,8 @@ void blend_box_values(const BlendBoxSource& source, float* out);
 // A MipExtremum (qdmr/texture/mip_texture.hpp) on this kernel's vectors (kernel/mip_reduce.cpp).
 void mip_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out,
                   int out_w, int out_h);
+
+// The rows of a dynamic height's rebuild on this kernel's vectors (kernel/height_rows.cpp).
+const HeightRows& height_rows();
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -274,7 +274,13 @@ std::string ao_key(const AoDesc& ao, float depth_scale) {
   Key k;
   k("depth_scale").v(depth_scale)("directions").v(ao.directions)("jitter").v(ao.jitter)("seed").v(ao.seed)("radius")
       .v(ao.radius)("coarse").v(ao.coarse)("strength").v(ao.strength)("resolution").v(ao.resolution);
+  if (ao.amortize_frames > 1) k("amortize_frames").v(ao.amortize_frames);
   return k.str();
+}
+
+// A dynamic AO map amortized over frames keeps its rows in floats for the next frame (prepare's AoHistory).
+void keep_ao_rows(DerivedPlan& d, const AoDesc& ao, AoMapSize side) {
+  if (d.dynamic && ao.amortize_frames > 1) d.bytes += std::uint64_t(side.width) * std::uint64_t(side.height) * sizeof(float);
 }
 
 std::string mib(std::uint64_t bytes) {
@@ -405,6 +411,7 @@ public:
                            where + "/ao", {m.combined_surface}, index,
                            mip_chain_bytes(side.width, side.height, TexelFormat::R16), -1, side.width);
           plan_.derived[std::size_t(m.blend_ao)].working_bytes = ao_bake_bytes(field_w, field_h, ao);
+          keep_ao_rows(plan_.derived[std::size_t(m.blend_ao)], ao, side);
         }
       }
     }
@@ -419,6 +426,7 @@ public:
                              side.width);
         // Baked (unless cached): the map in floats and, for coarse taps, the heights' max pyramid.
         plan_.derived[std::size_t(m.layers[l].ao)].working_bytes = ao_bake_bytes(h.width, h.height, desc.ao);
+        keep_ao_rows(plan_.derived[std::size_t(m.layers[l].ao)], desc.ao, side);
       }
     }
     const bool bilinear_patch =
@@ -746,7 +754,14 @@ std::string FramePlan::describe() const {
     if (d.texture >= 0) s << " from texture " << d.texture;
     s << ", " << mib(d.bytes);
     if (d.working_bytes > 0) s << " (" << mib(d.working_bytes) << " more while it is baked)";
-    s << "  <- " << d.where << (d.dynamic ? ", dynamic (rebuilt every frame)" : "") << "\n";
+    const int amortize = materials[std::size_t(d.material)].desc.ao.amortize_frames;
+    const bool ao = d.kind == DerivedKind::BlendAoMap || d.kind == DerivedKind::LayerAoMap;
+    s << "  <- " << d.where;
+    if (d.dynamic && ao && amortize > 1)
+      s << ", dynamic (1/" << amortize << " of its rows rebaked every frame, the others kept from the frames before)";
+    else if (d.dynamic)
+      s << ", dynamic (rebuilt every frame)";
+    s << "\n";
   }
   s << "meshes (" << meshes.size() << "):\n";
   for (const MeshPlan& m : meshes) {

@@ -17,6 +17,7 @@
 #include "qdmr/texture/height_texture.hpp"
 #include "qdmr/texture/twin_texels.hpp"
 #include "texture/blend_weights.hpp"
+#include "texture/height_family.hpp"
 
 namespace qdmr {
 namespace {
@@ -49,6 +50,8 @@ HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, Mip
   return stored;
 }
 
+void describe(TextureStat& stat, const TextureRequest& request, const Texture& texture);
+
 // Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
 // texture_working_bytes counts the most this holds at once, step by step.
 Texture build_texture(const TextureRequest& request, MipExtremum extremum, TextureStat& stat, const SharedHeight* shared) {
@@ -71,6 +74,11 @@ Texture build_texture(const TextureRequest& request, MipExtremum extremum, Textu
     texture = make_mip_texture(level0, request.format, request.srgb, request.reduce, extremum);
     add_linear_copy(texture);
   }
+  describe(stat, request, texture);
+  return texture;
+}
+
+void describe(TextureStat& stat, const TextureRequest& request, const Texture& texture) {
   stat.where = request.where;
   stat.purpose = purpose_name(request.purpose);
   stat.format = format_name(texture.format) + (texture.srgb ? " srgb" : "");
@@ -78,7 +86,6 @@ Texture build_texture(const TextureRequest& request, MipExtremum extremum, Textu
   stat.height = texture.height();
   stat.levels = texture.level_count();
   stat.bytes = texture.bytes();
-  return texture;
 }
 
 // Level 0 of a stored height texture in fp64, for the exact reference and the bakes.
@@ -93,10 +100,23 @@ HeightField height_field(const Texture& h, AddressMode address) {
   return field;
 }
 
-// An AO map from the bake cache, or baked every frame (and not kept) for a dynamic surface.
-Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic, AoMapRow row) {
-  return dynamic ? bake_ao_map(field, depth_scale, ao, row)
-                 : load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir(), row);
+// An AO map from the bake cache, or baked every frame (and not kept) for a dynamic surface: amortized over K
+// frames, the rows j % K == frame % K of the previous frame's map (`last`, when it is that frame's), else all.
+Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic, AoMapRow row, int frame,
+             const AoHistory* last, std::shared_ptr<const AoHistory>& history) {
+  if (!dynamic) return load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir(), row);
+  if (ao.amortize_frames <= 1) return bake_ao_map(field, depth_scale, ao, row);
+  const AoMapSize size = ao_map_size(field.width, field.height, ao);
+  auto next = std::make_shared<AoHistory>();
+  next->frame = frame;
+  if (last && last->frame == frame - 1 && last->map.width == size.width && last->map.height == size.height) {
+    next->map = last->map;
+    bake_ao_rows(field, depth_scale, ao, next->map, frame % ao.amortize_frames, ao.amortize_frames, row);
+  } else {
+    next->map = bake_ao_map(field, depth_scale, ao, row);
+  }
+  history = next;
+  return next->map;
 }
 
 // Items of the previous assets by key, to share instead of rebuild.
@@ -104,8 +124,17 @@ struct Previous {
   std::map<std::string, std::shared_ptr<const MeshData>> meshes;
   std::map<std::string, std::pair<std::shared_ptr<const Texture>, TextureStat>> textures;
   std::map<std::string, DerivedAsset> derived;
+  const Assets* assets = nullptr;
+  const FramePlan* plan = nullptr;
 
-  Previous(const Assets* assets, const FramePlan* plan) {
+  // The AO history of derived item `index` when the previous plan's item there is of the same kind and place.
+  const AoHistory* ao_history(std::size_t index, const DerivedPlan& d) const {
+    if (!assets || !plan || index >= plan->derived.size() || index >= assets->derived.size()) return nullptr;
+    const DerivedPlan& p = plan->derived[index];
+    return p.kind == d.kind && p.where == d.where ? assets->derived[index].ao_history.get() : nullptr;
+  }
+
+  Previous(const Assets* a, const FramePlan* p) : assets(a), plan(p) {
     if (!assets || !plan) return;
     for (std::size_t i = 0; i < plan->meshes.size() && i < assets->meshes.size(); ++i)
       meshes.emplace(plan->meshes[i].key, assets->meshes[i]);
@@ -119,8 +148,8 @@ struct Previous {
 class Preparer {
 public:
   Preparer(const FramePlan& plan, const Kernel& kernel, const Previous& previous, Assets& assets,
-           const std::function<void(double)>& progress)
-      : plan_(plan), kernel_(kernel), previous_(previous), assets_(assets), progress_(progress),
+           const std::function<void(double)>& progress, SpareTextures* spares)
+      : plan_(plan), kernel_(kernel), previous_(previous), assets_(assets), progress_(progress), spares_(spares),
         file_(plan.scene.file.string()) {}
 
   void run() {
@@ -197,10 +226,12 @@ private:
   // The dynamic layer heights that more than one texture to build is made from: their level 0, and their box chain
   // when a box-filtered height or from_height normals use it, made before the textures (one at a time, each with
   // every thread). Still heights keep the one-build-per-texture path (and its memory plan).
-  std::map<std::string, SharedHeight> shared_heights() const {
+  std::map<std::string, SharedHeight> shared_heights(const std::vector<bool>& done) const {
     std::map<std::string, std::vector<const TextureRequest*>> users;
-    for (const TextureRequest& r : plan_.textures)
-      if (r.dynamic && !r.height_key.empty() && !previous_.textures.count(r.key)) users[r.height_key].push_back(&r);
+    for (std::size_t i = 0; i < plan_.textures.size(); ++i) {
+      const TextureRequest& r = plan_.textures[i];
+      if (!done[i] && r.dynamic && !r.height_key.empty() && !previous_.textures.count(r.key)) users[r.height_key].push_back(&r);
+    }
     std::map<std::string, SharedHeight> shared;
     for (const auto& [key, requests] : users) {
       if (requests.size() < 2) continue;
@@ -215,11 +246,68 @@ private:
     return shared;
   }
 
+  // The dynamic heights whose every texture to build the family rebuild makes (heights stored as R8 or R16 with
+  // Box or Max chains, from_height normals): built first, one height at a time, each with every thread, into the
+  // spares' buffers where they fit. Returns which requests they built.
+  std::vector<bool> height_families() {
+    std::vector<bool> done(plan_.textures.size(), false);
+    std::map<std::string, std::vector<std::size_t>> users;
+    for (std::size_t i = 0; i < plan_.textures.size(); ++i) {
+      const TextureRequest& r = plan_.textures[i];
+      if (r.dynamic && !r.height_key.empty() && !previous_.textures.count(r.key)) users[r.height_key].push_back(i);
+    }
+    for (const auto& [key, requests] : users) {
+      const TextureRequest* heights = nullptr;
+      bool fits = true;
+      for (std::size_t i : requests) {
+        const TextureRequest& r = plan_.textures[i];
+        if (r.purpose == TexturePurpose::Height) {
+          fits = fits && (r.reduce == MipReduce::Box || r.reduce == MipReduce::Max) &&
+                 height_family_stores(r.desc, r.format, r.width, r.height) && (!heights || r.format == heights->format);
+          heights = heights ? heights : &r;
+        } else {
+          fits = fits && r.purpose == TexturePurpose::Normal && r.desc.source == TextureSource::FromHeight;
+        }
+      }
+      if (!fits || !heights) continue;
+      const ProgressStep step("dynamic height " + std::to_string(heights->width) + "x" + std::to_string(heights->height) +
+                              " (" + heights->where + ")");
+      const auto start = Clock::now();
+      std::vector<HeightFamilyMember> members(requests.size());
+      for (std::size_t k = 0; k < requests.size(); ++k) {
+        const TextureRequest& r = plan_.textures[requests[k]];
+        HeightFamilyMember& m = members[k];
+        m.normals = r.purpose == TexturePurpose::Normal;
+        m.reduce = r.reduce;
+        m.wrap_footprints = r.wrap_footprints;
+        m.normal_strength = r.layer.normal_strength;
+        if (spares_)
+          m.texture = spares_->take(r.width, r.height, m.normals ? TexelFormat::RGBA8 : r.format, r.wrap_footprints);
+      }
+      build_height_family(heights->layer, heights->format, heights->where, members, kernel_.height_rows(),
+                          kernel_.mip_extremum());
+      // Built together: each texture's step is the whole rebuild.
+      for (std::size_t k = 0; k < requests.size(); ++k) {
+        const std::size_t i = requests[k];
+        const TextureRequest& r = plan_.textures[i];
+        TextureStat& stat = assets_.texture_stats[i];
+        stat.height_format = format_name(heights->format);
+        describe(stat, r, members[k].texture);
+        assets_.textures[i] = std::make_shared<Texture>(std::move(members[k].texture));
+        record("texture " + r.key, plan_.meshes.size() + i, {"texture " + std::to_string(i), purpose_name(r.purpose), r.where},
+               start);
+        done[i] = true;
+      }
+    }
+    return done;
+  }
+
   void textures() {
     const std::size_t n = plan_.textures.size();
     assets_.textures.resize(n);
     assets_.texture_stats.resize(n);
-    const std::map<std::string, SharedHeight> shared = shared_heights();
+    const std::vector<bool> done = height_families();
+    const std::map<std::string, SharedHeight> shared = shared_heights(done);
     // At most kTexturesBuiltAtOnce in flight (the plan counts that many builds' working memory); each build's
     // own loops use every thread.
     std::size_t next = 0;
@@ -233,6 +321,7 @@ private:
                                             }) &
             tbb::make_filter<std::size_t, void>(tbb::filter_mode::parallel, [&](std::size_t i) {
               const TextureRequest& request = plan_.textures[i];
+              if (done[i]) return;
               if (auto it = previous_.textures.find(request.key); it != previous_.textures.end()) {
                 assets_.textures[i] = it->second.first;
                 assets_.texture_stats[i] = it->second.second;
@@ -242,7 +331,7 @@ private:
                                       " (" + request.where + ")");  // a line on a terminal when it takes seconds
               const auto start = Clock::now();
               const auto s = shared.find(request.height_key);
-              assets_.textures[i] = std::make_shared<const Texture>(build_texture(
+              assets_.textures[i] = std::make_shared<Texture>(build_texture(
                   request, kernel_.mip_extremum(), assets_.texture_stats[i], s == shared.end() ? nullptr : &s->second));
               record("texture " + request.key, plan_.meshes.size() + i,
                      {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
@@ -306,7 +395,8 @@ private:
         AoDesc ao = desc.ao;
         ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats
         ao.resolution = d.side;
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic, kernel_.ao_map_row()),
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic, kernel_.ao_map_row(),
+                                 plan_.scene.frame, previous_.ao_history(index, d), out.ao_history),
                           TexelFormat::R16, MipReduce::Box);
         break;
       }
@@ -320,7 +410,8 @@ private:
         break;
       case DerivedKind::LayerAoMap:
         // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic, kernel_.ao_map_row()),
+        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic, kernel_.ao_map_row(),
+                                 plan_.scene.frame, previous_.ao_history(index, d), out.ao_history),
                           TexelFormat::R16, MipReduce::Box);
         break;
       case DerivedKind::ConeMap:
@@ -343,6 +434,7 @@ private:
   const Previous& previous_;
   Assets& assets_;
   const std::function<void(double)>& progress_;
+  SpareTextures* spares_;
   std::string file_;
   std::size_t items_ = 0;
   std::mutex mutex_;
@@ -367,11 +459,25 @@ std::uint64_t Assets::mesh_bytes() const {
   return bytes;
 }
 
+Texture SpareTextures::take(int width, int height, TexelFormat format, bool wrap_footprints) {
+  for (auto it = textures.begin(); it != textures.end(); ++it) {
+    const Texture& t = **it;
+    if (it->use_count() != 1 || t.format != format || t.width() != width || t.height() != height ||
+        t.wrap_footprints.empty() == wrap_footprints)
+      continue;
+    // prepare makes every texture of Assets::textures as a non-const object; held only here, it may be emptied.
+    Texture out = std::move(*std::const_pointer_cast<Texture>(*it));
+    textures.erase(it);
+    return out;
+  }
+  return Texture{};
+}
+
 Assets prepare(const FramePlan& plan, const Kernel& kernel, const Assets* previous, const FramePlan* previous_plan,
-               const std::function<void(double)>& progress) {
+               const std::function<void(double)>& progress, SpareTextures* spares) {
   Assets assets;
   const Previous reuse(previous, previous_plan);
-  Preparer(plan, kernel, reuse, assets, progress).run();
+  Preparer(plan, kernel, reuse, assets, progress, spares).run();
   return assets;
 }
 

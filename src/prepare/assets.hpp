@@ -20,6 +20,13 @@ namespace qdmr {
 
 class Kernel;
 
+// An amortized AO map (AoDesc::amortize_frames) as floats, and the frame of the animation it is: the next frame
+// copies it and rebakes its share of the rows.
+struct AoHistory {
+  int frame = 0;
+  Image map;
+};
+
 // One derived item: the member its kind makes (weight textures, quadtrees, AO maps and bilinear bounds are
 // textures; combined surfaces and height fields are fields; cone maps are cones; a combined quadtree also has
 // its layers' heights side by side).
@@ -30,6 +37,7 @@ struct DerivedAsset {
   std::shared_ptr<const HeightField> field;
   std::shared_ptr<const ConeMap> cones;
   std::shared_ptr<const std::vector<float>> twin_texels;  // TwinTexels (qdmr/texture/twin_texels.hpp)
+  std::shared_ptr<const AoHistory> ao_history;  // an AO map amortized over frames: its rows in floats
 };
 
 struct Assets {
@@ -45,13 +53,25 @@ struct Assets {
   std::uint64_t mesh_bytes() const;
 };
 
+// Textures of dynamic items that the last prepare replaced, held by nothing else, kept for their buffers: the next
+// frame's rebuild of a dynamic height refills them (texture/height_family.hpp) instead of allocating and clearing
+// new memory (the Renderer keeps them between frames).
+struct SpareTextures {
+  std::vector<std::shared_ptr<const Texture>> textures;
+  // A spare of this layout (with wrap footprints or without), moved out of the list, or an empty texture.
+  Texture take(int width, int height, TexelFormat format, bool wrap_footprints);
+};
+
 // Builds what the plan lists, in parallel (in the caller's task arena); items whose key is in `previous` are
-// shared instead of rebuilt. The per-ISA work (max/min mip chains, a blend's box values) runs on `kernel`, the
+// shared instead of rebuilt; an AO map amortized over frames continues the previous assets' map of the same item
+// (same place in the plans) when that is the previous frame's (else it bakes every row). The per-ISA work (max/min mip chains, a blend's box values) runs on `kernel`, the
 // Renderer's, so a forced ISA holds here too: passed, not a process-wide choice, since renderers of different ISAs
 // share a process (tests, Python) and the builders run on TBB workers. Cone and AO maps go through the bake cache
-// in default_cache_dir(). `progress`, when set, is called with the fraction of the plan's items done each time an
-// item is built (from the building thread, one call at a time). Throws qdmr::Error on bad input.
+// in default_cache_dir(). Dynamic heights' textures are rebuilt together (texture/height_family.hpp) into `spares`
+// where they fit. `progress`, when set, is called with the fraction of the plan's items done each time an item is
+// built (from the building thread, one call at a time). Throws qdmr::Error on bad input.
 Assets prepare(const FramePlan& plan, const Kernel& kernel, const Assets* previous = nullptr,
-               const FramePlan* previous_plan = nullptr, const std::function<void(double fraction)>& progress = {});
+               const FramePlan* previous_plan = nullptr, const std::function<void(double fraction)>& progress = {},
+               SpareTextures* spares = nullptr);
 
 }  // namespace qdmr

@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -50,6 +51,26 @@ std::uint64_t unshared_bytes(const FramePlan& previous, const FramePlan& next) {
   return bytes;
 }
 
+// The most frames a dynamic baked AO map of the plan is amortized over (AoDesc::amortize_frames), else 1.
+int ao_window(const FramePlan& plan) {
+  int window = 1;
+  for (const DerivedPlan& d : plan.derived)
+    if (d.dynamic && (d.kind == DerivedKind::LayerAoMap || d.kind == DerivedKind::BlendAoMap))
+      window = std::max(window, plan.materials[std::size_t(d.material)].desc.ao.amortize_frames);
+  return window;
+}
+
+// Whether two plans make the same AO maps in the same places.
+bool same_ao_maps(const FramePlan& a, const FramePlan& b) {
+  if (a.derived.size() != b.derived.size()) return false;
+  for (std::size_t i = 0; i < a.derived.size(); ++i) {
+    const DerivedKind kind = b.derived[i].kind;
+    if ((kind == DerivedKind::LayerAoMap || kind == DerivedKind::BlendAoMap) && a.derived[i].key != b.derived[i].key)
+      return false;
+  }
+  return true;
+}
+
 std::uint64_t capacity_bytes(const PixelBuffer& plane) { return plane.capacity() * sizeof(float); }
 
 int thread_count(const RenderOptions& options) {
@@ -81,6 +102,7 @@ struct Renderer::State {
   std::optional<SceneDesc> scene;  // as given to set_scene (with heights handed over since), before any frame's time
   std::vector<Aov> aovs;           // of the last set_scene
   Assets assets;
+  SpareTextures spares;  // the dynamic textures the last prepare replaced: the next one refills their buffers
   std::vector<std::unique_ptr<Program>> programs;
   Framebuffer fb;
   DrawScratch scratch;  // the per-triangle arrays, kept between draws of one scene
@@ -178,7 +200,32 @@ void Renderer::prepare_scene(const SceneDesc& scene, const std::vector<Aov>& aov
   State& s = *state_;
   auto start = Clock::now();
   FramePlan plan = plan_frame(scene, PlanOptions{aovs});
-  s.pending_plan_ms = ms_since(start);
+  const double plan_ms = ms_since(start);
+  // Baked AO amortized over K frames on heights that change with time: frame N's map holds rows of frames N-K+1 .. N,
+  // so unless the scene prepared last was frame N - 1 of this sequence (the previous scene moved to frame N plans
+  // the same AO maps), those frames are prepared first, the first of them baking every row.
+  double replay_ms = 0;
+  if (const int window = ao_window(plan); window > 1 && scene.time_dependent()) {
+    const int n = scene.frame;
+    const bool continues = s.plan && s.plan->scene.frame == n - 1 &&
+                           same_ao_maps(plan_frame(scene_at_frame(s.plan->scene, n), PlanOptions{aovs}), plan);
+    if (!continues) {
+      for (DerivedAsset& d : s.assets.derived) d.ao_history.reset();
+      for (int f = std::max(0, n - window + 1); f < n; ++f) {
+        start = Clock::now();
+        prepare_plan(plan_frame(scene_at_frame(scene, f), PlanOptions{aovs}), 0.0);
+        replay_ms += ms_since(start);
+      }
+    }
+  }
+  prepare_plan(std::move(plan), plan_ms);
+  s.pending_prepare_ms += replay_ms;  // a frame's preparation includes the frames it replayed
+}
+
+void Renderer::prepare_plan(FramePlan plan, double plan_ms) {
+  State& s = *state_;
+  const SceneDesc& scene = plan.scene;
+  s.pending_plan_ms = plan_ms;
   if (const TextureCacheDesc& cache = plan.scene.texture_cache; cache.enabled && s.options.tile_size % cache.region != 0)
     throw Error(scene.file.string() + ": /texture_cache/region",
                 "the texture cache replays regions of " + std::to_string(cache.region) +
@@ -196,21 +243,29 @@ void Renderer::prepare_scene(const SceneDesc& scene, const std::vector<Aov>& aov
       needed - plan.framebuffer_bytes + s.frame_bytes() + unshared_bytes(*s.plan, plan) > limit) {
     s.programs.clear();
     s.assets = Assets{};
+    s.spares = SpareTextures{};
     s.plan.reset();
     s.fb = Framebuffer{};
     s.scratch = DrawScratch{};
     s.frame = Frame{};
   }
-  start = Clock::now();
+  const auto start = Clock::now();
   if (s.options.progress) s.options.progress("prepare", 0.0);
   std::function<void(double)> prepare_progress;
   if (s.options.progress) prepare_progress = [&report = s.options.progress](double f) { report("prepare", f); };
   s.arena.execute([&] {
-    Assets assets = prepare(plan, *s.kernel, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress);
+    Assets assets = prepare(plan, *s.kernel, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress, &s.spares);
     // Programs point into the new assets: make them before the old assets go.
     std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel);
     s.programs = std::move(programs);
+    // The previous frame's dynamic textures that nothing holds any more become the next frame's spares (the
+    // spares this prepare did not take go).
+    SpareTextures released;
+    for (std::size_t i = 0; s.plan && i < s.plan->textures.size() && i < s.assets.textures.size(); ++i)
+      if (s.plan->textures[i].dynamic) released.textures.push_back(s.assets.textures[i]);
     s.assets = std::move(assets);
+    std::erase_if(released.textures, [](const auto& t) { return t.use_count() != 1; });
+    s.spares = std::move(released);
   });
   s.plan = std::move(plan);
   if (s.options.progress) s.options.progress("prepare", 1.0);

@@ -45,7 +45,9 @@ SceneDesc scene_at_time(const SceneDesc& scene, double seconds) {
 }
 
 SceneDesc scene_at_frame(const SceneDesc& scene, int frame) {
-  return scene_at_time(scene, double(frame) / scene.animation.fps);
+  SceneDesc out = scene_at_time(scene, double(frame) / scene.animation.fps);
+  out.frame = frame;
+  return out;
 }
 
 }  // namespace qdmr

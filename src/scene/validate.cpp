@@ -383,7 +383,8 @@ ShadowDesc read_shadow(const Value& value) {
 }
 
 AoDesc read_ao(const Value& value) {
-  const Object object(value, {"mode", "directions", "jitter", "seed", "radius", "coarse", "strength", "resolution"});
+  const Object object(value, {"mode", "directions", "jitter", "seed", "radius", "coarse", "strength", "resolution",
+                              "amortize_frames"});
   AoDesc d;
   if (auto v = object.find("mode"))
     d.mode = v->choice<AoMode>({{"off", AoMode::Off}, {"frame", AoMode::Frame}, {"baked", AoMode::Baked}});
@@ -394,6 +395,7 @@ AoDesc read_ao(const Value& value) {
   if (auto v = object.find("coarse")) d.coarse = v->boolean();
   if (auto v = object.find("strength")) d.strength = static_cast<float>(v->number_in(0.0, 1.0));
   if (auto v = object.find("resolution")) d.resolution = static_cast<int>(v->integer(0, limits::kMaxTextureSide));
+  if (auto v = object.find("amortize_frames")) d.amortize_frames = static_cast<int>(v->integer(1, AoDesc::kMaxAmortizeFrames));
   return d;
 }
 

@@ -16,6 +16,7 @@
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/texture/texture.hpp"
+#include "texture/height_rows_code.hpp"
 #include "texture/internal.hpp"
 
 namespace qdmr {
@@ -369,59 +370,14 @@ Image fill_normalised(int size, bool with_cells, const Noise& noise, Offset offs
   return out;
 }
 
-// Waves: h = sum_i a_i ((1 + sin theta_i) / 2)^s_i / sum_i a_i, theta_i = 2 pi (k_i . (uv - scroll t) - |k_i| c_i t)
-// with k_i whole cycles per repeat (so the pattern tiles). Each phase is separable, sin(alpha_u + beta_v) =
-// sin alpha_u cos beta_v + cos alpha_u sin beta_v: one table per column and per row for each wave (sin_2pi in
-// double), then two products and a sum per texel in float. Every texel is computed alone: the same bits on any
-// thread count.
-template <int Sharpness>
-void add_wave(float* row, int n, const float* su, const float* cu, float sv, float cv, float weight) {
-  for (int x = 0; x < n; ++x) {
-    const float w = 0.5f + 0.5f * (su[x] * cv + cu[x] * sv);
-    float p = w;
-    for (int k = 1; k < Sharpness; ++k) p = p * w;
-    row[x] = row[x] + weight * p;
-  }
-}
-
-using AddWave = void (*)(float*, int, const float*, const float*, float, float, float);
-constexpr AddWave kAddWave[] = {add_wave<1>, add_wave<2>, add_wave<3>, add_wave<4>,
-                                add_wave<5>, add_wave<6>, add_wave<7>, add_wave<8>};
-
-Image fill_waves(const ProceduralDesc& d, bool with_cells, Offset offset) {
+Image fill_waves(const ProceduralDesc& d, bool with_cells) {
+  const texture_detail::WaveRows waves = texture_detail::wave_rows(d);
   const int n = d.size;
-  struct Tables {
-    std::vector<float> su, cu, sv, cv;
-    float weight;
-    int sharpness;
-  };
-  double total = 0.0;
-  for (const WaveDesc& w : d.waves) total += w.amplitude;
-  std::vector<Tables> tables;
-  for (const WaveDesc& w : d.waves) {
-    const double ku = w.cycles_u, kv = w.cycles_v, k = std::sqrt(ku * ku + kv * kv);
-    const double turns = fract(k * double(w.speed) * d.time) + ku * offset.u + kv * offset.v;
-    Tables t{std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)),
-             std::vector<float>(std::size_t(n)), float(total > 0.0 ? double(w.amplitude) / total : 0.0),
-             std::clamp(w.sharpness, 1, 8)};
-    for (int i = 0; i < n; ++i) {
-      const double c = (i + 0.5) / n;
-      const double a = fract(ku * c - turns), b = fract(kv * c);
-      t.su[std::size_t(i)] = float(sin_2pi(a));
-      t.cu[std::size_t(i)] = float(sin_2pi(a + 0.25));
-      t.sv[std::size_t(i)] = float(sin_2pi(b));
-      t.cv[std::size_t(i)] = float(sin_2pi(b + 0.25));
-    }
-    tables.push_back(std::move(t));
-  }
   Image out(n, n, with_cells ? 2 : 1);
   tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> row(static_cast<std::size_t>(n));
     for (int y = rows.begin(); y != rows.end(); ++y) {
-      std::fill(row.begin(), row.end(), 0.0f);
-      for (const Tables& t : tables)
-        kAddWave[t.sharpness - 1](row.data(), n, t.su.data(), t.cu.data(), t.sv[std::size_t(y)], t.cv[std::size_t(y)],
-                                  t.weight);
+      waves.row(y, row.data(), &height_row_code::add_wave);
       for (int x = 0; x < n; ++x) {
         out.at(x, y, 0) = std::min(1.0f, std::max(0.0f, row[std::size_t(x)]));
         if (with_cells) out.at(x, y, 1) = 0.5f;
@@ -448,6 +404,44 @@ void validate(const ProceduralDesc& d) {
 
 namespace texture_detail {
 
+// Waves: h = sum_i a_i ((1 + sin theta_i) / 2)^s_i / sum_i a_i, theta_i = 2 pi (k_i . (uv - scroll t) - |k_i| c_i t)
+// with k_i whole cycles per repeat (so the pattern tiles). Each phase is separable, sin(alpha_u + beta_v) =
+// sin alpha_u cos beta_v + cos alpha_u sin beta_v: one table per column and per row for each wave (sin_2pi in
+// double), then two products and a sum per texel in float. Every texel is computed alone: the same bits on any
+// thread count.
+WaveRows wave_rows(const ProceduralDesc& d) {
+  validate(d);
+  const Offset offset = scroll_offset(d);
+  const int n = d.size;
+  WaveRows out;
+  out.size = n;
+  double total = 0.0;
+  for (const WaveDesc& w : d.waves) total += w.amplitude;
+  for (const WaveDesc& w : d.waves) {
+    const double ku = w.cycles_u, kv = w.cycles_v, k = std::sqrt(ku * ku + kv * kv);
+    const double turns = fract(k * double(w.speed) * d.time) + ku * offset.u + kv * offset.v;
+    WaveRows::Wave t{std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)),
+                     std::vector<float>(std::size_t(n)), std::vector<float>(std::size_t(n)),
+                     float(total > 0.0 ? double(w.amplitude) / total : 0.0), std::clamp(w.sharpness, 1, 8)};
+    for (int i = 0; i < n; ++i) {
+      const double c = (i + 0.5) / n;
+      const double a = fract(ku * c - turns), b = fract(kv * c);
+      t.su[std::size_t(i)] = float(sin_2pi(a));
+      t.cu[std::size_t(i)] = float(sin_2pi(a + 0.25));
+      t.sv[std::size_t(i)] = float(sin_2pi(b));
+      t.cv[std::size_t(i)] = float(sin_2pi(b + 0.25));
+    }
+    out.waves.push_back(std::move(t));
+  }
+  return out;
+}
+
+void WaveRows::row(int y, float* out, AddWave add) const {
+  std::fill(out, out + size, 0.0f);
+  for (const Wave& t : waves)
+    add(t.sharpness, out, size, t.su.data(), t.cu.data(), t.sv[std::size_t(y)], t.cv[std::size_t(y)], t.weight);
+}
+
 Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
   validate(d);
   const Offset o = scroll_offset(d);
@@ -460,7 +454,7 @@ Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
     case ProceduralPattern::Noise: return fill_normalised(d.size, with_cells, Noise(d), o);
     case ProceduralPattern::Flat: return fill(d.size, with_cells, Flat{}, o);
     case ProceduralPattern::Checker: return fill(d.size, with_cells, Checker{d.cells, d.seed}, o);
-    case ProceduralPattern::Waves: return fill_waves(d, with_cells, o);
+    case ProceduralPattern::Waves: return fill_waves(d, with_cells);
   }
   throw Error("procedural pattern", "unknown pattern");
 }

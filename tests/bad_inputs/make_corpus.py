@@ -572,6 +572,14 @@ case("waves_on_another_pattern", render("--set", '/materials/m/layers/0/height={
      "/materials/m/layers/0/height/waves: only the 'waves' pattern has waves")
 case("waves_without_waves", render("--set", '/materials/m/layers/0/height={"procedural": "waves"}'),
      "/materials/m/layers/0/height: missing key 'waves'")
+# AO amortized over frames: a whole number of frames from 1 to 64.
+def amortized(k):
+    return frames("--frames", "0:1", "--set", '/materials/m/ao={"mode": "baked", "amortize_frames": %s}' % k)
+case("ao_amortize_zero", amortized("0"), "/materials/m/ao/amortize_frames: must be an integer from 1 to 64, got 0")
+case("ao_amortize_negative", amortized("-3"), "/materials/m/ao/amortize_frames: must be an integer from 1 to 64, got -3")
+case("ao_amortize_huge", amortized("1e12"), "/materials/m/ao/amortize_frames: must be an integer from 1 to 64")
+case("ao_amortize_not_an_integer", amortized("2.5"), "/materials/m/ao/amortize_frames: expected an integer, got 2.5")
+case("ao_amortize_a_string", amortized('"4"'), "/materials/m/ao/amortize_frames")
 case("cone_map_on_a_dynamic_height", frames("--frames", "0:1", "--set", "/materials/m/technique/name=csm"),
      "/materials/m/technique/name: 'csm' marches a cone map baked from the heights, and this material's heights change every frame")
 

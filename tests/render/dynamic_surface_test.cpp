@@ -9,7 +9,10 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "cli/cli_test_util.hpp"
 #include "kernel/kernel.hpp"
@@ -87,16 +90,23 @@ TEST(DynamicSurface, AScrollAtTimeZeroReadsTheStillPattern) {
     for (int x = 0; x < 64; ++x) ASSERT_EQ(moved.at(x, y, 0), a.at((x + 64 - 4) % 64, y, 0)) << x << "," << y;
 }
 
-TEST(DynamicSurface, AFrameOfASequenceEqualsTheFrameAloneOnAnyThreadCount) {
-  const SceneDesc scene = water();
+// Frames 0 .. last of `scene` drawn one after the other by one renderer on two threads, as `qdmr render --frames`
+// draws them; the renderer, its last frame drawn.
+std::unique_ptr<Renderer> draw_sequence(const SceneDesc& scene, int last) {
   RenderOptions options;
   options.threads = 2;
-  Renderer sequence(options);
-  for (int n = 0; n <= 3; ++n) {
-    sequence.set_scene(scene_at_frame(scene, n));
-    sequence.draw();
+  auto renderer = std::make_unique<Renderer>(options);
+  for (int n = 0; n <= last; ++n) {
+    renderer->set_scene(scene_at_frame(scene, n));
+    renderer->draw();
   }
-  const Frame& third = sequence.frame();
+  return renderer;
+}
+
+TEST(DynamicSurface, AFrameOfASequenceEqualsTheFrameAloneOnAnyThreadCount) {
+  const SceneDesc scene = water();
+  const std::unique_ptr<Renderer> sequence = draw_sequence(scene, 3);
+  const Frame& third = sequence->frame();
   for (int threads : {1, 2, 3}) EXPECT_TRUE(same_bits(third.color, render(scene_at_frame(scene, 3), threads).color)) << threads;
 }
 
@@ -193,6 +203,65 @@ TEST(DynamicSurface, ConeSteppingOnADynamicHeightIsRefusedUnlessRebaked) {
   before ? ::setenv("QDMR_CACHE_DIR", saved.c_str(), 1) : ::unsetenv("QDMR_CACHE_DIR");
   EXPECT_FALSE(std::filesystem::is_empty(cache));
   std::filesystem::remove_all(cache);
+}
+
+// Baked AO amortized over frames (issue #58): frame N's map holds row j as frame N - ((N - j) mod K) baked it
+// (frame 0 bakes every row), and frame N rendered alone replays the frames it needs: the same bits as frame N of
+// a sequence, whatever the route and the thread count.
+SceneDesc water_ao(int frames) {
+  return water({{"/materials/water/ao", R"({"mode": "baked", "amortize_frames": )" + std::to_string(frames) + "}"}});
+}
+
+// The stored level 0 of the layer AO map, row j (R16 codes).
+std::vector<std::uint8_t> ao_row(const FramePlan& plan, const Assets& assets, int j) {
+  for (std::size_t i = 0; i < plan.derived.size(); ++i)
+    if (plan.derived[i].kind == DerivedKind::LayerAoMap) {
+      const Texture& t = *assets.derived[i].texture;
+      const std::uint8_t* row = t.texel_address(0, 0, j);
+      return {row, row + std::size_t(t.width()) * 2};
+    }
+  ADD_FAILURE() << "no layer AO map";
+  return {};
+}
+
+TEST(DynamicSurface, AnAmortizedAoMapHoldsEachRowAsTheFrameThatLastBakedItBakedIt) {
+  constexpr int kWindow = 3, kFrame = 5;
+  const Kernel& kernel = kernel_for(resolve_isa(Isa::Auto));
+  std::vector<FramePlan> plans;
+  std::vector<Assets> frames;
+  for (int n = 0; n <= kFrame; ++n) {
+    plans.push_back(plan_frame(scene_at_frame(water_ao(kWindow), n)));
+    frames.push_back(n == 0 ? prepare(plans[0], kernel) : prepare(plans[n], kernel, &frames[n - 1], &plans[n - 1]));
+  }
+  std::vector<FramePlan> full_plans;
+  std::vector<Assets> full;  // every frame baked whole
+  for (int n = 0; n <= kFrame; ++n) {
+    full_plans.push_back(plan_frame(scene_at_frame(water_ao(1), n)));
+    full.push_back(prepare(full_plans[n], kernel));
+  }
+  int from_earlier = 0;
+  for (int n : {1, kFrame})
+    for (int j = 0; j < 64; ++j) {
+      const int baked_at = std::max(0, n - (n - j % kWindow + kWindow) % kWindow);
+      EXPECT_EQ(ao_row(plans[n], frames[n], j), ao_row(full_plans[baked_at], full[baked_at], j)) << n << " row " << j;
+      from_earlier += baked_at != n && ao_row(full_plans[baked_at], full[baked_at], j) != ao_row(full_plans[n], full[n], j);
+    }
+  EXPECT_GT(from_earlier, 0);  // the rows of earlier frames are not those of the frame itself (the test can fail)
+}
+
+TEST(DynamicSurface, AnAmortizedFrameAloneEqualsTheFrameOfASequence) {
+  const SceneDesc scene = water_ao(3);
+  const std::unique_ptr<Renderer> sequence = draw_sequence(scene, 5);
+  const Frame fifth = sequence->take_frame();
+  for (int threads : {1, 2, 3}) EXPECT_TRUE(same_bits(fifth.color, render(scene_at_frame(scene, 5), threads).color)) << threads;
+  Renderer by_frames;  // set_frame from the scene as loaded
+  by_frames.set_scene(scene);
+  by_frames.set_frame(5);
+  EXPECT_TRUE(same_bits(fifth.color, by_frames.draw().color));
+  sequence->set_frame(2);  // back: replays frames 0 to 2
+  EXPECT_TRUE(same_bits(sequence->draw().color, render(scene_at_frame(scene, 2), 1).color));
+  // And the amortized frame is not the frame baked whole (the test can fail).
+  EXPECT_FALSE(same_bits(fifth.color, render(scene_at_frame(water_ao(1), 5), 2).color));
 }
 
 }  // namespace

@@ -35,6 +35,11 @@ using AoMapRow = void (*)(const ao::Bake& bake, int j, float* row);
 // field.
 Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row = nullptr);
 
+// Rows first, first + step, ... of `map` (sized as bake_ao_map makes it) baked as bake_ao_map bakes them; the other
+// rows are left as they are (an amortized map's rows of earlier frames: AoDesc::amortize_frames).
+void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
+                  AoMapRow row = nullptr);
+
 struct AoMapSize {
   int width, height;
 };

@@ -100,6 +100,7 @@ public:
 
 private:
   void prepare_scene(const SceneDesc& scene, const std::vector<Aov>& aovs);  // plan and prepare, the scene kept as is
+  void prepare_plan(FramePlan plan, double plan_ms);  // prepare a planned scene
   std::vector<Aov> options_aovs() const;
   struct State;
   std::unique_ptr<State> state_;

@@ -232,6 +232,10 @@ struct AoDesc {
                             // the fetches); false: a tap every texel on the filtered surface (at most 64 per direction)
   float strength = 1.0f;    // ao' = 1 - strength * (1 - ao); baked maps store ao and apply it when shading
   int resolution = 0;       // baked: texture width (0 = the height map's size); height keeps the aspect
+  // baked, on heights that change every frame: each frame rebakes the rows j with j % K == frame % K of the
+  // previous frame's map (frame 0 bakes them all), so a map holds the last K frames' rows. 1..kMaxAmortizeFrames.
+  int amortize_frames = 1;
+  static constexpr int kMaxAmortizeFrames = 64;
 };
 
 // Height blending of up to 4 layers (the talk's "Surface Blending" / "Height Blending").
@@ -337,6 +341,7 @@ struct AnimationDesc {
 struct SceneDesc {
   std::filesystem::path file;  // the scene file (for messages)
   AnimationDesc animation;
+  int frame = 0;  // the frame of the animation the scene is at (scene_at_frame sets it)
   OutputDesc output;
   CameraDesc camera;
   LightsDesc lights;

@@ -1,0 +1,10 @@
+// Kernel::height_rows: the rows of a dynamic height's rebuild (texture/height_rows_code.hpp) compiled with this
+// kernel's flags, so the compiler runs them on its vectors.
+#include "kernel/preparation.hpp"
+#include "texture/height_rows_code.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE {
+
+const HeightRows& height_rows() { return height_row_code::table(); }
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -1,0 +1,201 @@
+#pragma once
+// The code of HeightRows (qdmr/texture/height_rows.hpp): plain loops over a row, written so that the compiler
+// vectorises them (one lane per texel, the generic builders' IEEE operations in their order: the same bits on any
+// vector width). In the ISA namespace: kernel/height_rows.cpp compiles it per ISA, texture/height_family.cpp for
+// the baseline.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "core/isa_namespace.hpp"
+#include "qdmr/texture/height_rows.hpp"
+#include "texture/mip_reduce.hpp"
+
+namespace qdmr::QDMR_ISA_NAMESPACE::height_row_code {
+
+template <int Sharpness>
+void add_wave_n(float* row, int n, const float* su, const float* cu, float sv, float cv, float weight) {
+  for (int x = 0; x < n; ++x) {
+    const float w = 0.5f + 0.5f * (su[x] * cv + cu[x] * sv);
+    float p = w;
+    for (int k = 1; k < Sharpness; ++k) p = p * w;
+    row[x] = row[x] + weight * p;
+  }
+}
+
+inline void add_wave(int sharpness, float* row, int n, const float* su, const float* cu, float sv, float cv,
+                     float weight) {
+  using F = void (*)(float*, int, const float*, const float*, float, float, float);
+  static constexpr F kBySharpness[] = {add_wave_n<1>, add_wave_n<2>, add_wave_n<3>, add_wave_n<4>,
+                                       add_wave_n<5>, add_wave_n<6>, add_wave_n<7>, add_wave_n<8>};
+  kBySharpness[std::clamp(sharpness, 1, 8) - 1](row, n, su, cu, sv, cv, weight);
+}
+
+inline void finish_waves(float* row, int n, float scale, float offset) {
+  for (int x = 0; x < n; ++x) {
+    const float h = std::min(1.0f, std::max(0.0f, row[x]));
+    row[x] = std::clamp(h * scale + offset, 0.0f, 1.0f);
+  }
+}
+
+// make_mip_texture's quantisation: clamp to [0, 1] (NaN to 0), round to nearest, ties up (exact in double).
+template <int Max>
+inline double code_of(float v) {
+  const double q = std::floor(double(v) * double(Max) + 0.5);
+  return v >= 1.0f ? double(Max) : v > 0.0f ? q : 0.0;
+}
+
+template <class Code>
+inline Code load_code(const std::uint8_t* p, int i) {
+  Code c;
+  std::memcpy(&c, p + std::size_t(i) * sizeof(Code), sizeof(Code));
+  return c;
+}
+
+template <class Code>
+inline void store_code(std::uint8_t* p, int i, Code c) {
+  std::memcpy(p + std::size_t(i) * sizeof(Code), &c, sizeof(Code));
+}
+
+template <class Code, int Max>
+void quantise_n(const float* h, int n, std::uint8_t* codes, float* decoded) {
+  for (int x = 0; x < n; ++x) {
+    const Code c = Code(int(code_of<Max>(h[x])));
+    store_code<Code>(codes, x, c);
+    decoded[x] = float(c) / float(Max);
+  }
+}
+
+inline void quantise(TexelFormat format, const float* h, int n, std::uint8_t* codes, float* decoded) {
+  if (format == TexelFormat::R16) quantise_n<std::uint16_t, 65535>(h, n, codes, decoded);
+  else quantise_n<std::uint8_t, 255>(h, n, codes, decoded);
+}
+
+template <class Code, int Max>
+void decode_n(const std::uint8_t* codes, int n, float* decoded) {
+  for (int x = 0; x < n; ++x) decoded[x] = float(load_code<Code>(codes, x)) / float(Max);
+}
+
+inline void decode(TexelFormat format, const std::uint8_t* codes, int n, float* decoded) {
+  if (format == TexelFormat::R16) decode_n<std::uint16_t, 65535>(codes, n, decoded);
+  else decode_n<std::uint8_t, 255>(codes, n, decoded);
+}
+
+// reduce_box<false>: the sum of the taps in tap order (rows, then columns), divided by their count.
+template <class Code, int Max>
+void box_n(const float* const* in, int rows, int in_w, int out_w, std::uint8_t* codes, float* decoded) {
+  const auto put = [&](int x, float sum, float count) {
+    const Code c = Code(int(code_of<Max>(sum / count)));
+    store_code<Code>(codes, x, c);
+    decoded[x] = float(c) / float(Max);
+  };
+  // Texels of two taps per row, in vectors where the rows are two (every level of an even-sided map).
+  int x = 0;
+  if (in_w > 1) {
+    const int pairs = out_w - (in_w & 1);
+    if (rows == 2) {
+      const float *a = in[0], *b = in[1];
+      for (; x < pairs; ++x) put(x, 0.0f + a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1], 4.0f);
+    }
+  }
+  for (; x < out_w; ++x) {  // the rest, with the generic taps
+    const mip::Taps tx = mip::taps(x, in_w, out_w);
+    float sum = 0.0f;
+    for (int j = 0; j < rows; ++j)
+      for (int i = tx.first; i < tx.first + tx.count; ++i) sum += in[j][i];
+    put(x, sum, float(tx.count * rows));
+  }
+}
+
+inline void box(TexelFormat format, const float* const* in, int rows, int in_w, int out_w, std::uint8_t* codes,
+                float* decoded) {
+  if (format == TexelFormat::R16) box_n<std::uint16_t, 65535>(in, rows, in_w, out_w, codes, decoded);
+  else box_n<std::uint8_t, 255>(in, rows, in_w, out_w, codes, decoded);
+}
+
+// 0.5 + 0.5 n of a unit normal component, as an RGBA8 code.
+inline std::uint8_t unorm8_of_normal(float n) { return std::uint8_t(int(code_of<255>(0.5f + 0.5f * n))); }
+
+// normals_from_height and the from_height slot's normalise (a zero or non-finite length gives (0, 0, 1)).
+inline void normal_texel(float nx, float ny, std::uint8_t* rgba) {
+  const float nz = 1.0f;
+  const double len2 = double(nx) * nx + double(ny) * ny + double(nz) * nz;
+  const bool ok = len2 > 0.0 && len2 <= DBL_MAX;
+  const double inv = 1.0 / std::sqrt(ok ? len2 : 1.0);
+  rgba[0] = unorm8_of_normal(ok ? float(nx * inv) : 0.0f);
+  rgba[1] = unorm8_of_normal(ok ? float(ny * inv) : 0.0f);
+  rgba[2] = unorm8_of_normal(ok ? float(nz * inv) : 1.0f);
+  rgba[3] = 255;
+}
+
+inline void normals(const float* up, const float* row, const float* down, int w, double kx, double ky,
+                    std::uint8_t* rgba) {
+  const auto at = [&](int x, int left, int right) {
+    normal_texel(float(-kx * (double(row[right]) - row[left])), float(-ky * (double(down[x]) - up[x])), rgba + 4 * x);
+  };
+  at(0, w - 1, w > 1 ? 1 : 0);
+  for (int x = 1; x < w - 1; ++x) at(x, x - 1, x + 1);
+  if (w > 1) at(w - 1, w - 2, 0);
+}
+
+// reduce_box<true> on RGBA8: the taps' 2v - 1 summed per channel (alpha: v), renormalised.
+inline void box_normal_texel(const float* sum, float count, std::uint8_t* rgba) {
+  const double len2 = double(sum[0]) * sum[0] + double(sum[1]) * sum[1] + double(sum[2]) * sum[2];
+  const double inv = len2 > 0.0 ? 1.0 / std::sqrt(len2 > 0.0 ? len2 : 1.0) : 0.0;
+  rgba[0] = unorm8_of_normal(len2 > 0.0 ? float(sum[0] * inv) : 0.0f);
+  rgba[1] = unorm8_of_normal(len2 > 0.0 ? float(sum[1] * inv) : 0.0f);
+  rgba[2] = unorm8_of_normal(len2 > 0.0 ? float(sum[2] * inv) : 1.0f);
+  rgba[3] = std::uint8_t(int(code_of<255>(sum[3] / count)));
+}
+
+inline float unorm8(std::uint8_t c) { return float(c) / 255.0f; }
+
+inline void box_normals(const std::uint8_t* const* in, int rows, int in_w, int out_w, std::uint8_t* rgba) {
+  int x = 0;
+  if (in_w > 1 && rows == 2) {
+    const std::uint8_t *a = in[0], *b = in[1];
+    for (const int pairs = out_w - (in_w & 1); x < pairs; ++x) {
+      float sum[4];
+      for (int c = 0; c < 4; ++c) {
+        const float a0 = unorm8(a[8 * x + c]), a1 = unorm8(a[8 * x + 4 + c]), b0 = unorm8(b[8 * x + c]),
+                    b1 = unorm8(b[8 * x + 4 + c]);
+        sum[c] = c < 3 ? 0.0f + (2.0f * a0 - 1.0f) + (2.0f * a1 - 1.0f) + (2.0f * b0 - 1.0f) + (2.0f * b1 - 1.0f)
+                       : 0.0f + a0 + a1 + b0 + b1;
+      }
+      box_normal_texel(sum, 4.0f, rgba + 4 * x);
+    }
+  }
+  for (; x < out_w; ++x) {  // the rest, with the generic taps
+    const mip::Taps tx = mip::taps(x, in_w, out_w);
+    float sum[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int j = 0; j < rows; ++j)
+      for (int i = tx.first; i < tx.first + tx.count; ++i)
+        for (int c = 0; c < 4; ++c) {
+          const float v = unorm8(in[j][4 * i + c]);
+          sum[c] += c < 3 ? 2.0f * v - 1.0f : v;
+        }
+    box_normal_texel(sum, float(tx.count * rows), rgba + 4 * x);
+  }
+}
+
+inline void footprints(const float* row, const float* below, int w, float* out) {
+  for (int x = 0; x + 1 < w; ++x) {
+    out[4 * x] = row[x];
+    out[4 * x + 1] = row[x + 1];
+    out[4 * x + 2] = below[x];
+    out[4 * x + 3] = below[x + 1];
+  }
+  float* last = out + 4 * std::size_t(w - 1);
+  last[0] = row[w - 1], last[1] = row[0], last[2] = below[w - 1], last[3] = below[0];
+}
+
+// The table of this ISA's rows.
+inline const HeightRows& table() {
+  static constexpr HeightRows rows{&add_wave, &finish_waves, &quantise, &decode, &box, &normals, &box_normals,
+                                   &footprints};
+  return rows;
+}
+
+}  // namespace qdmr::QDMR_ISA_NAMESPACE::height_row_code
