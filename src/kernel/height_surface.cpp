@@ -19,6 +19,17 @@ SamplerState max_chain_state(SamplerState state) {
   return state;
 }
 
+InlineHeight inline_height_for(const SamplerKey& k) {
+  constexpr std::pair<SamplerKey, InlineHeight> kInline[] = {
+      {inline_height_key(TexelFormat::R16), InlineHeight::BilinearR16},
+      {inline_height_key(TexelFormat::R8), InlineHeight::BilinearR8},
+      {inline_height_key(TexelFormat::R16, 8), InlineHeight::BilinearR16Hw8},
+      {inline_height_key(TexelFormat::R8, 8), InlineHeight::BilinearR8Hw8}};
+  for (const auto& [key, inline_height] : kInline)
+    if (k == key) return inline_height;
+  return InlineHeight::None;
+}
+
 }  // namespace
 
 HeightLayerTextures::HeightLayerTextures(const Texture& height_texture, const Texture* quadtree,
@@ -28,9 +39,7 @@ HeightLayerTextures::HeightLayerTextures(const Texture& height_texture, const Te
       has_tree(quadtree != nullptr),
       sampler(material_sampler),
       fetch(height_fetch),
-      inline_height(height.key() == inline_height_key(TexelFormat::R16)  ? InlineHeight::BilinearR16
-                    : height.key() == inline_height_key(TexelFormat::R8) ? InlineHeight::BilinearR8
-                                                                         : InlineHeight::None),
+      inline_height(inline_height_for(height.key())),
       inline_max_chain(inline_load_for(tree.key())) {}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -19,15 +19,17 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // The height fetches inlined into the tracing loops (a call through the sampler's pointer would make each loop
 // spill its vector registers): bilinear 8- and 16-bit heights with wrap addressing on a power-of-two map, the
-// default fetch of the usual height map. Any other key calls its sampler.
-enum class InlineHeight : std::uint8_t { None, BilinearR8, BilinearR16 };
+// default fetch of the usual height map, with exact weights or 8-bit ones (precision hw8, math sm4 or exact: its
+// key's exact_texel). Any other key calls its sampler.
+enum class InlineHeight : std::uint8_t { None, BilinearR8, BilinearR16, BilinearR8Hw8, BilinearR16Hw8 };
 
-constexpr SamplerKey inline_height_key(TexelFormat format) {
+// fraction_bits: 0 (exact weights) or 8 (hw8).
+constexpr SamplerKey inline_height_key(TexelFormat format, int fraction_bits = 0) {
   SamplerKey k;
   k.filter = Filter::Bilinear;
   k.address = AddressMode::Wrap;
-  k.fraction_bits = 0;
-  k.exact_texel = false;
+  k.fraction_bits = fraction_bits;
+  k.exact_texel = fraction_bits > 0;
   k.format = format;
   k.srgb = false;
   k.fetch = simd::kHasHardwareGather ? simd::FetchPath::Gather : simd::FetchPath::Portable;
@@ -102,6 +104,12 @@ public:
         return sampling_code::sample_first<inline_height_key(TexelFormat::R16), Recorded>(t.view(), t.state(), u, v, lod);
       case InlineHeight::BilinearR8:
         return sampling_code::sample_first<inline_height_key(TexelFormat::R8), Recorded>(t.view(), t.state(), u, v, lod);
+      case InlineHeight::BilinearR16Hw8:
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R16, 8), Recorded>(t.view(), t.state(), u, v,
+                                                                                              lod);
+      case InlineHeight::BilinearR8Hw8:
+        return sampling_code::sample_first<inline_height_key(TexelFormat::R8, 8), Recorded>(t.view(), t.state(), u, v,
+                                                                                             lod);
       case InlineHeight::None: break;
     }
     simd::Float h[4];

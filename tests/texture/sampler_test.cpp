@@ -668,6 +668,44 @@ TEST(TextureSampler, CellMaxIsLoadWrapped) {
   }
 }
 
+// The heights the tracing loops read (SingleLayerSurface::height): inlined for bilinear R8 and R16 maps with exact or
+// 8-bit weights (the math modes whose key floors the exact texel coordinate for hw8), through the sampler
+// otherwise; the bits of the height sampler's first channel either way, including coordinates far out and non-finite.
+TEST(TextureSampler, SurfaceHeightIsTheHeightSamplers) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> coordinate(-3.0f, 3.0f);
+  for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16, TexelFormat::R32F})
+    for (const SamplePrecision precision : kPrecisions)
+      for (const MathMode math : kMathModes) {
+        Image img(32, 16, 1);
+        for (int y = 0; y < 16; ++y)
+          for (int x = 0; x < 32; ++x) img.at(x, y, 0) = float((x * 7 + y * 13) % 31) / 30.0f;
+        const Texture heights = make_mip_texture(img, format, false, MipReduce::Box);
+        SamplerState state;
+        state.precision = precision;
+        state.math = math;
+        const HeightLayerTextures textures(heights, nullptr, state, HeightFetch::Bilinear);
+        const bool inlined = format != TexelFormat::R32F && precision != SamplePrecision::Hw6 &&
+                             (precision == SamplePrecision::Exact || math != MathMode::Sm3);
+        EXPECT_EQ(textures.inline_height != InlineHeight::None, inlined)
+            << int(format) << " " << int(precision) << " " << int(math);
+        const SingleLayerSurface surface(textures);
+        for (int round = 0; round < 32; ++round) {
+          Lanes u, v;
+          for (int l = 0; l < kLanes; ++l) {
+            u[std::size_t(l)] = coordinate(rng);
+            v[std::size_t(l)] = coordinate(rng);
+          }
+          if (round == 0) u[0] = kNaN;
+          Float expected[4];
+          textures.height.sample(load(u), load(v), Float(0.0f), expected);
+          const Lanes want = lanes(expected[0]), got = lanes(surface.height(load(u), load(v), Float(0.0f)));
+          for (int l = 0; l < kLanes; ++l)
+            ASSERT_EQ(bits(got[std::size_t(l)]), bits(want[std::size_t(l)])) << int(format) << " lane " << l;
+        }
+      }
+}
+
 // A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler (their
 // rgb; the alphas are not sampled and are 1 on every path), for every sampler state, on both fetch paths, with and
 // without the albedo's decoded sRGB copy, with and without the two interleaved (twin_texels.hpp), power-of-two and
