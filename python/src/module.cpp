@@ -111,15 +111,6 @@ namespace {
 PyObject* scene_error = nullptr;  // qdmr.SceneError(ValueError)
 PyObject* input_error = nullptr;  // qdmr.InputError(OSError)
 
-// qdmr::Error is one type for every bad input; a message about a file that cannot be read is an InputError,
-// everything else (a field's value, a spec, a manifest) a SceneError.
-bool is_file_problem(const std::string& message) {
-  for (const char* sign : {"file not found", "cannot be accessed", "cannot open ", "cannot read ", "not a regular file",
-                           "is a directory", "cannot be written", "cannot write", "cannot create", "cannot load "})
-    if (message.find(sign) != std::string::npos) return true;
-  return false;
-}
-
 }  // namespace
 
 void raise_interrupt() {
@@ -515,8 +506,8 @@ PYBIND11_MODULE(_qdmr, m) {
       PyErr_SetString(input_error, e.what());
     } catch (const BadValue& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const qdmr::Error& e) {
-      PyErr_SetString(is_file_problem(e.what()) ? input_error : scene_error, e.what());
+    } catch (const qdmr::Error& e) {  // its kind: a file as a whole (InputError), or a value (SceneError)
+      PyErr_SetString(e.kind() == qdmr::Error::Kind::File ? input_error : scene_error, e.what());
     } catch (const Interrupted&) {
       try {
         raise_interrupt();

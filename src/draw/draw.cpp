@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "qdmr/core/progress.hpp"
+#include "qdmr/reference/reference_memo.hpp"
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
 #include "qdmr/texture/cache_model.hpp"
@@ -134,7 +135,8 @@ void summarise_cache(const TextureCacheDesc& desc, const TextureAddressMap& map,
 
 }  // namespace
 
-std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel) {
+std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
+                                                    ReferenceMemo* memo) {
   const LightRig lights = LightRig::from_scene(plan.scene);
   std::vector<std::unique_ptr<Program>> programs;
   for (const MaterialPlan& m : plan.materials) {
@@ -168,11 +170,12 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       inputs.surface = assets.derived[std::size_t(m.layers[0].field)].field.get();
     }
     if (m.reference) {
-      if (m.blend) {
-        inputs.reference = assets.derived[std::size_t(m.combined_surface)].field.get();
-        inputs.reference_scale = m.weights_scale;
-      } else {
-        inputs.reference = assets.derived[std::size_t(m.layers[0].field)].field.get();
+      const auto& field = assets.derived[std::size_t(m.blend ? m.combined_surface : m.layers[0].field)].field;
+      inputs.reference = field.get();
+      if (m.blend) inputs.reference_scale = m.weights_scale;
+      if (memo) {
+        inputs.reference_memo = memo;
+        inputs.reference_id = memo->field_id(field);
       }
     }
     programs.push_back(kernel.make_program(m.desc, inputs, lights));

@@ -22,8 +22,10 @@ struct DrawOptions {
   std::function<void(double fraction)> progress;
 };
 
-// One program per plan material, made by `kernel` from the prepared assets.
-std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel);
+// One program per plan material, made by `kernel` from the prepared assets; their exact reference hits are
+// remembered in `memo` when one is given.
+std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
+                                                    ReferenceMemo* memo = nullptr);
 
 // The per-triangle arrays of a frame (screen vertices and triangles, tile bins). Kept between draws (of
 // one scene or the next), their pages are reused: a frame of a million triangles otherwise faults in ~270 MB of

@@ -55,7 +55,7 @@ const Backend& load() {
     }
     tried += (tried.empty() ? "" : ", ") + path.string();
   }
-  throw Error("image I/O", std::string("cannot load ") + kModule + " (" + last_error + "; looked at " + tried +
+  throw FileError("image I/O", std::string("cannot load ") + kModule + " (" + last_error + "; looked at " + tried +
                                "; set QDMR_IMAGEIO_MODULE to its path)");
 }
 

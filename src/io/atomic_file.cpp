@@ -105,7 +105,7 @@ LockedTemporary create_temporary(const std::filesystem::path& file, const std::s
     t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (t.fd < 0) {
       if (errno == EEXIST) continue;
-      throw Error(file.string(), "cannot write " + what + ": cannot create a temporary file in its folder: " +
+      throw FileError(file.string(), "cannot write " + what + ": cannot create a temporary file in its folder: " +
                                      std::strerror(errno));
     }
     struct stat locked{}, named{};
@@ -114,7 +114,7 @@ LockedTemporary create_temporary(const std::filesystem::path& file, const std::s
       return t;
     ::close(t.fd);
   }
-  throw Error(file.string(), "cannot write " + what + ": no temporary file could be created and locked");
+  throw FileError(file.string(), "cannot write " + what + ": no temporary file could be created and locked");
 }
 
 // An image library's message ("File output failed") with the OS reason behind it where it has none: the errno
@@ -150,7 +150,7 @@ void OutputBatch::commit() {
   while (!pending_.empty()) {
     const Pending& p = pending_.front();
     std::filesystem::rename(p.temporary, p.target, ec);
-    if (ec) throw Error(p.target.string(), "cannot write: " + ec.message());  // the rest: the destructor's
+    if (ec) throw FileError(p.target.string(), "cannot write: " + ec.message());  // the rest: the destructor's
     ::close(p.lock);
     pending_.erase(pending_.begin());
   }
@@ -159,7 +159,7 @@ void OutputBatch::commit() {
 void write_atomically(const std::filesystem::path& file, const std::string& what,
                       const std::function<std::string(const std::filesystem::path&)>& write) {
   const std::filesystem::path folder = folder_of(file);
-  if (!std::filesystem::is_directory(folder)) throw Error(file.string(), "folder does not exist: " + folder.string());
+  if (!std::filesystem::is_directory(folder)) throw FileError(file.string(), "folder does not exist: " + folder.string());
   remove_stale_temporaries(file);
   const LockedTemporary temporary = create_temporary(file, what);
   std::string message;
@@ -185,7 +185,7 @@ void write_atomically(const std::filesystem::path& file, const std::string& what
   }
   std::filesystem::remove(temporary.path, ec);
   ::close(temporary.fd);
-  throw Error(file.string(), "cannot write " + what + ": " + message);
+  throw FileError(file.string(), "cannot write " + what + ": " + message);
 }
 
 void write_image_file(const std::filesystem::path& file, const imageio::WriteSpec& spec, const void* data,

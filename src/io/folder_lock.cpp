@@ -18,17 +18,17 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& w
     : folder_(folder), created_(created), exceptions_(std::uncaught_exceptions()) {
   const std::filesystem::path file = folder / kFileName;
   fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-  if (fd_ < 0) throw Error(file.string(), "cannot create the " + what + " lock: " + std::strerror(errno));
+  if (fd_ < 0) throw FileError(file.string(), "cannot create the " + what + " lock: " + std::strerror(errno));
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int error = errno;
     char holder[32] = {};
     const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
     ::close(fd_);
     if (error != EWOULDBLOCK)
-      throw Error(file.string(), "cannot lock the " + what + " folder: " + std::strerror(error));
+      throw FileError(file.string(), "cannot lock the " + what + " folder: " + std::strerror(error));
     std::string pid(holder, std::size_t(std::max<ssize_t>(n, 0)));
     pid.erase(pid.find_last_not_of(" \n") + 1);
-    throw Error(folder.string(), "is in use by another qdmr " + what + (pid.empty() ? "" : " (process " + pid + ")") +
+    throw FileError(folder.string(), "is in use by another qdmr " + what + (pid.empty() ? "" : " (process " + pid + ")") +
                                      ": wait until it ends, or choose another -o");
   }
   // The holder's id, for the message above (best effort: a full disk only loses the id).

@@ -103,12 +103,12 @@ std::string non_regular_reason(const std::filesystem::path& file) {
 std::uint64_t check_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
   struct stat st {};
   if (::stat(file.c_str(), &st) != 0) {
-    if (errno == ENOENT || errno == ENOTDIR) throw Error(where, about(file, where, "file not found"));
-    throw Error(where, about(file, where, std::string("cannot be accessed (") + std::strerror(errno) + ")"));
+    if (errno == ENOENT || errno == ENOTDIR) throw FileError(where, about(file, where, "file not found"));
+    throw FileError(where, about(file, where, std::string("cannot be accessed (") + std::strerror(errno) + ")"));
   }
   std::string reason = type_reason(st.st_mode);
   if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
-  if (!reason.empty()) throw Error(where, about(file, where, reason));
+  if (!reason.empty()) throw FileError(where, about(file, where, reason));
   note_identity({st.st_dev, st.st_ino}, file);
   return std::uint64_t(st.st_size);
 }
@@ -116,16 +116,16 @@ std::uint64_t check_input_file(const std::filesystem::path& file, const std::str
 std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
   check_input_file(file, where, kind);
   const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) throw Error(where, "cannot open " + shown_path(file) + ": " + std::strerror(errno));
+  if (fd < 0) throw FileError(where, "cannot open " + shown_path(file) + ": " + std::strerror(errno));
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw Error(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) != 0) throw FileError(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
   std::string reason = type_reason(st.st_mode);
   if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
-  if (!reason.empty()) throw Error(where, about(file, where, reason));
+  if (!reason.empty()) throw FileError(where, about(file, where, reason));
   // The size fstat gave, then a probe for more through a small buffer: a file that grew while it is read is
   // still read to its end, bounded by the limit + 1, and a file that did not grow costs no larger buffer.
   const std::uint64_t limit = input_size_limit(kind);
@@ -141,14 +141,14 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
     const ssize_t n = ::read(fd, into, room);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw Error(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
+      throw FileError(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
     }
     if (n == 0) break;
     if (probing) text.append(probe, std::size_t(n));
     have += std::size_t(n);
   }
   text.resize(have);
-  if (have > limit || have == 0) throw Error(where, about(file, where, size_reason(have, kind)));
+  if (have > limit || have == 0) throw FileError(where, about(file, where, size_reason(have, kind)));
   return text;
 }
 

@@ -9,6 +9,7 @@
 #include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
+#include "qdmr/reference/reference_memo.hpp"
 #include "qdmr/core/limits.hpp"
 #include "kernel/ambient_occlusion.hpp"
 #include "kernel/self_shadow.hpp"
@@ -46,7 +47,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
                      inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
                          ? kWeight0 + int(inputs.layers.size())
                          : kBaseVaryingCount),
-      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), surface_(inputs.surface),
+      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo), reference_id_(inputs.reference_id), surface_(inputs.surface),
       sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
       technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
       shadow_(material.shadow), ao_(material.ao), lights_(lights) {
@@ -135,7 +136,9 @@ void DisplacementProgram::trace_reference(const Ray& ray, const Float& ds, const
   for (int l = 0; l < kLanes; ++l) {
     if (!((lanes >> l) & 1u)) continue;
     const SurfaceRay r{{u0[l] * k, v0[l] * k, 0.0}, {du[l] * k, dv[l] * k, 1.0}};
-    per_lane(l, r, intersect_reference(*reference_, depth[l], r, surface, 1 << 16));
+    per_lane(l, r,
+             reference_memo_ ? reference_memo_->intersect(reference_id_, *reference_, depth[l], r, surface, 1 << 16)
+                             : intersect_reference(*reference_, depth[l], r, surface, 1 << 16));
   }
 }
 

@@ -156,6 +156,8 @@ private:
   const ConeMap* cones_;
   const HeightField* reference_;
   int reference_scale_;
+  ReferenceMemo* reference_memo_;
+  std::uint64_t reference_id_;
   const HeightField* surface_;
   SamplerState sampler_;
   LodMode lod_mode_;

@@ -50,6 +50,7 @@ struct Reading {
   std::string where;                     // for messages
   std::set<fs::path> image_files;        // external images: checked, never read by tinygltf
   std::string error;                     // the first qdmr error raised inside a callback
+  Error::Kind error_kind = Error::Kind::Value;  // ... and its kind
   const tinygltf::Model* model = nullptr;
   std::vector<std::string> embedded;     // per image: its bytes when stored in the asset (data: URI or buffer view)
 };
@@ -82,7 +83,10 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
     out->assign(bytes.begin(), bytes.end());
     return true;
   } catch (const Error& e) {
-    if (r.error.empty()) r.error = e.what();
+    if (r.error.empty()) {
+      r.error = e.what();
+      r.error_kind = e.kind();
+    }
     if (err) *err += e.what();
     return false;
   }
@@ -897,7 +901,7 @@ std::vector<std::string> prescan(const std::string& json_text, Reading& reading)
   try {
     doc = scene_detail::parse_json_bounded(json_text);
   } catch (const Error& e) {
-    throw Error(reading.where, e.what());
+    throw e.within(reading.where);
   } catch (const nlohmann::json::exception& e) {
     const std::string what = e.what();
     const auto start = what.find("parse error");
@@ -956,7 +960,7 @@ MeshData load_gltf(const MeshDesc& desc, const std::string& where, std::uint64_t
     throw Error(reading.where, std::string("tinygltf: ") + e.what());
   }
   std::string().swap(bytes);  // tinygltf holds its own copy of every buffer: the file is no longer needed
-  if (!reading.error.empty()) throw Error(reading.error);
+  if (!reading.error.empty()) throw Error(reading.error, reading.error_kind);
   if (!ok || !err.empty()) {
     std::string first = err.substr(0, err.find('\n'));
     if (first.empty()) first = "tinygltf could not read the asset";

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -139,7 +140,7 @@ public:
     try {
       text = read_input_file(file, where_, InputKind::Mtl);
     } catch (const Error& e) {
-      if (error_.empty()) error_ = e.what();
+      if (!error_) error_ = e;
       return false;
     }
     std::istringstream in(text);
@@ -149,13 +150,14 @@ public:
   }
 
   const std::string& missing() const { return missing_; }
-  const std::string& error() const { return error_; }
+  const std::optional<Error>& error() const { return error_; }
   const fs::path& folder_of(std::size_t material) const { return material_folders_.at(material); }
 
 private:
   fs::path folder_;
   std::string where_;
-  std::string missing_, error_;
+  std::string missing_;
+  std::optional<Error> error_;
   std::vector<fs::path> material_folders_;
 };
 
@@ -326,13 +328,13 @@ MeshData load_obj(const MeshDesc& desc, const std::string& where) {
   // Faces as they are (triangulate = false): tinyobjloader's own ear clipping misreads concave faces and takes
   // quadratic time and more; quads and larger faces are split below.
   const bool ok = tinyobj::LoadObj(&attrib, &shapes, &mtls, &warn, &err, &stream, &reader, false, false);
-  if (!reader.error().empty()) throw Error(reader.error());
+  if (reader.error()) throw *reader.error();
   if (!ok || !err.empty()) {
     while (!err.empty() && std::isspace(static_cast<unsigned char>(err.back()))) err.pop_back();
     throw Error(where, err.empty() ? "tinyobjloader failed to parse " + file.string() : err);
   }
   if (warn.find("Failed to load material file(s)") != std::string::npos)
-    throw Error(where, "material library not found: " + reader.missing());
+    throw FileError(where, "material library not found: " + reader.missing());
   if (const std::string line = first_line_containing(warn, "not found in .mtl"); !line.empty())
     throw Error(where, line);
 

@@ -1,6 +1,7 @@
 #pragma once
 // What a displacement program reads, made by prepare and handed to the draw kernel that builds the program:
 // textures, derived data and the exact reference of one material. ISA-independent.
+#include <cstdint>
 #include <vector>
 
 #include "qdmr/bake/cone_map.hpp"
@@ -9,6 +10,8 @@
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
+
+class ReferenceMemo;
 
 struct LayerInputs {
   const Texture* albedo = nullptr;      // RGBA8 sRGB
@@ -31,6 +34,8 @@ struct DisplacementInputs {
   const ConeMap* cones = nullptr;         // CSM (conservative) / RCSM (relaxed): one ratio per level-0 texel of height
   const HeightField* reference = nullptr; // level-0 heights in fp64, for error_texels / missed; may be null
   int reference_scale = 1;                // texture repeats the reference spans (a blend's combined surface)
+  ReferenceMemo* reference_memo = nullptr;  // remembers the reference's hits across frames, when set
+  std::uint64_t reference_id = 0;           // ... under this id (ReferenceMemo::field_id of the reference)
   // qdm with bilinear-patch refinement: the fp64 heights solved exactly, and height_max built from
   // bilinear_upper_bound() of them (conservative for the bilinear surface).
   const HeightField* surface = nullptr;

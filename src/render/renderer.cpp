@@ -256,7 +256,7 @@ void Renderer::prepare_plan(FramePlan plan, double plan_ms) {
   s.arena.execute([&] {
     Assets assets = prepare(plan, *s.kernel, &s.assets, s.plan ? &*s.plan : nullptr, prepare_progress, &s.spares);
     // Programs point into the new assets: make them before the old assets go.
-    std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel);
+    std::vector<std::unique_ptr<Program>> programs = make_programs(plan, assets, *s.kernel, s.options.reference_memo.get());
     s.programs = std::move(programs);
     // The previous frame's dynamic textures that nothing holds any more become the next frame's spares (the
     // spares this prepare did not take go).

@@ -34,7 +34,7 @@ nlohmann::json parse_value(const std::string& text, const std::string& where) {
   try {
     return parse_json_bounded(text);
   } catch (const Error& e) {
-    throw Error(where, e.what());
+    throw e.within(where);
   } catch (const nlohmann::json::exception&) {
     return nlohmann::json(text);
   }

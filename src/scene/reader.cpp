@@ -57,7 +57,7 @@ nlohmann::json parse_json_file(const std::filesystem::path& file, InputKind kind
   try {
     document = parse_json_bounded(contents);
   } catch (const Error& e) {
-    throw Error(name, e.what());
+    throw e.within(name);
   } catch (const nlohmann::json::exception& e) {
     // what() is "[json.exception.parse_error.N] parse error at line L, column C: ..."; keep from "parse error".
     // Other exceptions of the parser (a number too large for a double: out_of_range.406) lose the bracket.
@@ -116,8 +116,8 @@ std::string escape_pointer_token(std::string_view token) {
   return out;
 }
 
-void Value::fail(const std::string& what) const {
-  throw Error(context_->file + ": " + (pointer_.empty() ? "/" : pointer_), what);
+void Value::fail(const std::string& what, Error::Kind kind) const {
+  throw Error(context_->file + ": " + (pointer_.empty() ? "/" : pointer_), what, kind);
 }
 
 void Value::expect_type(nlohmann::json::value_t type, std::string_view description) const {
@@ -208,8 +208,9 @@ std::filesystem::path Value::existing_file() const {
   if (!path.has_filename()) path = path.parent_path();  // "dir/." normalises to "dir/"
   // Devices, FIFOs and sockets are refused here, before anything opens them; sizes are checked when read.
   const std::string reason = non_regular_reason(path);
-  if (reason == "file not found" || reason == "is a directory, not a file") fail(reason + ": " + shown_path(path));
-  if (!reason.empty()) fail(shown_path(path) + " " + reason);
+  if (reason == "file not found" || reason == "is a directory, not a file")
+    fail(reason + ": " + shown_path(path), Error::Kind::File);
+  if (!reason.empty()) fail(shown_path(path) + " " + reason, Error::Kind::File);
   note_input(path);
   return path;
 }

@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "qdmr/core/error.hpp"
+
 #include "io/input_file.hpp"
 
 namespace qdmr::scene_detail {
@@ -52,7 +54,7 @@ public:
   const std::string& pointer() const { return pointer_; }
   const Context& context() const { return *context_; }
 
-  [[noreturn]] void fail(const std::string& what) const;
+  [[noreturn]] void fail(const std::string& what, Error::Kind kind = Error::Kind::Value) const;
   void require(bool ok, const std::string& what) const {
     if (!ok) fail(what);
   }

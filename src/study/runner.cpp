@@ -24,6 +24,7 @@
 #include "qdmr/core/version.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
+#include "qdmr/reference/reference_memo.hpp"
 #include "qdmr/render/render.hpp"
 #include "qdmr/study/study.hpp"
 #include "qdmr/write/write.hpp"
@@ -42,9 +43,10 @@ std::string cpu_model() {
   return "unknown";
 }
 
-RenderOptions with_threads(int threads) {
+RenderOptions with_threads(int threads, std::shared_ptr<ReferenceMemo> memo = nullptr) {
   RenderOptions options;
   options.threads = threads;
+  options.reference_memo = std::move(memo);
   return options;
 }
 
@@ -95,12 +97,13 @@ private:
 };
 
 // One configuration's row: everything deterministic from a frame without AOVs (timing) and one with the error
-// AOVs, against the baseline's colour.
+// AOVs, against the baseline's colour. The untimed frames remember the exact reference's hits: a configuration's
+// error AOVs and reference image trace the same rays, and so do configurations that differ only in sampling.
 class Measurer {
 public:
   Measurer(const StudySpec& spec, const SceneSource& source, int threads)
-      : spec_(spec), source_(source), timing_(with_threads(threads)), measuring_(with_threads(threads)),
-        baseline_renderer_(with_threads(threads)) {}
+      : spec_(spec), source_(source), timing_(with_threads(threads)),
+        measuring_(with_threads(threads, std::make_shared<ReferenceMemo>())), baseline_renderer_(with_threads(threads)) {}
 
   // The colour of the baseline configuration for `config`: its values with the spec's baseline values put in
   // (the other axes stay, so each row is compared at its own angle, depth, ...). Rendered once per distinct one.
@@ -287,7 +290,7 @@ nlohmann::ordered_json make_header(const StudySpec& spec, std::size_t configurat
 // folder's lock appends.
 void append_line(const std::filesystem::path& file, const std::string& line) {
   const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(file.string(), std::string("cannot open for appending: ") + std::strerror(errno));
+  if (fd < 0) throw FileError(file.string(), std::string("cannot open for appending: ") + std::strerror(errno));
   struct stat before{};
   const bool sized = ::fstat(fd, &before) == 0;
   const std::string text = line + "\n";
@@ -296,7 +299,7 @@ void append_line(const std::filesystem::path& file, const std::string& line) {
   if (written != ssize_t(text.size()) && written > 0 && sized) static_cast<void>(::ftruncate(fd, before.st_size));
   ::close(fd);
   if (written != ssize_t(text.size()))
-    throw Error(file.string(), std::string("cannot append a row: ") +
+    throw FileError(file.string(), std::string("cannot append a row: ") +
                                    (written < 0 ? std::strerror(error) : "short write (disk full?)"));
 }
 
@@ -309,7 +312,7 @@ std::vector<StudyRow> rows_to_resume(const std::filesystem::path& file) {
   std::vector<StudyRow> rows = read_study_rows(file, &valid);
   if (std::filesystem::file_size(file, ec) != valid || ec) {
     std::filesystem::resize_file(file, valid, ec);
-    if (ec) throw Error(file.string(), "cannot cut its half-written last row: " + ec.message());
+    if (ec) throw FileError(file.string(), "cannot cut its half-written last row: " + ec.message());
   }
   return rows;
 }
@@ -388,7 +391,7 @@ StudyRow StudyMeasurer::measure(std::size_t index, const std::filesystem::path& 
   try {
     return s.measurer.measure(config, scene, out / "images", s.camera);
   } catch (const Error& e) {
-    throw Error(study_label(s.spec, config), e.what());
+    throw e.within(study_label(s.spec, config));
   }
 }
 
@@ -431,7 +434,7 @@ StudyFolder::StudyFolder(const StudySpec& spec, const std::filesystem::path& out
     : state_([&] {
         std::error_code made;
         const bool created = std::filesystem::create_directories(out, made);
-        if (made) throw Error(out.string(), "cannot create the results folder: " + made.message());
+        if (made) throw FileError(out.string(), "cannot create the results folder: " + made.message());
         return std::make_unique<State>(out, created);
       }()) {
   State& s = *state_;
@@ -445,7 +448,7 @@ StudyFolder::StudyFolder(const StudySpec& spec, const std::filesystem::path& out
     try {
       old = nlohmann::ordered_json::parse(std::ifstream(header_file));
     } catch (const nlohmann::json::exception&) {
-      throw Error(header_file.string(), "unreadable: cannot resume (remove the folder to start again)");
+      throw FileError(header_file.string(), "unreadable: cannot resume (remove the folder to start again)");
     }
     if (old.value("spec_hash", "") != spec.hash)
       throw Error(out.string(), "holds results of another spec (" + old.value("spec_hash", std::string("?")) + ", this one is " +
@@ -581,7 +584,7 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
     try {
       h = nlohmann::ordered_json::parse(std::ifstream(file));
     } catch (const nlohmann::json::exception&) {
-      throw Error(file.string(), "missing or unreadable: not a study folder");
+      throw FileError(file.string(), "missing or unreadable: not a study folder");
     }
     if (header.is_null()) {
       header = h;
@@ -617,7 +620,7 @@ void merge_studies(const std::vector<std::filesystem::path>& shards, const std::
   header["shard"] = {1, 1};
   std::error_code made;
   const bool created = std::filesystem::create_directories(out, made);
-  if (made) throw Error(out.string(), "cannot create the merged folder: " + made.message());
+  if (made) throw FileError(out.string(), "cannot create the merged folder: " + made.message());
   const FolderLock lock_folder(out, "study merge", created);
   write_text_file(out / "study.json", header.dump(2) + "\n");
   std::sort(rows.begin(), rows.end(),

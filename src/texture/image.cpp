@@ -264,7 +264,7 @@ Error read_error(const std::string& where, const std::filesystem::path& file, st
     message.replace(at, 1, "; ");
   }
   if (message.empty()) message = "the decoder stopped without saying why (damaged or missing pixel data)";
-  return Error(where, "cannot read '" + shown_path(file) + "': " + message);
+  return FileError(where, "cannot read '" + shown_path(file) + "': " + message);
 }
 
 // The file checked before it is opened (kind, size, an OpenEXR header, PNG chunks, PNM fields): its size.

@@ -1,6 +1,11 @@
 # Studies on a Dask cluster: a LocalCluster of 2 single-thread worker processes draws the configurations, one task
 # each, with one persistent measurer per worker; the rows equal a one-process run's (deterministic columns bit for
-# bit: JSON numbers of the same doubles), and an interrupted run resumes. The `if __name__ == "__main__"` guard that LocalCluster needs is pytest's own module.
+# bit: JSON numbers of the same doubles), and an interrupted run resumes. The same through a scheduler and workers
+# started as separate commands, as a batch job starts them. The `if __name__ == "__main__"` guard that LocalCluster needs is pytest's own module.
+import os
+import subprocess
+import sys
+
 import pytest
 
 import qdmr
@@ -52,3 +57,51 @@ def test_an_interrupted_dask_run_resumes(client, tmp_path):
     resumed = qdmr.study.run(SPEC, out, client=client)
     assert resumed["resumed"] == 2 and resumed["rendered"] == 4
     assert [r["index"] for r in qdmr.study.load(out)] == list(range(6))
+
+
+def test_any_client_scheduler_and_workers_started_as_commands(tmp_path):
+    # The shape of a cluster job (dask-jobqueue's Slurm script, a Kubernetes pod): a scheduler process writes its
+    # address to a shared file, worker processes started apart (each under its nanny) connect through it, and the
+    # caller's Client does too. qdmr.study.run only sees the Client.
+    scheduler_file = tmp_path / "scheduler.json"
+    command = [sys.executable, "-m"]
+    started = [subprocess.Popen(command + ["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                                           "--no-dashboard", "--scheduler-file", str(scheduler_file)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        for _ in range(2):
+            started.append(subprocess.Popen(
+                command + ["distributed.cli.dask_worker", "--scheduler-file", str(scheduler_file), "--nthreads", "1",
+                           "--no-dashboard", "--death-timeout", "60"],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=os.environ.copy()))
+        with distributed.Client(scheduler_file=str(scheduler_file), timeout="60s") as client:
+            client.wait_for_workers(2, timeout=60)
+            spread = qdmr.study.run(SPEC, tmp_path / "dask", client=client)
+        assert spread["processes"] == 2 and spread["rendered"] == 6
+        one = qdmr.study.run(SPEC, tmp_path / "one", threads=1)
+        assert deterministic(qdmr.study.load(tmp_path / "dask")) == deterministic(qdmr.study.load(tmp_path / "one"))
+        assert one["total"] == 6
+    finally:
+        for process in reversed(started):  # the workers first, then the scheduler
+            process.terminate()
+        for process in started:
+            process.wait(timeout=60)
+
+
+def test_the_cluster_snippets_call_only_the_documented_api():
+    # docs/python.md's dask-jobqueue and dask-kubernetes snippets cannot run here (neither package is in Debian):
+    # what can be checked is that they are Python and call qdmr.study.run as it is, with a client.
+    import ast
+    import inspect
+    from conftest import SOURCE_DIR
+    text = open(os.path.join(SOURCE_DIR, "docs", "python.md")).read()
+    blocks = [b.split("\n", 1)[1] for b in text.split("```")[1::2] if b.startswith("python\n")]
+    snippets = [b for b in blocks if "dask_jobqueue" in b or "dask_kubernetes" in b]
+    assert snippets
+    run = inspect.signature(qdmr.study.run)
+    calls = [node for tree in map(ast.parse, snippets) for node in ast.walk(tree)
+             if isinstance(node, ast.Call) and ast.unparse(node.func) == "qdmr.study.run"]
+    assert calls
+    for call in calls:
+        run.bind(*[None] * len(call.args), **{k.arg: None for k in call.keywords})  # TypeError when they differ
+        assert "client" in {k.arg for k in call.keywords}

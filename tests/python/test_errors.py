@@ -46,6 +46,35 @@ def test_bad_scene_dict_names_the_field():
         qdmr.load_scene(scene, base_dir=SOURCE_DIR)
 
 
+def with_mesh(path):
+    scene = json.load(open(PLANE))
+    scene["objects"][0]["mesh"] = {"type": "obj", "file": str(path)}
+    return scene
+
+
+def test_the_exception_follows_the_kind_of_error_not_its_words(tmp_path):
+    scenes = os.path.dirname(PLANE)
+    # A value whose words sound like a file problem is still a bad value ...
+    with pytest.raises(qdmr.SceneError, match="cannot read file not found"):
+        qdmr.load_scene(PLANE, {"/materials/bricks/technique/name": "cannot read file not found"})
+    # ... and a mesh file's content is a value too (the OBJ reader's message says "cannot read")
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n")
+    with pytest.raises(qdmr.SceneError, match="cannot read the face index 'x'"):
+        qdmr.load_scene(with_mesh(bad), base_dir=scenes)
+    # A file refused as a whole is an InputError whatever its message says: empty, a missing material library.
+    empty = tmp_path / "empty.json"
+    empty.write_text("")
+    with pytest.raises(qdmr.InputError, match="empty.json.*is empty"):
+        qdmr.load_scene(empty)
+    no_mtl = tmp_path / "no_mtl.obj"
+    no_mtl.write_text("mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(qdmr.InputError, match="material library not found: .*absent.mtl"):
+        qdmr.load_scene(with_mesh(no_mtl), base_dir=scenes)
+    with pytest.raises(qdmr.InputError, match="absent.obj"):
+        qdmr.load_scene(with_mesh(tmp_path / "absent.obj"), base_dir=scenes)
+
+
 def test_argument_types_name_the_parameter(tmp_path):
     cases = [
         (lambda: qdmr.load_scene(3), "scene"),
@@ -117,10 +146,14 @@ def test_bad_specs_and_manifests(tmp_path):
         qdmr.study.run({**SPEC, "widht": 3}, tmp_path / "s")
     with pytest.raises(qdmr.InputError, match="nope.json"):
         qdmr.study.run(tmp_path / "nope.json", tmp_path / "s")
+    with pytest.raises(qdmr.InputError, match="/scene: file not found: .*absent.json"):
+        qdmr.study.run({**SPEC, "scene": str(tmp_path / "absent.json")}, tmp_path / "s")
     manifest = tmp_path / "m.json"
     manifest.write_text(json.dumps({"bits_version": qdmr.bits_version, "checks": [{"name": "a b", "scene": PLANE}]}))
     with pytest.raises(qdmr.SceneError, match="/checks/0/name"):
         qdmr.check.run(manifest)
     with pytest.raises(qdmr.InputError):
         qdmr.study.load(tmp_path)
+    with pytest.raises(qdmr.InputError, match="m.json: cannot create the results folder"):
+        qdmr.study.run(SPEC, manifest)  # a file where the results folder would be
     assert sorted(os.listdir(tmp_path)) == ["m.json"]

@@ -23,6 +23,7 @@
 namespace qdmr {
 
 struct FramePlan;
+class ReferenceMemo;
 
 struct RenderOptions {
   int threads = 0;       // 0 = every core
@@ -35,6 +36,9 @@ struct RenderOptions {
   // Called with a stage name ("prepare", "raster") and the fraction done, from any worker thread,
   // never concurrently with itself. Optional.
   std::function<void(const char* stage, double fraction)> progress;
+  // Remembers the exact reference's hits (error AOVs, exact_hits) across frames and renderers that share it
+  // (qdmr/reference/reference_memo.hpp): the same bits, computed once. Optional.
+  std::shared_ptr<ReferenceMemo> reference_memo;
 };
 
 // Throws qdmr::Error("--threads" / "--tile" / "--isa", ...) when options are out of range or the ISA is unusable.
