@@ -9,11 +9,11 @@ find_package(nlohmann_json CONFIG REQUIRED)
 find_package(tinyobjloader CONFIG REQUIRED)  # reports "2rc10": no version argument
 find_package(TinyGLTF 2.7 CONFIG REQUIRED)  # glTF 2.0 (mesh/gltf.cpp); its images go through qdmr's readers
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)  # SHA-1 (core/sha1.hpp); FindOpenSSL, Debian ships no config
-find_package(PNG REQUIRED)  # io/png_writer.hpp: PNG output without the image module; FindPNG
-find_package(JPEG REQUIRED)  # imageio/native_reader.hpp: JPEG textures without the image module; FindJPEG
+find_package(PNG REQUIRED)  # codec/png_writer.hpp: PNG output without the image module; FindPNG
+find_package(JPEG REQUIRED)  # codec/native_reader.hpp: JPEG textures without the image module; FindJPEG
 find_package(TIFF REQUIRED)  # ... and most TIFF textures; FindTIFF
 find_package(OpenEXR CONFIG REQUIRED)  # ... and OpenEXR textures
-# io/png_writer.hpp: the PNG's pixel data compressed by ISA-L's igzip by default (about 2.5 times libdeflate's
+# codec/png_writer.hpp: the PNG's pixel data compressed by ISA-L's igzip by default (about 2.5 times libdeflate's
 # fastest level) or by libdeflate for the smallest file; Debian's libisal-dev and libdeflate-dev ship pkg-config
 # files only.
 find_package(PkgConfig REQUIRED)

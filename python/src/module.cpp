@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "common.hpp"
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/core/version.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common.hpp"
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/check/manifest.hpp"
 #include "qdmr/core/error.hpp"

@@ -9,7 +9,7 @@
 #include "qdmr/bake/cone_map.hpp"
 #include "bake/content_hash.hpp"
 #include "bake/float_cache.hpp"
-#include "io/atomic_file.hpp"
+#include "codec/image_file.hpp"
 #include "qdmr/core/error.hpp"
 
 namespace qdmr {

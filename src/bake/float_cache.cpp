@@ -5,8 +5,8 @@
 #include <string>
 
 #include "bake/content_hash.hpp"
-#include "io/atomic_file.hpp"
-#include "io/input_file.hpp"
+#include "file/atomic_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/warning.hpp"

@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "imageio/backend.hpp"
+#include "codec/backend.hpp"
 
 namespace qdmr {
 namespace {

@@ -5,7 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "io/atomic_file.hpp"
+#include "codec/image_file.hpp"
+#include "file/atomic_file.hpp"
 #include "qdmr/check/compare.hpp"
 #include "qdmr/write/write.hpp"
 

@@ -4,7 +4,7 @@
 #include <set>
 #include <sstream>
 
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/aov.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"

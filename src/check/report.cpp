@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "io/atomic_file.hpp"
+#include "file/atomic_file.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/core/version.hpp"
 

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "check/diff_folder.hpp"
-#include "io/atomic_file.hpp"
-#include "io/os_error.hpp"
+#include "file/atomic_file.hpp"
+#include "file/os_error.hpp"
 #include "qdmr/check/canonical_hash.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/core/error.hpp"

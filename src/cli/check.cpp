@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "check/diff_folder.hpp"
-#include "io/output_check.hpp"
+#include "file/output_check.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/check/compare.hpp"
 #include "qdmr/core/error.hpp"

@@ -19,12 +19,12 @@
 #include "cli/check.hpp"
 #include "cli/frame_range.hpp"
 #include "cli/interrupt.hpp"
-#include "io/os_error.hpp"
+#include "file/os_error.hpp"
 #include "cli/report.hpp"
 #include "cli/step_progress.hpp"
 #include "cli/study.hpp"
-#include "io/atomic_file.hpp"
-#include "io/output_check.hpp"
+#include "file/atomic_file.hpp"
+#include "file/output_check.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/limits.hpp"
@@ -97,7 +97,7 @@ qdmr::Aov aov_from(const std::string& name) {
   throw qdmr::Error("--aov", "unknown AOV '" + name + "' (valid: " + valid + ")");
 }
 
-// The image type of an output; where it may be written is checked by check_outputs (io/output_check.hpp).
+// The image type of an output; where it may be written is checked by check_outputs (file/output_check.hpp).
 void check_output_type(const std::string& option, const std::filesystem::path& out) {
   std::string ext = out.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "scene/overrides.hpp"

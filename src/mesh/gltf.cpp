@@ -18,8 +18,8 @@
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 
-#include "io/atomic_file.hpp"
-#include "io/input_file.hpp"
+#include "file/atomic_file.hpp"
+#include "file/input_file.hpp"
 #include "mesh/builders.hpp"
 #include "mesh/gltf_files.hpp"
 #include "mesh/mikktspace.hpp"

@@ -17,7 +17,7 @@
 
 #include "mesh/builders.hpp"
 #include "mesh/triangulate.hpp"
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/texture/image.hpp"

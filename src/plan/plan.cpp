@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "imageio/native_reader.hpp"
+#include "codec/native_reader.hpp"
 #include "program/variant.hpp"
 #include "raster/framebuffer.hpp"
 #include "qdmr/bake/ao_map.hpp"
@@ -600,7 +600,7 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
 }
 
 // Whether building the frame reads an image file through the image module (the `qdmr` command then loads it):
-// PNG, JPEG, OpenEXR, PBM/PGM/PPM and most TIFF files are read in process (imageio/native_reader.hpp).
+// PNG, JPEG, OpenEXR, PBM/PGM/PPM and most TIFF files are read in process (codec/native_reader.hpp).
 bool reads_image_files(const SceneDesc& scene, const FramePlan& plan) {
   const auto through_module = [](const TextureDesc& d) {
     return d.source == TextureSource::File && !imageio::read_natively(d.file.string());

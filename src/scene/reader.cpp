@@ -8,7 +8,7 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 
 namespace qdmr::scene_detail {
 

@@ -13,7 +13,7 @@
 
 #include "qdmr/core/error.hpp"
 
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 
 namespace qdmr::scene_detail {
 

@@ -5,7 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "io/atomic_file.hpp"
+#include "file/atomic_file.hpp"
 
 namespace qdmr {
 namespace {

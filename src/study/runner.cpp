@@ -15,8 +15,8 @@
 #include <set>
 #include <thread>
 
-#include "io/atomic_file.hpp"
-#include "io/folder_lock.hpp"
+#include "file/atomic_file.hpp"
+#include "file/folder_lock.hpp"
 #include "qdmr/check/canonical_hash.hpp"
 #include "qdmr/check/compare.hpp"
 #include "qdmr/core/error.hpp"

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "core/sha1.hpp"
-#include "io/input_file.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 #include "scene/reader.hpp"

@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "imageio/backend.hpp"
-#include "io/input_file.hpp"
+#include "codec/backend.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
 

@@ -10,8 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/atomic_file.hpp"
-#include "io/png_writer.hpp"
+#include "file/atomic_file.hpp"
+#include "codec/image_file.hpp"
+#include "codec/png_writer.hpp"
 #include "qdmr/core/pixel_buffer.hpp"
 #include "qdmr/core/version.hpp"
 #include "qdmr/core/error.hpp"

@@ -24,7 +24,7 @@ constexpr const char* kScene = R"({
   "objects": [{"mesh": {"type": "plane"}, "material": "rock"}]
 })";
 
-// The temporaries of `target` in its folder (".<name>.tmp<pid>-<n><ext>", see io/atomic_file.cpp).
+// The temporaries of `target` in its folder (".<name>.tmp<pid>-<n><ext>", see file/atomic_file.cpp).
 std::vector<fs::path> temporaries_of(const fs::path& target) {
   std::vector<fs::path> found;
   std::string prefix = ".";  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + string

@@ -1,4 +1,4 @@
-// The command loads OpenImageIO (libqdmr_imageio.so, src/imageio/lazy.cpp) only when a job reads or writes an
+// The command loads OpenImageIO (libqdmr_imageio.so, src/codec/lazy.cpp) only when a job reads or writes an
 // image: a missing module must not matter to anything else, and must be one clear error where an image is needed.
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "cli/cli_test_util.hpp"
 #include "support/converted_tiff.hpp"
-#include "imageio/backend.hpp"
+#include "codec/backend.hpp"
 #include "qdmr/core/version.hpp"
 #include "write/srgb_encode.hpp"
 
@@ -46,7 +46,7 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
                                                (dir / "b.bin").string()});
   // bench writes its one image through the module: without it, a clear error and nothing written.
   EXPECT_EQ(bench.exit_code, 2) << bench.output;
-  // 8-bit PNG output is written with libpng directly (io/png_writer.hpp): no module needed.
+  // 8-bit PNG output is written with libpng directly (codec/png_writer.hpp): no module needed.
   const CommandResult png = run(cli(), {"render", plane, "-o", (dir / "p.png").string(), "--width", "32",
                                              "--height", "18"});
   EXPECT_EQ(png.exit_code, 0) << png.output;
@@ -59,7 +59,7 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
   // PNG, JPEG, OpenEXR, PGM, PFM and TIFF (of the layouts OpenImageIO passes through) textures are read in process
-  // (imageio/native_reader.hpp): planned and rendered without the module. A TIFF that OpenImageIO converts needs
+  // (codec/native_reader.hpp): planned and rendered without the module. A TIFF that OpenImageIO converts needs
   // it, and says so.
   const std::filesystem::path images = source_dir() / "tests/bad_inputs/files/images";
   const auto albedo = [&](const char* file) { return "/materials/bricks/layers/0/albedo=" + (images / file).string(); };

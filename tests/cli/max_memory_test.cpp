@@ -242,7 +242,7 @@ TEST(MaxMemory, ThePlanCountsTheImageLibraryWhenAFileIsRead) {
     EXPECT_NE(plan.describe().find("image library 48.00 MiB (to read image files)"), std::string::npos)
         << plan.describe();
   }
-  // PNG, JPEG, OpenEXR, PGM, PFM and most TIFF files are read in process (imageio/native_reader.hpp): no image
+  // PNG, JPEG, OpenEXR, PGM, PFM and most TIFF files are read in process (codec/native_reader.hpp): no image
   // library to count.
   const std::filesystem::path images = std::filesystem::path(QDMR_SOURCE_DIR) / "tests/bad_inputs/files/images";
   write_file(dir / "grey.pgm", "P5\n4 4\n255\n" + std::string(16, char(100)));

@@ -19,7 +19,7 @@ import pytest
 QDMR = os.environ["QDMR"]
 SOURCE = os.environ["QDMR_SOURCE_DIR"]
 PLANE = os.path.join(SOURCE, "scenes", "plane.json")
-TEMPORARY = re.compile(r"^\..*\.tmp\d+-\d+|^\.report-")  # io/atomic_file.hpp's and the report's temporaries
+TEMPORARY = re.compile(r"^\..*\.tmp\d+-\d+|^\.report-")  # file/atomic_file.hpp's and the report's temporaries
 
 
 def env(**extra):

@@ -63,7 +63,7 @@ if(NOT header STREQUAL "000000a00000005a")
 endif()
 message(STATUS "installed qdmr works: ${image}")
 
-# The installed command loads its image module from lib/qdmr/ relative to itself (src/imageio/lazy.cpp): an
+# The installed command loads its image module from lib/qdmr/ relative to itself (src/codec/lazy.cpp): an
 # OpenEXR output goes through it (PNG is written, and PNG and JPEG textures are read, without it).
 set(command_image "${WORK_DIR}/command.exr")
 run("${prefix}/bin/qdmr" render "${SOURCE_DIR}/scenes/plane.json" -o "${command_image}" --width 48 --height 32)

@@ -33,7 +33,7 @@ struct Image {
 // Every check on the file and its header is made before any pixel is decoded (see docs/scene-format.md, "What
 // qdmr accepts as an input file"): a regular file within the size limit, PNG, JPEG, OpenEXR, TIFF or PNM,
 // 1..16384 pixels a side, 1 to 4 channels, sane PNM fields, a JPEG with whole segments and its end marker (its
-// metadata segments are dropped unread: imageio/jpeg_segments.hpp). Then a decoder error or warning, or a short
+// metadata segments are dropped unread: codec/jpeg_segments.hpp). Then a decoder error or warning, or a short
 // read, is an error too: never a partial image.
 Image read_image(const std::filesystem::path& file, const std::string& where);
 
