@@ -18,7 +18,7 @@
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "kernel/ambient_occlusion.hpp"
 #include "kernel/height_surface.hpp"
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "qdmr/texture/bc3.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace {
 

@@ -16,7 +16,7 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/image.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace {
 

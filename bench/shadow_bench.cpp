@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "qdmr/texture/mip_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/self_shadow.hpp"
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: a check manifest read and validated by qdmr::read_manifest (the path `qdmr check MANIFEST`
-// takes), then, for its first checks, what the check runner does before it renders (check/runner.cpp,
+// takes), then, for its first checks, what the check runner does before it renders (check/check.cpp,
 // CheckJob::run_check): the check's scene loaded with its overrides and size. Input: the manifest JSON, written
 // as manifest.json next to a valid scene.json (fuzz_util.hpp), which the seeds' checks name.
 #include <cstddef>

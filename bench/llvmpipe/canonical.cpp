@@ -4,7 +4,7 @@
 //            + - * / sqrt floor only, so the same bits on every machine), size 512, cells 8, seed 1,
 //            mortar 0.08; stored as r16 (round to nearest of h * 65535) and sampled as code / 65535;
 //   max chain: each texel of level k + 1 the largest of its 2x2 texels of level k (qdmr's max-quadtree);
-//   normals: "from_height", central differences of the stored heights with wrap (src/texture/texture.cpp);
+//   normals: "from_height", central differences of the stored heights with wrap (src/texture/texture_level0.cpp);
 //   albedo: lerp(color_low, color_high, h) times the per-stone brightness jitter, sRGB 8-bit.
 // Normals and albedo only colour the image (the texel check compares hit UVs; their content does not change
 // what a fetch costs), and their mip chains are glGenerateMipmap's rather than qdmr's box chains.
@@ -108,7 +108,7 @@ std::uint8_t srgb8(float linear) {
   return unorm8(v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f);
 }
 
-// qdmr's normals_from_height (src/texture/texture.cpp) on the stored heights, as RGBA8 0.5 + 0.5 n.
+// qdmr's normals_from_height (src/texture/texture_level0.cpp) on the stored heights, as RGBA8 0.5 + 0.5 n.
 std::vector<std::uint8_t> normals_from_height(const std::vector<float>& h, int side) {
   std::vector<std::uint8_t> out(std::size_t(side) * std::size_t(side) * 4);
   const double k = kFromHeightDepth * side * 0.5;

@@ -8,7 +8,7 @@
 #include <glm/vec2.hpp>
 
 #include "mesh/builders.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace qdmr::mesh_detail {
 

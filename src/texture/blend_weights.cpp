@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace qdmr {
 namespace {

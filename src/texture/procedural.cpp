@@ -15,7 +15,7 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "texture/height_rows_code.hpp"
 #include "texture/internal.hpp"
 

@@ -20,7 +20,7 @@ nlohmann::json reference_stats(const std::string& weight_mode) {
 
 TEST(CliBlendReference, VertexWeightsFloatPixelWeightsAreExact) {
   const nlohmann::json pixel = reference_stats("pixel"), vertex = reference_stats("vertex");
-  // QDMHB over the box surface of the blend is exact (tests/shade/height_blend_test.cpp); what is left are rays
+  // QDMHB over the box surface of the blend is exact (tests/kernel/height_blend_test.cpp); what is left are rays
   // that reach the 128-iteration cap near the horizon (measured 0.07% at 1920x1080).
   EXPECT_LT(pixel.at("missed_fraction").get<double>(), 0.005);
   // At depth scale 0.15 the weights change along most view rays (measured 57% off by more than a texel).

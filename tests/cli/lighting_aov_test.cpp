@@ -11,7 +11,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "cli/cli_test_util.hpp"
-#include "shade/displacement_test_util.hpp"
+#include "kernel/displacement_test_util.hpp"
 
 namespace qdmr::test {
 namespace {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/cli_test_util.hpp"
-#include "shade/displacement_test_util.hpp"
+#include "kernel/displacement_test_util.hpp"
 
 namespace qdmr::test {
 namespace {

@@ -21,7 +21,7 @@
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/render/render.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "support/frames.hpp"
 
 namespace qdmr::test {

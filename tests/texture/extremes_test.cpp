@@ -16,7 +16,7 @@
 #include <random>
 #include <vector>
 
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "texture/reference_sampler.hpp"
 #include "kernel/sampler.hpp"
 

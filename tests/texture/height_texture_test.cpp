@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "qdmr/texture/height_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace qdmr {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/image.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "support/test_support.hpp"
 #include "texture/internal.hpp"
 

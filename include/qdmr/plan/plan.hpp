@@ -14,7 +14,7 @@
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/format.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 
 namespace qdmr {
 

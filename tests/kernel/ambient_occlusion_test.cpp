@@ -12,7 +12,7 @@
 
 #include "qdmr/bake/ao_map.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "kernel/ambient_occlusion.hpp"
 #include "bake/ao_pattern.hpp"
 #include "kernel/height_surface.hpp"

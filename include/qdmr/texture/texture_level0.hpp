@@ -1,5 +1,6 @@
 #pragma once
-// Textures of a material: level-0 images made from TextureDesc, and their box-filtered mip chains.
+// The level-0 image of each texture slot of a material, made from its TextureDesc: a file, a procedural pattern,
+// normals from a height. Their mip chains are a Texture's (mip_texture.hpp).
 #include <cstdint>
 #include <string>
 #include <vector>

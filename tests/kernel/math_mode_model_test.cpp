@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "core/math_mode.hpp"
+#include "kernel/math_mode_model.hpp"
 
 namespace qdmr {
 namespace {

@@ -1,4 +1,4 @@
-// Self-shadowing (shade/self_shadow.hpp): the hard shadow against the exact fp64 light visibility on analytic
+// Self-shadowing (kernel/self_shadow.hpp): the hard shadow against the exact fp64 light visibility on analytic
 // and procedural box surfaces, with and without the max-quadtree; the soft shadows against the hard one; flat
 // maps, the iteration cap, bad inputs, and lane independence (what lets SSE4.2 and AVX2 agree).
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/texture/mip_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/self_shadow.hpp"
 #include "reference/shadow_shapes.hpp"

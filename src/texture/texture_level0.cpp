@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "qdmr/core/error.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "texture/internal.hpp"
 
 namespace qdmr {

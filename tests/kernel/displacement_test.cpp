@@ -8,8 +8,8 @@
 
 #include "qdmr/render/render.hpp"
 #include "qdmr/load/load.hpp"
-#include "qdmr/texture/texture.hpp"
-#include "shade/displacement_test_util.hpp"
+#include "qdmr/texture/texture_level0.hpp"
+#include "kernel/displacement_test_util.hpp"
 #include "kernel/traversal.hpp"
 #include "support/test_support.hpp"
 

@@ -1,4 +1,4 @@
-// core/quad_rows.hpp: a batch's lanes to and from the two framebuffer rows it covers (lane 4q + 2r + c is pixel
+// kernel/quad_rows.hpp: a batch's lanes to and from the two framebuffer rows it covers (lane 4q + 2r + c is pixel
 // (2q + c, r)), the shuffles of the build these tests are compiled for: the AVX2 kernel (qdmr_tests) and the
 // AVX-512 one (qdmr_avx512_tests, where the CPU has it); the SSE4.2 version is covered by golden.shipped_scenes,
 // which renders with every kernel the CPU runs.

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "shade/displacement_test_util.hpp"
+#include "kernel/displacement_test_util.hpp"
 
 namespace qdmr::test {
 namespace {

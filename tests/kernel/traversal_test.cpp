@@ -1,4 +1,4 @@
-// The max-quadtree cell stepping (shade/traversal.hpp) has a shortcut for rays that GridRay calls regular (no lane
+// The max-quadtree cell stepping (kernel/traversal.hpp) has a shortcut for rays that GridRay calls regular (no lane
 // parallel to an axis, no infinite reciprocal, finite origin): it must move every lane exactly as the general
 // rules do, including rays standing exactly on a wall or a mid line, where the two sides of a comparison meet.
 // Compiled as the AVX2 kernel here and as the AVX-512 one in qdmr_avx512_tests (their masks are their own).
