@@ -124,7 +124,7 @@ Hit qdm(const Surface& surface, const Ray& ray, const Float& ds, const Float& st
 
 // Two walks to their ends, a step of each per round while both run. Never inlined: inlined into its caller (as an
 // unrelated change to the texel loads once made GCC do), the loop's register allocation got worse and the
-// canonical QDM frame 1.33x slower.
+// canonical QDM frame much slower (docs/performance-history.md).
 template <class V, class Surface>
 [[gnu::noinline]] void qdm_pair(QdmWalk<V, Surface, false>& a, QdmWalk<V, Surface, false>& b) {
   bool a_runs = true, b_runs = true;

@@ -595,7 +595,7 @@ void raster_tile(const RasterContext& context, int tile_index, const PixelRect& 
   const int width = tile.x1 - tile.x0 + 1, height = tile.y1 - tile.y0 + 1;
   // The tile's colour, cleared to the background here and written to the frame once, after the tile: into the
   // frame, a tile's pixels were cleared at its start and, by the time its long shading wrote them, often evicted,
-  // so each frame line was read from memory twice (canonical QDM 0.1 1.015x and 0.3 1.020x faster this way).
+  // so each frame line was read from memory twice (measured in docs/performance-history.md).
   thread_local PixelBuffer color_plane;
   const bool own_plane = width * height <= kMaxTileColorPixels;
   if (own_plane && color_plane.size() < 3 * std::size_t(width) * std::size_t(height))

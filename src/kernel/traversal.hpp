@@ -47,7 +47,7 @@ private:
 
 // Where the ray x(t) = origin + dir t crosses the line x = wall, per lane: in fp32 (wall - origin) * inv_dir, with
 // inv_dir = fl(1 / dir) computed once per ray (as GPUs divide: a reciprocal, then a product; dividing at every
-// crossing made the canonical QDM frame about 9 % slower), or with Fp64 (wall - origin) / dir in fp64 rounded once
+// crossing made the canonical QDM frame slower), or with Fp64 (wall - origin) / dir in fp64 rounded once
 // to fp32 (the `exact` math mode's QDM walk). Either way the same line always gives the same t, and t is monotonic
 // in the wall, which is what the cell stepping needs: a ray standing on a wall is never put back into the cell it
 // just left.

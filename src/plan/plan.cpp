@@ -524,7 +524,7 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
                                                        : std::string("height blending needs a height map in every layer"));
       // Heights fetched bilinearly with wrap addressing read level 0's footprints whole (Texture::wrap_footprints).
       // Not for blended layers: their fetches read every layer at one point, and four footprint arrays (16 bytes
-      // per texel each) missed the cache more than they saved (the terrain's frame 2 % slower, docs/performance-history.md).
+      // per texel each) missed the cache more than they saved (the terrain's frame slower, docs/performance-history.md).
       const bool wrap_footprints = !plan.blend && material.technique.height_fetch == HeightFetch::Bilinear &&
                                    material.sampling.address == AddressMode::Wrap;
       lp.height = add_request(textures, layer.height, TexturePurpose::Height, MipReduce::Box, layer,
