@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "kernel/kernel.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture_level0.hpp"

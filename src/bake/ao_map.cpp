@@ -1,5 +1,5 @@
 // Baked ambient occlusion: the per-frame horizon AO per texel in double precision, and its content-hash cache.
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

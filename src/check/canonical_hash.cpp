@@ -1,4 +1,4 @@
-#include "qdmr/check/canonical_hash.hpp"
+#include "check/canonical_hash.hpp"
 
 #include <bit>
 #include <cstdint>

@@ -13,7 +13,7 @@
 #include "check/diff_folder.hpp"
 #include "file/atomic_file.hpp"
 #include "file/os_error.hpp"
-#include "qdmr/check/canonical_hash.hpp"
+#include "check/canonical_hash.hpp"
 #include "qdmr/check/check.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/progress.hpp"

@@ -1,6 +1,6 @@
 #include "qdmr/core/zeroed_buffer.hpp"
 
-#include "qdmr/core/address_sanitizer.hpp"
+#include "core/address_sanitizer.hpp"
 
 #include <sys/mman.h>
 

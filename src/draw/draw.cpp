@@ -13,7 +13,7 @@
 #include "qdmr/reference/reference_memo.hpp"
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
-#include "qdmr/texture/cache_model.hpp"
+#include "texture/cache_model.hpp"
 
 namespace qdmr {
 namespace {

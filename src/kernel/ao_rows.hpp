@@ -1,5 +1,5 @@
 #pragma once
-// A row of a baked AO map with this ISA's vectors (qdmr/bake/ao_map.hpp's definition, the same bits as
+// A row of a baked AO map with this ISA's vectors (bake/ao_map.hpp's definition, the same bits as
 // bake/ao_texel.hpp's scalar form): Kernel::ao_map_row.
 #include "bake/ao_texel.hpp"
 #include "core/isa_namespace.hpp"

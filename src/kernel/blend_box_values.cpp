@@ -1,4 +1,4 @@
-// The blend's level-0 box values (qdmr/texture/blend_box_values.hpp), computed by this kernel with the code its
+// The blend's level-0 box values (texture/blend_box_values.hpp), computed by this kernel with the code its
 // QDM walks run at a level-0 cell (level0_box_value), so a walk reading them keeps its bits. Preparation runs it
 // (Kernel::blend_box_values).
 #include <tbb/parallel_for.h>

@@ -8,7 +8,7 @@
 // cell_max is conservative: the level-0 box value is exact (weights at the texel centre), coarser cells use
 // max(hmax_i * wmax_i) — "QDM1 * QDM2 = conservative QDM" — with wmax_i the largest weight over the UV box the
 // queries of this batch stay in (from the weight texture's max chain), so QDM stays exact over the blend.
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/fetch_trace.hpp"
 

@@ -11,10 +11,10 @@
 #include "program/inputs.hpp"
 #include "program/light_rig.hpp"
 #include "program/program.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
+#include "texture/blend_box_values.hpp"
 #include "qdmr/texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "raster/raster_context.hpp"
@@ -39,12 +39,12 @@ public:
   // Clears and draws one tile (see kernel/tile_raster.hpp); the context's programs must come from this kernel.
   virtual void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                            TileCounters& counters) const = 0;
-  // Preparation: a blend's level-0 box values (qdmr/texture/blend_box_values.hpp) into `out`, which holds
+  // Preparation: a blend's level-0 box values (texture/blend_box_values.hpp) into `out`, which holds
   // blend_box_value_count(source) floats (not 0); every kernel gives the same bits.
   virtual void blend_box_values(const BlendBoxSource& source, float* out) const = 0;
   // Preparation: the max/min reduction of one mip level (MipReduce::Max / Min), for make_mip_texture.
   virtual MipExtremum mip_extremum() const = 0;
-  // Preparation: one row of a baked AO map (qdmr/bake/ao_map.hpp), for bake_ao_map.
+  // Preparation: one row of a baked AO map (bake/ao_map.hpp), for bake_ao_map.
   virtual AoMapRow ao_map_row() const = 0;
   // Preparation: the rows of a dynamic height's rebuild (texture/height_family.hpp).
   virtual const HeightRows& height_rows() const = 0;

@@ -12,7 +12,7 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
-  // twin_texels: the two maps interleaved (qdmr/texture/twin_texels.hpp), or null.
+  // twin_texels: the two maps interleaved (texture/twin_texels.hpp), or null.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const float* twin_texels,
                        const SamplingDesc& sampling, const LightingDesc& lighting, const SpecularFromAlbedo& specular,
                        const LightRig& lights)

@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "core/isa_namespace.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
+#include "texture/blend_box_values.hpp"
 #include "qdmr/texture/format.hpp"
 #include "qdmr/texture/height_rows.hpp"
 

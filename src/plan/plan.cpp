@@ -13,14 +13,14 @@
 #include "codec/native_reader.hpp"
 #include "program/variant.hpp"
 #include "raster/framebuffer.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
-#include "qdmr/texture/height_texture.hpp"
+#include "texture/blend_box_values.hpp"
+#include "texture/height_texture.hpp"
 #include "qdmr/texture/image.hpp"
-#include "qdmr/texture/layer_heights.hpp"
-#include "qdmr/texture/twin_texels.hpp"
+#include "texture/layer_heights.hpp"
+#include "texture/twin_texels.hpp"
 
 namespace qdmr {
 namespace {

@@ -10,12 +10,12 @@
 #include <optional>
 
 #include "kernel/kernel.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/progress.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
-#include "qdmr/texture/height_texture.hpp"
-#include "qdmr/texture/twin_texels.hpp"
+#include "texture/blend_box_values.hpp"
+#include "texture/height_texture.hpp"
+#include "texture/twin_texels.hpp"
 #include "texture/blend_weights.hpp"
 #include "texture/height_family.hpp"
 

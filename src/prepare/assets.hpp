@@ -13,7 +13,7 @@
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/core/stats.hpp"
 #include "qdmr/texture/heightfield.hpp"
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
@@ -33,10 +33,10 @@ struct AoHistory {
 struct DerivedAsset {
   std::shared_ptr<const Texture> texture;
   std::shared_ptr<const LayerHeights> layer_heights;  // a combined quadtree's: its walk's level-0 cells, when made
-  std::shared_ptr<const std::vector<float>> box_values;  // with them: its level 0 (qdmr/texture/blend_box_values.hpp)
+  std::shared_ptr<const std::vector<float>> box_values;  // with them: its level 0 (texture/blend_box_values.hpp)
   std::shared_ptr<const HeightField> field;
   std::shared_ptr<const ConeMap> cones;
-  std::shared_ptr<const std::vector<float>> twin_texels;  // TwinTexels (qdmr/texture/twin_texels.hpp)
+  std::shared_ptr<const std::vector<float>> twin_texels;  // TwinTexels (texture/twin_texels.hpp)
   std::shared_ptr<const AoHistory> ao_history;  // an AO map amortized over frames: its rows in floats
 };
 

@@ -6,7 +6,7 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/heightfield.hpp"
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
@@ -19,7 +19,7 @@ struct LayerInputs {
   const Texture* height = nullptr;      // box-filtered heights (techniques, height blending)
   const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
   const Texture* ao = nullptr;          // baked AO of this layer's heights (R16), when the material bakes AO
-  const float* twin_texels = nullptr;   // albedo and normal map interleaved (qdmr/texture/twin_texels.hpp), or null
+  const float* twin_texels = nullptr;   // albedo and normal map interleaved (texture/twin_texels.hpp), or null
 };
 
 struct DisplacementInputs {

@@ -9,7 +9,7 @@
 
 #include "program/program.hpp"
 #include "qdmr/core/texture_cache.hpp"
-#include "qdmr/texture/cache_model.hpp"
+#include "texture/cache_model.hpp"
 #include "raster/binner.hpp"
 #include "raster/framebuffer.hpp"
 #include "raster/geometry.hpp"

@@ -17,7 +17,7 @@
 
 #include "file/atomic_file.hpp"
 #include "file/folder_lock.hpp"
-#include "qdmr/check/canonical_hash.hpp"
+#include "check/canonical_hash.hpp"
 #include "qdmr/check/compare.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/progress.hpp"

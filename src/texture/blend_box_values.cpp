@@ -1,4 +1,4 @@
-#include "qdmr/texture/blend_box_values.hpp"
+#include "texture/blend_box_values.hpp"
 
 namespace qdmr {
 

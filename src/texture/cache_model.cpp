@@ -1,4 +1,4 @@
-#include "qdmr/texture/cache_model.hpp"
+#include "texture/cache_model.hpp"
 
 #include <algorithm>
 #include <bit>

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "qdmr/core/texture_cache.hpp"
-#include "qdmr/texture/cache_model.hpp"
+#include "texture/cache_model.hpp"
 
 namespace qdmr {
 

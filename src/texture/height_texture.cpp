@@ -1,4 +1,4 @@
-#include "qdmr/texture/height_texture.hpp"
+#include "texture/height_texture.hpp"
 
 namespace qdmr {
 

@@ -1,4 +1,4 @@
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 
 namespace qdmr {
 

@@ -1,4 +1,4 @@
-#include "qdmr/texture/twin_texels.hpp"
+#include "texture/twin_texels.hpp"
 
 #include <cstring>
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "bake/ao_pattern.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
 #include "kernel/kernel.hpp"
 #include "qdmr/core/isa.hpp"

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "qdmr/check/canonical_hash.hpp"
+#include "check/canonical_hash.hpp"
 #include "qdmr/check/compare.hpp"
 
 namespace qdmr {

@@ -23,7 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "qdmr/core/address_sanitizer.hpp"
+#include "core/address_sanitizer.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {

@@ -14,9 +14,9 @@
 
 #include "kernel/kernel.hpp"
 #include "prepare/assets.hpp"
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/bake/cone_map.hpp"
-#include "qdmr/core/address_sanitizer.hpp"
+#include "core/address_sanitizer.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"

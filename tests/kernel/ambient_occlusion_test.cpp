@@ -10,7 +10,7 @@
 #include <set>
 #include <vector>
 
-#include "qdmr/bake/ao_map.hpp"
+#include "bake/ao_map.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "qdmr/texture/texture_level0.hpp"
 #include "kernel/ambient_occlusion.hpp"

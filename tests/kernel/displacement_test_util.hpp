@@ -12,7 +12,7 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/reference/reference.hpp"
-#include "qdmr/texture/height_texture.hpp"
+#include "texture/height_texture.hpp"
 #include "qdmr/texture/texture_level0.hpp"
 #include "kernel/displacement.hpp"
 #include "support/test_support.hpp"

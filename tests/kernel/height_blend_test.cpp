@@ -12,7 +12,7 @@
 #include "displacement_test_util.hpp"
 #include "kernel/kernel.hpp"
 #include "kernel/self_shadow.hpp"
-#include "qdmr/texture/blend_box_values.hpp"
+#include "texture/blend_box_values.hpp"
 #include "texture/blend_weights.hpp"
 
 namespace qdmr::test {

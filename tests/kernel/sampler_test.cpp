@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "program/variant.hpp"
-#include "qdmr/texture/twin_texels.hpp"
+#include "texture/twin_texels.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/sampler.hpp"
 #include "texture/sampler_test_util.hpp"

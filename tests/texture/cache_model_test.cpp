@@ -6,7 +6,7 @@
 #include <set>
 
 #include "qdmr/core/error.hpp"
-#include "qdmr/texture/cache_model.hpp"
+#include "texture/cache_model.hpp"
 
 namespace qdmr::test {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "qdmr/texture/height_texture.hpp"
+#include "texture/height_texture.hpp"
 #include "qdmr/texture/texture_level0.hpp"
 
 namespace qdmr {

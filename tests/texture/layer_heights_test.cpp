@@ -2,7 +2,7 @@
 // cells instead of each layer's chain, and what the plan counts for them.
 #include <gtest/gtest.h>
 
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 
 namespace qdmr {
 namespace {

@@ -16,7 +16,7 @@
 namespace qdmr {
 
 enum class CheckMode {
-  Exact,      // the canonical hash (qdmr/check/canonical_hash.hpp) of every output, stored in the manifest
+  Exact,      // the canonical hash (check/canonical_hash.hpp) of every output, stored in the manifest
   Tolerance,  // every output against a golden image file, within a Tolerance
 };
 

@@ -62,7 +62,7 @@ enum class DerivedKind {
   LayerAoMap,        // baked AO of one layer's heights
   ConeMap,           // csm, rcsm
   BilinearBound,     // qdm with bilinear-patch refinement: max-quadtree of the 3x3 maxima
-  TwinTexels,        // a layer's albedo and normal map interleaved per texel (qdmr/texture/twin_texels.hpp)
+  TwinTexels,        // a layer's albedo and normal map interleaved per texel (texture/twin_texels.hpp)
 };
 const char* derived_kind_name(DerivedKind kind);
 

@@ -9,7 +9,7 @@
 #include <cstdint>
 
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/texture/layer_heights.hpp"
+#include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {
