@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "qdmr/core/error.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "texture/height_rows_code.hpp"
 #include "texture/internal.hpp"
 

@@ -11,8 +11,8 @@
 
 #include "kernel/kernel.hpp"
 #include "qdmr/core/isa.hpp"
-#include "qdmr/texture/height_texture.hpp"
-#include "qdmr/texture/texture.hpp"
+#include "texture/height_texture.hpp"
+#include "qdmr/texture/texture_level0.hpp"
 #include "texture/height_family.hpp"
 
 namespace qdmr {
