@@ -31,7 +31,7 @@ qdmr::HeightField field_of(const qdmr::Image& image) {
   qdmr::HeightField f;
   f.width = image.width;
   f.height = image.height;
-  f.h.resize(std::size_t(image.width) * std::size_t(image.height));
+  f.h = qdmr::ZeroedBuffer<double>(std::size_t(image.width) * std::size_t(image.height));
   for (std::size_t k = 0; k < f.h.size(); ++k) f.h[k] = image.texels[k * std::size_t(image.channels)];
   return f;
 }

@@ -321,7 +321,7 @@ int run_bake_cone(const ConeArgs& args) {
     field.width = image.width;
     field.height = image.height;
     field.address = mode;
-    field.h.resize(std::size_t(image.width) * std::size_t(image.height));
+    field.h = qdmr::ZeroedBuffer<double>(std::size_t(image.width) * std::size_t(image.height));
     for (std::size_t k = 0; k < field.h.size(); ++k)
       field.h[k] = image.texels[k * std::size_t(image.channels) + std::size_t(channel)];
   }  // the image is freed before the bake

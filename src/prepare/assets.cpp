@@ -94,7 +94,7 @@ HeightField height_field(const Texture& h, AddressMode address) {
   field.width = h.width();
   field.height = h.height();
   field.address = address;
-  field.h.resize(std::size_t(h.width()) * std::size_t(h.height()));
+  field.h = ZeroedBuffer<double>(std::size_t(h.width()) * std::size_t(h.height()));
   for (int y = 0; y < h.height(); ++y)
     for (int x = 0; x < h.width(); ++x) field.h[std::size_t(y) * std::size_t(h.width()) + std::size_t(x)] = h.texel(0, x, y, 0);
   return field;
@@ -159,7 +159,14 @@ public:
     meshes();
     textures();
     assets_.derived.resize(plan_.derived.size());
-    for (std::size_t i = 0; i < plan_.derived.size(); ++i) derived(i);
+    for (std::size_t i = 0, end = 0; i < plan_.derived.size(); i = end) {
+      // Consecutive twin-texel items read built textures only and hold no working memory: each is a one-thread
+      // copy, so they are built side by side.
+      end = i + 1;
+      if (plan_.derived[i].kind == DerivedKind::TwinTexels)
+        while (end < plan_.derived.size() && plan_.derived[end].kind == DerivedKind::TwinTexels) ++end;
+      tbb::parallel_for(i, end, [&](std::size_t k) { derived(k); });
+    }
     // Built and reused lines in plan order, whatever order the parallel builds finished in.
     for (const std::string& item : items)
       (std::find(built_.begin(), built_.end(), item) != built_.end() ? assets_.built : assets_.reused).push_back(item);
@@ -348,7 +355,8 @@ private:
     const auto start = Clock::now();
     const MaterialPlan& m = plan_.materials[std::size_t(d.material)];
     const MaterialDesc& desc = m.desc;
-    const ProgressStep step(std::string(derived_kind_name(d.kind)) + " of " + m.name);  // (and Ctrl-C stops here)
+    const ProgressStep step(std::string(derived_kind_name(d.kind)) + " of " + m.name);
+  // (and Ctrl-C stops here)
     const auto input = [&](std::size_t k) -> const DerivedAsset& { return assets_.derived[std::size_t(d.inputs.at(k))]; };
     const auto mip = [&](Image image, TexelFormat format, MipReduce reduce) {
       return std::make_shared<const Texture>(make_mip_texture(image, format, false, reduce, kernel_.mip_extremum()));
@@ -384,9 +392,9 @@ private:
           const BlendBoxSource source{input(1).texture.get(), m.weights_scale, out.layer_heights.get(), desc.blend.op,
                                       int(m.layers.size())};
           if (const std::size_t count = blend_box_value_count(source); count > 0) {
-            std::vector<float> values(count);
+            ZeroedBuffer<float> values(count);  // zero pages, committed by the rows' threads
             kernel_.blend_box_values(source, values.data());
-            out.box_values = std::make_shared<const std::vector<float>>(std::move(values));
+            out.box_values = std::make_shared<const ZeroedBuffer<float>>(std::move(values));
           }
         }
         break;

@@ -12,6 +12,7 @@
 #include "qdmr/mesh/mesh.hpp"
 #include "qdmr/plan/plan.hpp"
 #include "qdmr/core/stats.hpp"
+#include "qdmr/core/zeroed_buffer.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
@@ -33,7 +34,7 @@ struct AoHistory {
 struct DerivedAsset {
   std::shared_ptr<const Texture> texture;
   std::shared_ptr<const LayerHeights> layer_heights;  // a combined quadtree's: its walk's level-0 cells, when made
-  std::shared_ptr<const std::vector<float>> box_values;  // with them: its level 0 (texture/blend_box_values.hpp)
+  std::shared_ptr<const ZeroedBuffer<float>> box_values;  // with them: its level 0 (texture/blend_box_values.hpp)
   std::shared_ptr<const HeightField> field;
   std::shared_ptr<const ConeMap> cones;
   std::shared_ptr<const std::vector<float>> twin_texels;  // TwinTexels (texture/twin_texels.hpp)

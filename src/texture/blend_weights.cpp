@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "qdmr/texture/texture_level0.hpp"
@@ -84,7 +85,7 @@ Image terrain_map(const WeightsDesc& desc, int layers, const std::string& where)
   p.octaves = 3;
   const Image noise = generate_procedural(p);
   Image map(h.width, h.height, 4);
-  for (int y = 0; y < h.height; ++y)
+  tbb::parallel_for(0, h.height, [&](int y) {  // texels alone: the same bits on any thread count
     for (int x = 0; x < h.width; ++x) {
       const auto at = [&](int i, int j) { return double(h.at(std::clamp(i, 0, h.width - 1), std::clamp(j, 0, h.height - 1), 0)); };
       // Slope in height units per map width, times the relief (vertical extent over width).
@@ -99,6 +100,7 @@ Image terrain_map(const WeightsDesc& desc, int layers, const std::string& where)
       const double w[4] = {rock, (1 - rock) * (1 - sand) * (1 - dirt), (1 - rock) * sand, (1 - rock) * (1 - sand) * dirt};
       for (int i = 0; i < layers; ++i) map.at(x, y, i) = float(w[i]);
     }
+  });
   normalise_to_strongest(map, layers);
   return map;
 }
@@ -177,13 +179,15 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   // Level 0 of the textures decoded once: the layers' heights and the RGBA weights.
   const int lw = heights[0]->width(), lh = heights[0]->height(), layers = int(heights.size());
   std::vector<float> h(std::size_t(layers) * std::size_t(lw) * std::size_t(lh));
-  for (int i = 0; i < layers; ++i)
-    for (int y = 0; y < lh; ++y)
-      for (int x = 0; x < lw; ++x) h[(std::size_t(i) * lh + y) * lw + x] = heights[std::size_t(i)]->texel(0, x, y, 0);
+  tbb::parallel_for(0, layers * lh, [&](int row) {
+    const int i = row / lh, y = row % lh;
+    for (int x = 0; x < lw; ++x) h[(std::size_t(i) * lh + y) * lw + x] = heights[std::size_t(i)]->texel(0, x, y, 0);
+  });
   Image w(weights.width(), weights.height(), 4);
-  for (int y = 0; y < w.height; ++y)
+  tbb::parallel_for(0, w.height, [&](int y) {
     for (int x = 0; x < w.width; ++x)
       for (int c = 0; c < 4; ++c) w.at(x, y, c) = weights.texel(0, x, y, c);
+  });
   // Weight-texture indices: floor(x) of a coordinate in [-0.5, n - 0.5) lies in [-1, n - 1], and its successor in
   // [0, n]: one step wraps them (no integer division per texel: those were most of this loop's time).
   const auto wrap_index = [](int i, int n) { return i < 0 ? i + n : i >= n ? i - n : i; };
@@ -191,39 +195,63 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   HeightField field;
   field.width = lw * scale;
   field.height = lh * scale;
-  field.h.resize(std::size_t(field.width) * std::size_t(field.height));
+  field.h = ZeroedBuffer<double>(std::size_t(field.width) * std::size_t(field.height));  // zero pages: the rows' threads commit them
   // The weights at the texel centre, bilinear at weight-texture coordinates (x + 0.5) / (W scale) - 0.5; the
   // fraction is taken before wrapping, so it is exact on both sides of 0 (the texture unit's arithmetic). What
   // depends on x alone is the same in every row: computed once per column.
   struct Column {
-    int xa, xb, lx;  // weight texels left and right, the layers' texel (x mod lw)
+    int xa, xb;  // weight texels left and right
     double fx;
   };
   std::vector<Column> columns(std::size_t(field.width));
   for (int x = 0; x < field.width; ++x) {
     const double wx = (x + 0.5) / field.width * w.width - 0.5;
     const int x0 = int(std::floor(wx));
-    columns[std::size_t(x)] = {wrap_index(x0, w.width), wrap_index(x0 + 1, w.width), x % lw, wx - x0};
+    columns[std::size_t(x)] = {wrap_index(x0, w.width), wrap_index(x0 + 1, w.width), wx - x0};
   }
-  tbb::parallel_for(0, field.height, [&](int y) {
-    const double wy = (y + 0.5) / field.height * w.height - 0.5;
-    const int y0 = int(std::floor(wy));
-    const double fy = wy - y0;
-    const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);
-    const std::size_t layer_row = std::size_t(y % lh) * std::size_t(lw);
-    for (int x = 0; x < field.width; ++x) {
-      const auto [xa, xb, lx, fx] = columns[std::size_t(x)];
-      double top = 0.0, sum_wh = 0.0, sum_w = 0.0;
-      for (int i = 0; i < layers; ++i) {
-        const double wi = (double(w.at(xa, ya, i)) * (1 - fx) + double(w.at(xb, ya, i)) * fx) * (1 - fy) +
-                          (double(w.at(xa, yb, i)) * (1 - fx) + double(w.at(xb, yb, i)) * fx) * fy;
-        const double hi = h[std::size_t(i) * lh * lw + layer_row + std::size_t(lx)];
-        top = std::max(top, wi * hi);
-        sum_wh += wi * hi;
-        sum_w += wi;
+  const std::size_t width = std::size_t(field.width), repeat = std::size_t(lw);
+  // The first step of the bilinear weights, along weight row r: w(xa, r, i) (1 - fx) + w(xb, r, i) fx for every
+  // layer i and column. A field row interpolates two of them (rows ya and yb) by fy; the `scale` field rows between
+  // two weight rows share them, so a band of rows makes them again only when ya changes.
+  const auto along_row = [&](int r, std::vector<double>& out) {
+    for (int i = 0; i < layers; ++i)
+      for (std::size_t x = 0; x < width; ++x) {
+        const Column& c = columns[x];
+        out[std::size_t(i) * width + x] = double(w.at(c.xa, r, i)) * (1 - c.fx) + double(w.at(c.xb, r, i)) * c.fx;
       }
-      field.h[std::size_t(y) * std::size_t(field.width) + std::size_t(x)] =
-          op != BlendOperator::Alpha ? top : (sum_w > 0.0 ? sum_wh / sum_w : 0.0);
+  };
+  tbb::parallel_for(tbb::blocked_range<int>(0, field.height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<double> a(std::size_t(layers) * width), b(a.size()), sum_wh, sum_w;
+    int held = -1;  // the ya of a and b
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      const double wy = (y + 0.5) / field.height * w.height - 0.5;
+      const int y0 = int(std::floor(wy));
+      const double fy = wy - y0;
+      const int ya = wrap_index(y0, w.height), yb = wrap_index(y0 + 1, w.height);  // yb follows from ya
+      if (ya != held) along_row(ya, a), along_row(yb, b), held = ya;
+      const float* layer_row = h.data() + std::size_t(y % lh) * repeat;
+      // Layer after layer, each texel's operations those of the per-texel formula, in its order; the layers'
+      // texels repeat every lw columns.
+      const auto each = [&](auto&& add) {
+        for (int i = 0; i < layers; ++i) {
+          const double* ai = a.data() + std::size_t(i) * width;
+          const double* bi = b.data() + std::size_t(i) * width;
+          const float* hi = layer_row + std::size_t(i) * std::size_t(lh) * repeat;
+          for (std::size_t x0 = 0; x0 < width; x0 += repeat)
+            for (std::size_t x = x0; x < x0 + repeat; ++x) {
+              const double wi = ai[x] * (1 - fy) + bi[x] * fy;
+              add(x, wi, wi * double(hi[x - x0]));
+            }
+        }
+      };
+      double* out = field.h.data() + std::size_t(y) * width;  // zero until written
+      if (op != BlendOperator::Alpha) {
+        each([&](std::size_t x, double, double p) { out[x] = out[x] < p ? p : out[x]; });  // std::max, from 0
+      } else {
+        sum_wh.assign(width, 0.0), sum_w.assign(width, 0.0);
+        each([&](std::size_t x, double wi, double p) { sum_wh[x] += p, sum_w[x] += wi; });
+        for (std::size_t x = 0; x < width; ++x) out[x] = sum_w[x] > 0.0 ? sum_wh[x] / sum_w[x] : 0.0;
+      }
     }
   });
   return field;

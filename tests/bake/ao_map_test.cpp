@@ -31,10 +31,11 @@ HeightField random_field(int w, int h, AddressMode address, std::uint32_t seed) 
   f.width = w;
   f.height = h;
   f.address = address;
+  f.h = ZeroedBuffer<double>(std::size_t(w) * std::size_t(h));
   std::uint32_t state = seed;
-  for (int k = 0; k < w * h; ++k) {
+  for (double& v : f.h) {
     state = state * 1664525u + 1013904223u;
-    f.h.push_back(double(state >> 8) / double(1u << 24));
+    v = double(state >> 8) / double(1u << 24);
   }
   return f;
 }
@@ -90,8 +91,9 @@ TEST(AoMap, PitCentreWithinTheClosedFormBounds) {
   const double r = 12.0, depth = 0.5, ds = 0.1;
   HeightField f;
   f.width = f.height = n;
+  f.h = ZeroedBuffer<double>(std::size_t(n) * std::size_t(n));
   for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) f.h.push_back((x - c) * (x - c) + (y - c) * (y - c) < r * r ? 1.0 - depth : 1.0);
+    for (int x = 0; x < n; ++x) f.h[std::size_t(y * n + x)] = (x - c) * (x - c) + (y - c) * (y - c) < r * r ? 1.0 - depth : 1.0;
   const auto visibility = [&](double texels) {
     const double slope = ds * depth / (texels / n);
     return 1.0 - slope / std::sqrt(1.0 + slope * slope);

@@ -38,7 +38,7 @@ HeightField random_field(int w, int h, AddressMode address, std::uint32_t seed, 
   f.width = w;
   f.height = h;
   f.address = address;
-  f.h.resize(std::size_t(w) * std::size_t(h));
+  f.h = ZeroedBuffer<double>(std::size_t(w) * std::size_t(h));
   // 8-bit levels: ties (equal heights) are common, as in real maps.
   for (double& v : f.h) v = low + (1.0 - low) * double(rng() % 256) / 255.0;
   return f;

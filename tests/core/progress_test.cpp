@@ -34,8 +34,9 @@ struct Recorder final : ProgressSink {
 HeightField bumps(int size) {
   HeightField f;
   f.width = f.height = size;
+  f.h = ZeroedBuffer<double>(std::size_t(size) * std::size_t(size));
   for (int j = 0; j < size; ++j)
-    for (int i = 0; i < size; ++i) f.h.push_back(((i * 7 + j * 13) % 17) / 16.0);
+    for (int i = 0; i < size; ++i) f.h[std::size_t(j * size + i)] = ((i * 7 + j * 13) % 17) / 16.0;
   return f;
 }
 

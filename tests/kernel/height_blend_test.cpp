@@ -127,7 +127,7 @@ HeightField combined_field(const std::vector<Image>& heights, const BlendHarness
   HeightField f;
   f.width = heights[0].width;
   f.height = heights[0].height;
-  f.h.resize(std::size_t(f.width) * std::size_t(f.height));
+  f.h = ZeroedBuffer<double>(std::size_t(f.width) * std::size_t(f.height));
   for (int y = 0; y < f.height; ++y)
     for (int x = 0; x < f.width; ++x) {
       float top = 0.0f;
@@ -181,11 +181,12 @@ TEST(HeightBlend, QdmhbWithVertexWeightsIsExactOverItsConstantWeights) {
   const std::vector<TechniqueResult> results = harness.run(rays, std::vector<std::array<float, kLayers>>(rays.size(), w));
   HeightField field;
   field.width = field.height = size;
+  field.h = ZeroedBuffer<double>(std::size_t(size) * std::size_t(size));
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
       float top = 0.0f;
       for (int i = 0; i < kLayers; ++i) top = std::max(top, w[std::size_t(i)] * heights[std::size_t(i)].at(x, y, 0));
-      field.h.push_back(top);
+      field.h[std::size_t(y * size + x)] = top;
     }
   for (std::size_t k = 0; k < rays.size(); ++k) {
     const ReferenceHit ref = intersect_reference(field, 0.2, {{rays[k].u0, rays[k].v0, 0.0}, {rays[k].du, rays[k].dv, 1.0}},
@@ -327,11 +328,12 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
 
   HeightField field;  // the two repeats, as one map
   field.width = field.height = 2 * n;
+  field.h = ZeroedBuffer<double>(std::size_t(4 * n * n));
   for (int y = 0; y < 2 * n; ++y)
     for (int x = 0; x < 2 * n; ++x) {
       float top = 0.0f;
       for (int i = 0; i < kLayers; ++i) top = std::max(top, weights.texel(0, x, y, i) * heights[std::size_t(i)].at(x % n, y % n, 0));
-      field.h.push_back(top);
+      field.h[std::size_t(y * 2 * n + x)] = top;
     }
   const double ds = 0.2;
   ShadowDesc desc;

@@ -94,8 +94,8 @@ std::vector<Case> cases() {
   noise.pattern = ProceduralPattern::Noise;
   noise.size = 64;
   noise.cells = 4;
-  HeightField noise_field{64, 64, {}, AddressMode::Wrap};
-  for (float t : generate_procedural(noise).texels) noise_field.h.push_back(t);
+  const Image noise_image = generate_procedural(noise);
+  HeightField noise_field{64, 64, ZeroedBuffer<double>(noise_image.texels.begin(), noise_image.texels.end()), AddressMode::Wrap};
   HeightField checker = flat_field(32, 0.0);
   for (int j = 0; j < 32; ++j)
     for (int i = 0; i < 32; ++i) checker.h[std::size_t(j * 32 + i)] = (i + j) % 2 ? 0.8 : 0.1;  // finest-level alternation

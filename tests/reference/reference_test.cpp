@@ -32,7 +32,7 @@ std::string sci(double x) {
 }
 
 HeightField make_field(int w, int h, double value, AddressMode mode = AddressMode::Wrap) {
-  return HeightField{w, h, std::vector<double>(std::size_t(w) * std::size_t(h), value), mode};
+  return HeightField{w, h, ZeroedBuffer<double>(std::size_t(w) * std::size_t(h), value), mode};
 }
 
 void set(HeightField& f, int i, int j, double value) {
@@ -461,7 +461,7 @@ TEST(StudyReference, BruteForceOnRandomFields) {
 TEST(StudyReference, Map4096Squared) {
   // Rows equal, h_i = (i + 0.5) / W: bilinear depth D (1 - u) between the first and last centres.
   constexpr int W = 4096;
-  HeightField f{W, W, std::vector<double>(std::size_t(W) * W), AddressMode::Wrap};
+  HeightField f{W, W, ZeroedBuffer<double>(std::size_t(W) * W), AddressMode::Wrap};
   for (int j = 0; j < W; ++j)
     for (int i = 0; i < W; ++i) f.h[std::size_t(j) * W + i] = (i + 0.5) / W;
   const double D = 0.05, u0 = 0.01;

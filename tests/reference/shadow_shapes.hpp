@@ -11,7 +11,7 @@
 namespace qdmr::test {
 
 inline HeightField flat_field(int size, double h) {
-  return HeightField{size, size, std::vector<double>(std::size_t(size) * std::size_t(size), h), AddressMode::Wrap};
+  return HeightField{size, size, ZeroedBuffer<double>(std::size_t(size) * std::size_t(size), h), AddressMode::Wrap};
 }
 
 // Texels x < size / 2 at `low`, the others at `high` (a wall at x = size / 2 and, wrapping, at x = 0).

@@ -18,7 +18,7 @@ namespace qdmr {
 
 struct HeightField {
   int width = 0, height = 0;
-  std::vector<double> h;                   // row-major, row 0 at v = 0; values in [0, 1]
+  ZeroedBuffer<double> h;                  // row-major, row 0 at v = 0; values in [0, 1]; zero pages until written
   AddressMode address = AddressMode::Wrap;  // wrap repeats the map; clamp extends the edge texels; mirror reflects
 
   // Texel (i, j) with the address mode applied: wrap i mod W; clamp to [0, W); mirror with period 2W
