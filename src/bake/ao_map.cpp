@@ -63,6 +63,37 @@ ao::MaxPyramid::MaxPyramid(const HeightField& field) {
   }
 }
 
+ao::UniformColumns::UniformColumns(const Bake& b) : taps(b.taps.count) {
+  const HeightField& f = *b.field;
+  const MaxPyramid& p = *b.pyramid;
+  const int n = direction_count(b.desc), w = b.map_width;
+  cell.resize(std::size_t(n) * std::size_t(taps) * std::size_t(w));
+  left.resize(std::size_t(w));
+  right.resize(std::size_t(w));
+  fraction.resize(std::size_t(w));
+  tbb::parallel_for(0, n, [&](int d) {
+    const double dx = kDirections.cos[std::size_t(direction_index(n, d, 0))];
+    for (int k = 0; k < taps; ++k) {
+      const Tap& tap = b.taps.tap[std::size_t(k)];
+      const int level = std::min(tap.level, p.top());
+      std::int32_t* out = cell.data() + (std::size_t(d) * std::size_t(taps) + std::size_t(k)) * std::size_t(w);
+      for (int i = 0; i < w; ++i)
+        out[i] = std::int32_t(p.cell_x(level, tap_texel(texel_u(b, i) + dx * double(tap.distance), f.width, f.address)));
+    }
+  });
+  for (int i = 0; i < w; ++i) {  // bilinear_surface_depth's columns
+    const double x = texel_u(b, i) * f.width - 0.5, fi = std::floor(x);
+    const auto c = std::int64_t(fi);
+    left[std::size_t(i)] = std::int32_t(HeightField::texel_index(c, f.width, f.address));
+    right[std::size_t(i)] = std::int32_t(HeightField::texel_index(c + 1, f.width, f.address));
+    fraction[std::size_t(i)] = x - fi;
+  }
+}
+
+std::uint64_t ao::UniformColumns::bytes(int map_width, int directions, int taps) {
+  return std::uint64_t(map_width) * (std::uint64_t(directions) * std::uint64_t(taps) * 4 + 4 + 4 + 8);
+}
+
 AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc) {
   if (desc.resolution <= 0) return {field_width, field_height};
   const auto h = std::int64_t(desc.resolution) * field_height / field_width;
@@ -72,11 +103,14 @@ AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc) {
 std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc) {
   const AoMapSize size = ao_map_size(field_width, field_height, desc);
   std::uint64_t bytes = std::uint64_t(size.width) * std::uint64_t(size.height) * sizeof(float);
-  if (desc.coarse)
+  if (desc.coarse) {
     for (int w = field_width, h = field_height; w > 1 || h > 1;) {
       w = std::max(1, w / 2), h = std::max(1, h / 2);
       bytes += std::uint64_t(w) * std::uint64_t(h) * sizeof(double);
     }
+    if (!desc.jitter)
+      bytes += ao::UniformColumns::bytes(size.width, ao::direction_count(desc), ao::make_taps(desc, field_width, field_height).count);
+  }
   return bytes;
 }
 
@@ -96,8 +130,12 @@ void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& de
   if (map.width != size.width || map.height != size.height || map.channels != 1 || step < 1 || first < 0)
     throw Error("ao map", "bake_ao_rows: the map or the rows do not fit the bake");
   const std::optional<ao::MaxPyramid> pyramid = desc.coarse ? std::optional<ao::MaxPyramid>(field) : std::nullopt;
-  const ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, desc, ao::make_taps(desc, field.width, field.height),
-                      size.width, size.height};
+  ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, desc, ao::make_taps(desc, field.width, field.height),
+                size.width, size.height};
+  // The kernels' rows of a coarse bake without jitter read the columns every row shares.
+  const std::optional<ao::UniformColumns> columns =
+      row && pyramid && !desc.jitter ? std::optional<ao::UniformColumns>(bake) : std::nullopt;
+  if (columns) bake.columns = &*columns;
   const int count = first < size.height ? (size.height - first + step - 1) / step : 0;
   ProgressStep progress("AO map " + std::to_string(size.width) + "x" + std::to_string(size.height), count);
   tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int>& rows) {

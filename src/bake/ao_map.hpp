@@ -47,7 +47,8 @@ struct AoMapSize {
 AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc);
 
 // What a bake (or a cache read) holds besides the field and the stored map: the map in floats and, for coarse
-// taps, the max pyramid of the heights above level 0 (fp64). For memory plans; nothing is baked.
+// taps, the max pyramid of the heights above level 0 (fp64) and, without jitter, the tap columns every row shares
+// (bake/ao_texel.hpp's UniformColumns). For memory plans; nothing is baked.
 std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc);
 
 // XXH3-64 of the format version, W, H, address mode, heights (as doubles), depth scale, direction count

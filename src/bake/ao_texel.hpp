@@ -26,12 +26,22 @@ struct MaxPyramid {
 
   int top() const { return int(level.size()) - 1; }
 
+  // The level-k cell column of level-0 column x, and row of row y.
+  std::int64_t cell_x(int k, std::int64_t x) const { return std::min<std::int64_t>(x >> k, width[std::size_t(k)] - 1); }
+  std::int64_t cell_y(int k, std::int64_t y) const { return std::min<std::int64_t>(y >> k, height[std::size_t(k)] - 1); }
+
   double cell_max(int k, std::int64_t x, std::int64_t y) const {
-    const std::int64_t cx = std::min<std::int64_t>(x >> k, width[std::size_t(k)] - 1);
-    const std::int64_t cy = std::min<std::int64_t>(y >> k, height[std::size_t(k)] - 1);
-    return level[std::size_t(k)][std::size_t(cy * width[std::size_t(k)] + cx)];
+    return level[std::size_t(k)][std::size_t(cell_y(k, y) * width[std::size_t(k)] + cell_x(k, x))];
   }
 };
+
+struct UniformColumns;
+
+// The level-0 texel a tap at coordinate t (UV) reads along an axis of n texels, under the address mode
+// (HeightField::at's rule; no division inside the map).
+inline std::int64_t tap_texel(double t, int n, AddressMode address) {
+  return HeightField::texel_index(std::int64_t(std::floor(t * n)), n, address);
+}
 
 // Everything one texel of a bake reads. pyramid is null for fine taps.
 struct Bake {
@@ -41,6 +51,22 @@ struct Bake {
   AoDesc desc;
   Taps taps;
   int map_width, map_height;
+  const UniformColumns* columns = nullptr;  // coarse without jitter: what every row shares (for the kernels' rows)
+};
+
+// Without jitter, every row of a coarse bake looks along the same directions from the same columns: tap k of
+// direction d at texel i reads the same pyramid column in every row, and texel i's bilinear footprint has the same
+// two columns and fraction. Found once per bake by the definition's own operations; the kernels' rows then read
+// them instead of finding them per texel, with the same bits.
+struct UniformColumns {
+  int taps = 0;                          // per direction (Bake::taps.count)
+  std::vector<std::int32_t> cell;        // [(d * taps + k) * map_width + i]: the tap's cell column, level min(k, top)
+  std::vector<std::int32_t> left, right; // texel i's bilinear footprint: its level-0 columns (address applied)
+  std::vector<double> fraction;          // and the fraction between them
+
+  explicit UniformColumns(const Bake& b);
+  // What they hold for a map `map_width` wide with `directions` x `taps` taps.
+  static std::uint64_t bytes(int map_width, int directions, int taps);
 };
 
 // The coarse taps' horizon slope along (dx, dy): the largest (s - depth_k) / d_k, where tap k reads max pyramid
@@ -56,9 +82,7 @@ inline double coarse_tap_rise(const Bake& b, int k, double s, double u, double v
   const HeightField& field = *b.field;
   const Tap& tap = b.taps.tap[std::size_t(k)];
   const double tu = u + dx * double(tap.distance), tv = v + dy * double(tap.distance);
-  // Level-0 texel of the tap under the address mode (HeightField::at's rule; no division inside the map).
-  const auto x = HeightField::texel_index(std::int64_t(std::floor(tu * field.width)), field.width, field.address);
-  const auto y = HeightField::texel_index(std::int64_t(std::floor(tv * field.height)), field.height, field.address);
+  const std::int64_t x = tap_texel(tu, field.width, field.address), y = tap_texel(tv, field.height, field.address);
   return s - b.depth_scale * (1.0 - b.pyramid->cell_max(std::min(tap.level, b.pyramid->top()), x, y));
 }
 

@@ -1,10 +1,13 @@
 // One row of a baked AO map with this ISA's vectors: fp64 lanes across the row's texels (2, 4 or 8), every
 // operation the one the scalar definition (bake/ao_texel.hpp) performs on each lane, in its order, so each texel
-// gets the definition's bits. A batch falls back to the scalar definition, lane by lane, where the vector form
-// would differ: a tap texel index beyond +-2^31 (the definition converts to int64), a largest scaled rise below
-// ao::kSmallestScaledRise.
+// gets the definition's bits. A coarse bake without jitter reads the columns every row shares
+// (ao::UniformColumns, found by the definition's code) in loops over chunks of the row; otherwise a batch falls
+// back to the scalar definition, lane by lane, where the vector form would differ: a tap texel index beyond
+// +-2^31 (the definition converts to int64). Either way a largest scaled rise below ao::kSmallestScaledRise is
+// compared tap by tap, as the definition does.
 #include "kernel/ao_rows.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -183,10 +186,88 @@ bool batch_ao(const ao::Bake& b, int i0, int j, std::array<double, kWidth>& out)
   return true;
 }
 
+// Texels per pass of a uniform row: its arrays (a few KiB) stay in L1.
+constexpr int kChunk = 256;
+static_assert(kChunk % kWidth == 0);
+
+// A row of a coarse bake without jitter, from the columns every row shares (ao::UniformColumns): per chunk of
+// texels, loops over the chunk that this ISA's vectors run, each texel's operations the definition's in its order.
+// A direction's taps read one pyramid row each, found once per row by the definition's own code.
+void uniform_row(const ao::Bake& b, int j, float* row) {
+  const HeightField& f = *b.field;
+  const ao::MaxPyramid& p = *b.pyramid;
+  const ao::UniformColumns& c = *b.columns;
+  const int n = ao::direction_count(b.desc), taps = c.taps;
+  const double v = ao::texel_v(b, j), ds = b.depth_scale, first = double(b.taps.tap[0].distance);
+  // bilinear_surface_depth's rows.
+  const double y = v * f.height - 0.5, fj = std::floor(y), fy = y - fj;
+  const auto r = std::int64_t(fj);
+  const double* row0 = f.h.data() + std::size_t(HeightField::texel_index(r, f.height, f.address) * f.width);
+  const double* row1 = f.h.data() + std::size_t(HeightField::texel_index(r + 1, f.height, f.address) * f.width);
+  // Each tap's pyramid row: [d * taps + k].
+  std::array<const double*, std::size_t(ao::kMaxDirections) * ao::kMaxTaps> tap_rows{};
+  std::array<double, ao::kMaxDirections> dxs{}, dys{};
+  for (int d = 0; d < n; ++d) {
+    const int index = ao::direction_index(n, d, 0);
+    dxs[std::size_t(d)] = ao::kDirections.cos[std::size_t(index)];
+    dys[std::size_t(d)] = ao::kDirections.sin[std::size_t(index)];
+    for (int k = 0; k < taps; ++k) {
+      const ao::Tap& tap = b.taps.tap[std::size_t(k)];
+      const int level = std::min(tap.level, p.top());
+      const std::int64_t cy = p.cell_y(level, ao::tap_texel(v + dys[std::size_t(d)] * double(tap.distance), f.height, f.address));
+      tap_rows[std::size_t(d * taps + k)] = p.level[std::size_t(level)] + std::size_t(cy * p.width[std::size_t(level)]);
+    }
+  }
+  alignas(64) std::array<double, kChunk> s{}, rise{}, slope{}, visible{};
+  for (int i0 = 0; i0 < b.map_width; i0 += kChunk) {
+    const int m = std::min(kChunk, b.map_width - i0);
+    const std::int32_t* left = c.left.data() + i0;
+    const std::int32_t* right = c.right.data() + i0;
+    const double* fraction = c.fraction.data() + i0;
+    for (int i = 0; i < m; ++i) {
+      const double fx = fraction[i];
+      const double h00 = row0[left[i]], h10 = row0[right[i]], h01 = row1[left[i]], h11 = row1[right[i]];
+      const double h = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
+      s[std::size_t(i)] = ds * (1.0 - h);
+      visible[std::size_t(i)] = 0.0;
+    }
+    for (int d = 0; d < n; ++d) {
+      std::fill_n(rise.begin(), m, 0.0);
+      double scale = 1.0;
+      for (int k = 0; k < taps; ++k, scale *= 0.5) {
+        const double* cells = tap_rows[std::size_t(d * taps + k)];
+        const std::int32_t* column = c.cell.data() + (std::size_t(d) * std::size_t(taps) + std::size_t(k)) * std::size_t(b.map_width) + std::size_t(i0);
+        for (int i = 0; i < m; ++i) {
+          const double t = (s[std::size_t(i)] - ds * (1.0 - cells[column[i]])) * scale;
+          rise[std::size_t(i)] = rise[std::size_t(i)] < t ? t : rise[std::size_t(i)];  // std::max
+        }
+      }
+      // coarse_slope: one division, or tap by tap where the largest scaled rise is tiny.
+      bool by_tap = false;
+      for (int i = 0; i < m; ++i) {
+        slope[std::size_t(i)] = rise[std::size_t(i)] / first;
+        by_tap |= !(rise[std::size_t(i)] == 0.0 || rise[std::size_t(i)] >= ao::kSmallestScaledRise);
+      }
+      if (by_tap)
+        for (int i = 0; i < m; ++i)
+          if (!(rise[std::size_t(i)] == 0.0 || rise[std::size_t(i)] >= ao::kSmallestScaledRise))
+            slope[std::size_t(i)] = ao::coarse_slope_by_tap(b, s[std::size_t(i)], ao::texel_u(b, i0 + i), v,
+                                                            dxs[std::size_t(d)], dys[std::size_t(d)]);
+      for (int i = 0; i < m; i += kWidth) {  // past m: lanes of earlier chunks or zeros, not stored
+        const Double sl = Double::load_aligned(&slope[std::size_t(i)]);
+        (Double::load_aligned(&visible[std::size_t(i)]) + (Double(1.0) - sl / xsimd::sqrt(Double(1.0) + sl * sl)))
+            .store_aligned(&visible[std::size_t(i)]);
+      }
+    }
+    for (int i = 0; i < m; ++i) row[i0 + i] = float(visible[std::size_t(i)] / double(n));
+  }
+}
+
 }  // namespace
 
 void ao_map_row(const ao::Bake& bake, int j, float* row) {
   kernel_calls.ao_rows.fetch_add(1, std::memory_order_relaxed);
+  if (bake.columns) return uniform_row(bake, j, row);
   int i = 0;
   std::array<double, kWidth> ao{};
   for (; i + kWidth <= bake.map_width; i += kWidth) {
