@@ -17,12 +17,12 @@
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
-#include "cli/frame_range.hpp"
 #include "cli/interrupt.hpp"
 #include "file/os_error.hpp"
 #include "cli/report.hpp"
 #include "cli/step_progress.hpp"
 #include "cli/study.hpp"
+#include "core/frame_pattern.hpp"
 #include "file/atomic_file.hpp"
 #include "file/output_check.hpp"
 #include "qdmr/bake/bake_cache.hpp"
@@ -125,7 +125,7 @@ qdmr::RenderOptions render_options(const RenderArgs& render) {
 struct FrameOutput {
   std::string option, pattern;
   // Frame -1 (a render without --frames or --frame) takes the name as it is.
-  std::filesystem::path at(int frame) const { return frame < 0 ? pattern : qdmr::cli::frame_name(pattern, frame); }
+  std::filesystem::path at(int frame) const { return frame < 0 ? pattern : qdmr::frame_name(pattern, frame); }
 };
 
 // The frames a render draws: --frames or --frame of the scene's animation, else the scene as it is (frame -1).
@@ -135,10 +135,11 @@ std::vector<int> frames_to_render(const RenderArgs& render, const qdmr::SceneDes
   const std::string option = sequence ? "--frames " + render.frames : "--frame " + std::to_string(*render.frame);
   if (!scene.animation.present)
     throw qdmr::Error(option, scene.file.string() + " has no /animation (frames and fps) to take frames from");
-  if (sequence) return qdmr::cli::parse_frame_range(render.frames, scene.animation.frames);
-  if (*render.frame < 0 || *render.frame >= scene.animation.frames)
+  const qdmr::FrameRange range =
+      sequence ? qdmr::parse_frame_range(option, render.frames) : qdmr::FrameRange{*render.frame, *render.frame, 1};
+  if (range.first < 0 || range.last >= scene.animation.frames)
     throw qdmr::Error(option, "the scene's animation has frames 0 to " + std::to_string(scene.animation.frames - 1));
-  return {*render.frame};
+  return range.frames();
 }
 
 int run_render(const SceneArgs& args, const RenderArgs& render) {
@@ -164,7 +165,7 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
   // A sequence names every output per frame; one frame may (or may not) number its names.
   const bool animated = !render.frames.empty() || render.frame;
   for (const FrameOutput& o : outputs)
-    if (animated && !qdmr::cli::has_frame_number(o.option, o.pattern) && !render.frames.empty())
+    if (animated && !qdmr::has_frame_number(o.option + " " + o.pattern, o.pattern) && !render.frames.empty())
       throw qdmr::Error(o.option + " " + o.pattern,
                         "names no frame number: a sequence (--frames) needs one, e.g. out_%04d.png");
   // Folders, and outputs equal to each other, before the scene is read (the frames are known after it).

@@ -6,11 +6,13 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
+#include "qdmr/texture/image.hpp"
 #include "scene/overrides.hpp"
 #include "scene/reader.hpp"
 #include "scene/validate.hpp"
@@ -25,7 +27,9 @@ namespace {
 void resolve_file_meshes(SceneDesc& scene, const nlohmann::json& document, const scene_detail::Context& context,
                          std::uint64_t max_memory_bytes, bool standalone = false) {
   const std::string file = scene.file.string();
-  const scene_detail::Value objects(context, document.at("objects"), "/objects");
+  scene_detail::Context timed = context;  // a glTF material's height may be a file sequence
+  timed.frames = scene.animation.frames;
+  const scene_detail::Value objects(timed, document.at("objects"), "/objects");
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     ObjectDesc& object = scene.objects[i];
     if (object.mesh.kind != MeshKind::Obj && object.mesh.kind != MeshKind::Gltf) continue;
@@ -65,6 +69,34 @@ void resolve_file_meshes(SceneDesc& scene, const nlohmann::json& document, const
   }
 }
 
+// Every frame of a height's file sequence has frame 0's size and sample depth: their headers are read now, so a
+// sequence is refused before anything is drawn, not at the frame that differs.
+void check_file_sequences(const SceneDesc& scene) {
+  std::set<std::string> checked;
+  const auto check = [&](const TextureDesc& t) {
+    const FileSequence& sequence = t.sequence;
+    if (t.source != TextureSource::File || sequence.pattern.empty() || !checked.insert(sequence.pattern).second) return;
+    const ImageHeader first = read_image_header(sequence_file(sequence, 0), sequence.field);
+    const auto describe = [](const ImageHeader& h) {
+      return std::to_string(h.width) + "x" + std::to_string(h.height) + " " +
+             (h.source_bits == 32 ? std::string("float") : std::to_string(h.source_bits) + "-bit");
+    };
+    for (int n = 1; n < scene.animation.frames; ++n) {
+      const std::filesystem::path path = sequence_file(sequence, n);
+      const ImageHeader h = read_image_header(path, sequence.field);
+      if (h.width != first.width || h.height != first.height || h.source_bits != first.source_bits)
+        throw Error(sequence.field, "frame " + std::to_string(n) + " of the animation, " + shown_path(path) + ", is " +
+                                        describe(h) + ", frame 0's is " + describe(first) +
+                                        " (every frame of a sequence has one size and sample depth)");
+    }
+  };
+  for (const MaterialDesc& m : scene.materials) {
+    for (const LayerDesc& l : m.layers) check(l.height);
+    check(m.blend.weights.height);
+  }
+  for (const ObjectDesc& o : scene.objects) check(o.mesh.height_map);
+}
+
 // A camera that frames the mesh: the default camera's direction (from -Y, above), the bounding sphere filling the
 // vertical field of view.
 CameraDesc framing_camera(const MeshData& mesh) {
@@ -102,6 +134,7 @@ SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<S
   if (!overrides.empty()) scene_detail::apply_overrides(document, overrides, context.file);
   SceneDesc scene = scene_detail::validate_scene(document, context);
   resolve_file_meshes(scene, document, context, max_memory_bytes, true);
+  check_file_sequences(scene);
   if (!document.contains("camera") && !scene.objects.empty() && scene.objects[0].obj_mesh) {
     const MeshData& mesh = *scene.objects[0].obj_mesh;
     scene.camera = mesh.cameras.empty() ? framing_camera(mesh) : mesh.cameras.front();
@@ -125,12 +158,14 @@ SceneDesc load_scene_json(const nlohmann::json& document, const std::filesystem:
   if (overrides.empty()) {
     SceneDesc scene = scene_detail::validate_scene(document, context);
     resolve_file_meshes(scene, document, context, max_memory_bytes);
+    check_file_sequences(scene);
     return scene;
   }
   nlohmann::json overridden = document;
   scene_detail::apply_overrides(overridden, overrides, context.file);
   SceneDesc scene = scene_detail::validate_scene(overridden, context);
   resolve_file_meshes(scene, overridden, context, max_memory_bytes);
+  check_file_sequences(scene);
   return scene;
 }
 

@@ -706,6 +706,10 @@ std::string FramePlan::describe() const {
   if (scene.animation.present)
     s << "animation: " << scene.animation.frames << " frames at " << scene.animation.fps << " fps; "
       << dynamic_items().size() << " dynamic items, rebuilt every frame\n";
+  // A moving camera rebuilds nothing: each frame's camera is only the draw's view.
+  if (!scene.camera.keyframes.empty())
+    s << "camera: animated, " << scene.camera.keyframes.size() << " keyframes, "
+      << (scene.camera.interpolation == CameraInterpolation::Smooth ? "smooth" : "linear") << " interpolation\n";
   s << "materials (" << materials.size() << "):\n";
   for (const MaterialPlan& m : materials) {
     s << "  " << m.name << ": " << m.variant << "\n";
@@ -839,6 +843,10 @@ nlohmann::json FramePlan::to_json() const {
   j["items"] = items();
   j["dynamic_items"] = dynamic_items();
   if (scene.animation.present) j["animation"] = {{"frames", scene.animation.frames}, {"fps", scene.animation.fps}};
+  if (!scene.camera.keyframes.empty())
+    j["camera"] = {{"animated", true},
+                   {"keyframes", scene.camera.keyframes.size()},
+                   {"interpolation", scene.camera.interpolation == CameraInterpolation::Smooth ? "smooth" : "linear"}};
   j["aovs"] = nlohmann::json::array();
   for (Aov a : aovs) j["aovs"].push_back(aov_name(a));
   if (const TextureCacheDesc& c = scene.texture_cache; c.enabled)

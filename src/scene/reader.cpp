@@ -200,12 +200,17 @@ glm::vec3 Value::vec3(NumberCheck component) const {
   return {(element(0).*component)(), (element(1).*component)(), (element(2).*component)()};
 }
 
-std::filesystem::path Value::existing_file() const {
+std::filesystem::path Value::file_path() const {
   const std::string text = string();
   require(!text.empty(), "expected a file path, got an empty string");
   std::filesystem::path path =
       std::filesystem::absolute(context_->base_dir / std::filesystem::path(text)).lexically_normal();
   if (!path.has_filename()) path = path.parent_path();  // "dir/." normalises to "dir/"
+  return path;
+}
+
+std::filesystem::path Value::existing_file() const {
+  const std::filesystem::path path = file_path();
   // Devices, FIFOs and sockets are refused here, before anything opens them; sizes are checked when read.
   const std::string reason = non_regular_reason(path);
   if (reason == "file not found" || reason == "is a directory, not a file")

@@ -42,6 +42,7 @@ std::string escape_pointer_token(std::string_view token);
 struct Context {
   std::string file;                // the scene file as named in messages
   std::filesystem::path base_dir;  // relative paths resolve against this
+  int frames = 1;                  // frames of the scene's animation (file sequences and keyframes are checked against it)
 };
 
 // One value in the document and where it is.
@@ -74,7 +75,8 @@ public:
   glm::vec3 vec3(NumberCheck component = &Value::number) const;  // [x, y, z]
   glm::vec3 color() const { return vec3(&Value::non_negative); }
   std::vector<Value> array() const;
-  std::filesystem::path existing_file() const;  // a path string resolved against base_dir; must exist
+  std::filesystem::path file_path() const;      // a path string resolved against base_dir
+  std::filesystem::path existing_file() const;  // file_path(), which must exist
 
   // One of a fixed set of names, e.g. {{"point", Filter::Point}, ...}.
   template <class E>

@@ -16,6 +16,8 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/frame_pattern.hpp"
+#include "file/input_file.hpp"
 #include "qdmr/core/limits.hpp"
 #include "qdmr/core/texture_cache.hpp"
 
@@ -75,30 +77,81 @@ OutputDesc read_output(const Value& value) {
   return output;
 }
 
+// The camera's view at one frame: a target apart from the position, an up vector not along the view.
+void check_view(const Value& target, const Value& up, const CameraDesc& camera, const std::string& frame) {
+  const glm::vec3 view = camera.target - camera.position;
+  target.require(glm::length(view) > 0, frame + "the target must differ from the position");
+  up.require(glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) > 1e-4f,
+             frame + "the up vector must not be parallel to the view direction (target - position)");
+}
+
+float read_fov(const Value& value) {
+  const float fov = static_cast<float>(value.number());
+  value.require(fov > 0 && fov < 180, "must be greater than 0 and less than 180, got " + format_number(fov));
+  return fov;
+}
+
+// Keyframes of a moving camera, sorted by frame, each inside the animation; `fov` is the camera's field of view,
+// which a keyframe without its own keeps.
+std::vector<CameraKeyframe> read_keyframes(const Value& value, float fov) {
+  const std::vector<Value> items = value.array();
+  value.require(!items.empty(), "expected at least one keyframe");
+  const int frames = value.context().frames;
+  std::vector<CameraKeyframe> keys;
+  for (const Value& item : items) {
+    const Object object(item, {"frame", "position", "target", "fov_deg"});
+    CameraKeyframe k;
+    const Value frame = object.required("frame");
+    k.frame = static_cast<int>(frame.integer(0, std::numeric_limits<int>::max()));
+    frame.require(k.frame < frames, "frame " + std::to_string(k.frame) + " is outside the animation's frames 0 to " +
+                                        std::to_string(frames - 1));
+    if (!keys.empty()) {
+      frame.require(k.frame != keys.back().frame, "two keyframes at frame " + std::to_string(k.frame));
+      frame.require(k.frame > keys.back().frame, "keyframes are listed by frame: " + std::to_string(k.frame) +
+                                                     " comes after " + std::to_string(keys.back().frame));
+    }
+    k.position = object.required("position").vec3();
+    k.target = object.required("target").vec3();
+    k.fov_y_deg = fov;
+    if (auto v = object.find("fov_deg")) k.fov_y_deg = read_fov(*v);
+    keys.push_back(k);
+  }
+  return keys;
+}
+
 CameraDesc read_camera(const Value& value) {
-  const Object object(value, {"position", "target", "up", "fov_deg", "near", "far"});
+  const Object object(value, {"position", "target", "up", "fov_deg", "near", "far", "keyframes", "interpolation"});
   CameraDesc camera;
   if (auto v = object.find("position")) camera.position = v->vec3();
   if (auto v = object.find("target")) camera.target = v->vec3();
   if (auto v = object.find("up")) camera.up = v->vec3();
-  if (auto v = object.find("fov_deg")) {
-    camera.fov_y_deg = static_cast<float>(v->number());
-    v->require(camera.fov_y_deg > 0 && camera.fov_y_deg < 180,
-               "must be greater than 0 and less than 180, got " + format_number(camera.fov_y_deg));
-  }
+  if (auto v = object.find("fov_deg")) camera.fov_y_deg = read_fov(*v);
   if (auto v = object.find("near")) camera.near = static_cast<float>(v->positive());
   if (auto v = object.find("far")) camera.far = static_cast<float>(v->number());
   member_or_self(object, "far")
       .require(camera.far > camera.near, "far (" + format_number(camera.far) + ") must be greater than near (" +
                                              format_number(camera.near) + ")");
-
-  const glm::vec3 view = camera.target - camera.position;
-  member_or_self(object, "target").require(glm::length(view) > 0, "the target must differ from the position");
   const Value up = member_or_self(object, "up");
   up.require(glm::length(camera.up) > 0, "the up vector must not be zero");
-  up.require(glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) > 1e-4f,
-             "the up vector must not be parallel to the view direction (target - position)");
-  return camera;
+
+  const auto keyframes = object.find("keyframes");
+  if (auto v = object.find("interpolation")) {
+    v->require(keyframes.has_value(), "only a camera with keyframes interpolates");
+    camera.interpolation = v->choice<CameraInterpolation>(
+        {{"linear", CameraInterpolation::Linear}, {"smooth", CameraInterpolation::Smooth}});
+  }
+  if (!keyframes) {
+    check_view(member_or_self(object, "target"), up, camera, "");
+    return camera;
+  }
+  for (const char* key : {"position", "target"})
+    if (auto v = object.find(key))
+      v->fail(std::string("a camera with keyframes takes its ") + key + " from them: give it there");
+  camera.keyframes = read_keyframes(*keyframes, camera.fov_y_deg);
+  // Every frame the keyframes span, as it will be drawn (before the first and after the last they hold).
+  for (int f = camera.keyframes.front().frame; f <= camera.keyframes.back().frame; ++f)
+    check_view(*keyframes, *keyframes, camera_at_frame(camera, f), "at frame " + std::to_string(f) + ", ");
+  return camera_at_frame(camera, 0);
 }
 
 // The emulated texture cache: present means on, unless "enabled": false.
@@ -181,12 +234,63 @@ void read_height_storage(const Object& object, TextureDesc& texture) {
   }
 }
 
+// A height's file: one file, or a frame-numbered sequence ("h_%04d.exr") whose `frames` FIRST:LAST[:STEP] (default
+// 0 up) are the file numbers of the animation's frames 0, 1, ... Every frame's file must exist now; their sizes are
+// compared when the scene is loaded (load/load.cpp reads the headers).
+void read_height_file(const Value& file, const std::optional<Value>& frames, TextureDesc& texture) {
+  const auto where = [](const Value& v) { return v.context().file + ": " + v.pointer(); };
+  texture.source = TextureSource::File;
+  if (!has_frame_number(where(file), file.string())) {
+    if (frames) frames->fail("only a frame-numbered file (e.g. h_%04d.exr) has frames");
+    texture.file = file.existing_file();
+    return;
+  }
+  FileSequence& sequence = texture.sequence;
+  sequence.pattern = file.file_path().string();
+  sequence.field = where(file);
+  const int count = file.context().frames;
+  FrameRange range{0, count - 1, 1};
+  if (frames) {
+    range = parse_frame_range(where(*frames), frames->string());
+    const long long needed = range.first + static_cast<long long>(count - 1) * range.step;
+    frames->require(needed <= range.last, "numbers " + std::to_string(range.size()) +
+                                              " files, fewer than the animation's " + std::to_string(count) +
+                                              " frames");
+  }
+  sequence.first = range.first;
+  sequence.step = range.step;
+  int found = 0;
+  std::optional<int> missing;
+  for (int n = 0; n < count; ++n) {
+    const std::filesystem::path path = sequence_file(sequence, n);
+    const std::string reason = non_regular_reason(path);
+    if (reason == "file not found") {
+      if (!missing) missing = n;
+      continue;
+    }
+    if (!reason.empty()) file.fail("frame " + std::to_string(n) + " of the animation: " + shown_path(path) + " " + reason);
+    note_input(path);
+    ++found;
+  }
+  if (found == 0)
+    file.fail("names no file: none of " + sequence_file(sequence, 0).filename().string() +
+              (count > 1 ? " to " + sequence_file(sequence, count - 1).filename().string() : std::string()) +
+              " exists in " + shown_path(sequence_file(sequence, 0).parent_path()));
+  if (missing)
+    file.fail("frame " + std::to_string(*missing) + " of the animation: file not found: " +
+              shown_path(sequence_file(sequence, *missing)));
+  texture.file = sequence_file(sequence, 0);
+}
+
 void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
   const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb", "factor"})
-                        : slot == Slot::Height ? Object(value, {"file", "channel", "format", "compression"})
+                        : slot == Slot::Height ? Object(value, {"file", "frames", "channel", "format", "compression"})
                                                : Object(value, {"file"});
   texture.source = TextureSource::File;
-  texture.file = object.required("file").existing_file();
+  if (slot == Slot::Height)
+    read_height_file(object.required("file"), object.find("frames"), texture);
+  else
+    texture.file = object.required("file").existing_file();
   if (auto v = object.find("channel")) {
     texture.channel = v->choice<Channel>({{"r", Channel::R},
                                           {"g", Channel::G},
@@ -300,6 +404,8 @@ TextureDesc read_texture(const Value& value, Slot slot) {
     if (value.string() == "from_height") {
       value.require(slot == Slot::Normal, "'from_height' is only valid for a normal map");
       texture.source = TextureSource::FromHeight;
+    } else if (slot == Slot::Height) {
+      read_height_file(value, std::nullopt, texture);
     } else {
       texture.source = TextureSource::File;
       texture.file = value.existing_file();
@@ -768,10 +874,17 @@ AnimationDesc read_animation(const Value& value) {
   return a;
 }
 
-SceneDesc validate_scene(const json& document, const Context& context) {
-  const Value root(context, document, "");
-  const Object object(root, {"output", "camera", "lights", "materials", "objects", "texture_cache", "animation"});
+SceneDesc validate_scene(const json& document, const Context& untimed) {
+  const auto top = [&](const Context& context) {
+    return Object(Value(context, document, ""),
+                  {"output", "camera", "lights", "materials", "objects", "texture_cache", "animation"});
+  };
   SceneDesc scene;
+  // The animation first: file sequences and camera keyframes are checked against its frames.
+  if (auto v = top(untimed).find("animation")) scene.animation = read_animation(*v);
+  Context context = untimed;
+  context.frames = scene.animation.frames;
+  const Object object = top(context);
   scene.file = context.file;
   if (auto v = object.find("output")) scene.output = read_output(*v);
   if (auto v = object.find("camera")) scene.camera = read_camera(*v);
@@ -783,7 +896,6 @@ SceneDesc validate_scene(const json& document, const Context& context) {
   }
   if (auto v = object.find("materials")) scene.materials = read_materials(*v);
   if (auto v = object.find("texture_cache")) scene.texture_cache = read_texture_cache(*v);
-  if (auto v = object.find("animation")) scene.animation = read_animation(*v);
   const std::vector<Value> objects = object.required("objects").array();
   for (std::size_t i = 0; i < objects.size(); ++i) scene.objects.push_back(read_object(objects[i], i, scene.materials));
   return scene;

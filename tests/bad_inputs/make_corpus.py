@@ -583,6 +583,62 @@ case("ao_amortize_a_string", amortized('"4"'), "/materials/m/ao/amortize_frames"
 case("cone_map_on_a_dynamic_height", frames("--frames", "0:1", "--set", "/materials/m/technique/name=csm"),
      "/materials/m/technique/name: 'csm' marches a cone map baked from the heights, and this material's heights change every frame")
 
+# Height layers from file sequences (issue #58): every frame's file is checked when the scene loads, before
+# anything is rendered. Frames 0, 1 and 3 of h_%04d.pgm exist (2 is missing); d_0001.pgm is smaller than d_0000.pgm.
+def pgm(side, value):
+    return b"P5\n%d %d\n255\n" % (side, side) + bytes([value]) * (side * side)
+for n in (0, 1, 3):
+    put("seq/h_%04d.pgm" % n, pgm(8, 40 * n))
+put("seq/d_0000.pgm", pgm(8, 10))
+put("seq/d_0001.pgm", pgm(4, 20))
+def sequence(height, frames=4):
+    return render("--set", '/animation={"frames": %d}' % frames, "--set", "/materials/m/layers/0/height=" + height)
+case("sequence_missing_frame", sequence('{"file": "seq/h_%04d.pgm"}'),
+     "/materials/m/layers/0/height/file: frame 2 of the animation: file not found: {in}/seq/h_0002.pgm")
+case("sequence_sizes_differ", sequence('{"file": "seq/d_%04d.pgm"}', 2),
+     "/materials/m/layers/0/height/file: frame 1 of the animation, {in}/seq/d_0001.pgm, is 4x4 8-bit, frame 0's is 8x8 8-bit")
+case("sequence_names_no_file", sequence('"seq/none_%04d.pgm"'),
+     "/materials/m/layers/0/height: names no file: none of none_0000.pgm to none_0003.pgm exists in {in}/seq")
+case("sequence_bad_percent", sequence('{"file": "seq/h_%4d.pgm"}'),
+     "/materials/m/layers/0/height/file: a '%' starts a frame number written %d or %0Nd")
+case("sequence_two_numbers", sequence('{"file": "seq/h_%04d_%d.pgm"}'), "/materials/m/layers/0/height/file: holds more than one frame number")
+case("sequence_range_reversed", sequence('{"file": "seq/h_%04d.pgm", "frames": "3:0"}'),
+     "/materials/m/layers/0/height/frames: the first frame is after the last")
+case("sequence_range_not_a_range", sequence('{"file": "seq/h_%04d.pgm", "frames": "0-3"}'),
+     "/materials/m/layers/0/height/frames: expected FIRST:LAST or FIRST:LAST:STEP")
+case("sequence_range_negative", sequence('{"file": "seq/h_%04d.pgm", "frames": "-1:3"}'),
+     "/materials/m/layers/0/height/frames: frame numbers start at 0")
+case("sequence_range_too_short", sequence('{"file": "seq/h_%04d.pgm", "frames": "0:3:2"}'),
+     "/materials/m/layers/0/height/frames: numbers 2 files, fewer than the animation's 4 frames")
+case("sequence_frames_without_number", sequence('{"file": "images/good_h.png", "frames": "0:3"}'),
+     "/materials/m/layers/0/height/frames: only a frame-numbered file (e.g. h_%04d.exr) has frames")
+
+# Camera keyframes (issue #58): checked when the scene loads.
+def keyframes(keys, extra="", frames=10):
+    return render("--set", '/animation={"frames": %d}' % frames,
+                  "--set", '/camera={"keyframes": [%s]%s}' % (keys, extra))
+KEY0 = '{"frame": 0, "position": [0, -3, 2], "target": [0, 0, 0]}'
+KEY5 = '{"frame": 5, "position": [1, -3, 2], "target": [0, 0, 0]}'
+case("keyframes_unsorted", keyframes(KEY5 + ", " + KEY0),
+     "/camera/keyframes/1/frame: keyframes are listed by frame: 0 comes after 5")
+case("keyframes_duplicate_frame", keyframes(KEY0 + ", " + KEY0), "/camera/keyframes/1/frame: two keyframes at frame 0")
+case("keyframes_missing_position", keyframes('{"frame": 0, "target": [0, 0, 0]}'),
+     "/camera/keyframes/0: missing key 'position'")
+case("keyframes_missing_frame", keyframes('{"position": [0, -3, 2], "target": [0, 0, 0]}'),
+     "/camera/keyframes/0: missing key 'frame'")
+case("keyframes_outside_the_animation", keyframes(KEY0 + ', {"frame": 10, "position": [1, -3, 2], "target": [0, 0, 0]}'),
+     "/camera/keyframes/1/frame: frame 10 is outside the animation's frames 0 to 9")
+case("keyframes_none", keyframes(""), "/camera/keyframes: expected at least one keyframe")
+case("keyframes_and_a_position", keyframes(KEY0, ', "position": [0, -3, 2]'),
+     "/camera/position: a camera with keyframes takes its position from them")
+case("keyframes_unknown_interpolation", keyframes(KEY0, ', "interpolation": "cubic"'),
+     "/camera/interpolation: unknown value 'cubic'")
+case("interpolation_without_keyframes", render("--set", '/camera={"interpolation": "smooth"}'),
+     "/camera/interpolation: only a camera with keyframes interpolates")
+case("keyframes_view_collapses", keyframes('{"frame": 0, "position": [0, -1, 1], "target": [0, 1, 1]}, '
+                                           '{"frame": 2, "position": [0, 1, 1], "target": [0, -1, 1]}'),
+     "/camera/keyframes: at frame 1, the target must differ from the position")
+
 with open(os.path.join(HERE, "cases.json"), "w") as f:
     json.dump({"comment": "Written by make_corpus.py; checked by tests/cli/bad_inputs_corpus_test.cpp.",
                "generated": generated, "cases": cases},

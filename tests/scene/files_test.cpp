@@ -117,7 +117,7 @@ TEST(SceneFiles, HeightFilesReadOneChannel) {
             "scene.json: /materials/rock/layers/0/height/channel: a height reads one channel: r, g, b or a");
   document["materials"]["rock"]["layers"][0] = {{"height", {{"file", "h.png"}, {"srgb", true}}}};
   EXPECT_EQ(test::load_error(document, {}, dir.path()),
-            "scene.json: /materials/rock/layers/0/height: unknown key 'srgb'; valid keys are: file, channel, format, compression");
+            "scene.json: /materials/rock/layers/0/height: unknown key 'srgb'; valid keys are: file, frames, channel, format, compression");
 }
 
 }  // namespace

@@ -25,6 +25,18 @@ struct OutputDesc {
   glm::vec3 background{0.05f, 0.06f, 0.08f};  // linear RGB where no triangle covers
 };
 
+// A camera that moves: at `frame` of the animation it is at `position`, looks at `target` with this field of view.
+struct CameraKeyframe {
+  int frame = 0;
+  glm::vec3 position{0.0f};
+  glm::vec3 target{0.0f};
+  float fov_y_deg = 45.0f;
+};
+
+// Between two keyframes: straight lines at constant speed, or a cubic through every keyframe whose velocity is
+// continuous (Catmull-Rom tangents over the keyframes' frame spacing) and zero at the first and the last.
+enum class CameraInterpolation { Linear, Smooth };
+
 struct CameraDesc {
   glm::vec3 position{0.0f, -3.0f, 2.0f};
   glm::vec3 target{0.0f, 0.0f, 0.0f};
@@ -32,7 +44,15 @@ struct CameraDesc {
   float fov_y_deg = 45.0f;  // vertical field of view
   float near = 0.05f;
   float far = 1000.0f;
+  // Sorted by frame, each frame once. Non-empty: position, target and fov_y_deg are those of the frame
+  // (camera_at_frame; frame 0's after loading), held before the first keyframe and after the last.
+  std::vector<CameraKeyframe> keyframes;
+  CameraInterpolation interpolation = CameraInterpolation::Linear;
 };
+
+// The camera at `frame`: position, target and field of view interpolated between its keyframes (in double,
+// rounded once to float: the same bits whoever asks). A camera without keyframes is returned as it is.
+CameraDesc camera_at_frame(const CameraDesc& camera, int frame);
 
 struct DirectionalLightDesc {
   glm::vec3 direction{0.3f, -0.4f, 0.87f};  // towards the light; normalised by the loader
@@ -83,6 +103,19 @@ struct ProceduralDesc {
 // Whether the pattern changes with ProceduralDesc::time: a scroll, or a wave with a speed.
 bool time_dependent(const ProceduralDesc& procedural);
 
+// Heights from a frame-numbered sequence of files (`"file": "h_%04d.exr"`, printf-style %d or %0Nd): frame n of
+// the animation reads file number first + n * step. The loader checks that every frame's file exists and that
+// they all have one size.
+struct FileSequence {
+  std::string pattern;  // absolute; empty: one file for every frame
+  int first = 0;
+  int step = 1;
+  std::string field;    // the scene file and the field that named it (for messages)
+};
+
+// Frame `frame`'s file of a sequence.
+std::filesystem::path sequence_file(const FileSequence& sequence, int frame);
+
 // Pixels: heights handed over by a program (Renderer::update_height), not read from the scene file.
 enum class TextureSource { None, File, Procedural, Constant, FromHeight, Pixels };
 
@@ -102,6 +135,7 @@ struct TextureDesc {
   TextureFormatChoice format = TextureFormatChoice::Auto;
   Compression compression = Compression::None;  // heights only: BC3/DXT5 alpha blocks (implies R8)
   std::filesystem::path file;        // absolute after loading (resolved against the scene file)
+  FileSequence sequence;             // heights only: `file` is then the frame's file (frame 0's after loading)
   Channel channel = Channel::Default;
   bool srgb = true;                  // albedo files only
   glm::vec3 factor{1.0f, 1.0f, 1.0f}; // albedo files only: multiplies the linear colour (glTF's baseColorFactor)
@@ -116,7 +150,7 @@ struct TextureDesc {
   std::uint64_t pixels_version = 0;
 };
 
-// Whether the texture's content changes from frame to frame (a time-dependent procedural).
+// Whether the texture's content changes from frame to frame (a time-dependent procedural, a file sequence).
 bool time_dependent(const TextureDesc& texture);
 
 enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
@@ -349,7 +383,7 @@ struct SceneDesc {
   std::vector<ObjectDesc> objects;      // submission order
   TextureCacheDesc texture_cache;       // the emulated texture cache (off unless asked for)
 
-  // Whether any texture of the scene changes with time.
+  // Whether any texture of the scene changes with time (what each frame rebuilds; a moving camera builds nothing).
   bool time_dependent() const;
 
   const MaterialDesc* find_material(const std::string& name) const {
@@ -359,9 +393,10 @@ struct SceneDesc {
   }
 };
 
-// The scene at `seconds`: every time-dependent texture evaluated then. Still textures are left as they are.
+// The scene at `seconds`: every time-dependent procedural evaluated then. Other textures are left as they are.
 SceneDesc scene_at_time(const SceneDesc& scene, double seconds);
-// The scene at frame `frame` of its animation (time frame / fps); frame 0 of a scene without animation is itself.
+// The scene at frame `frame` of its animation: procedurals at time frame / fps, each file sequence's file of the
+// frame, the camera at the frame (camera_at_frame). Frame 0 of a scene without animation is itself.
 SceneDesc scene_at_frame(const SceneDesc& scene, int frame);
 
 }  // namespace qdmr
