@@ -4,12 +4,13 @@ qdmr's procedural grid (time: at most 1.5 x), and the peak memory of that plan a
 plan counts it (at most 1.3 x; the asset has no textures).
 
 The .glb is written here: the grid of `{"type": "grid", "resolution": R}` (R = 708: 1,002,528 triangles) with
-POSITION, NORMAL, TEXCOORD_0 and 32-bit indices, no TANGENT (generated, as for the grid). Each round runs
+POSITION, NORMAL, TEXCOORD_0 and 32-bit indices, and no TANGENT (qdmr generates them, MikkTSpace's way), or with
+TANGENT (--tangents: as exporters write them for normal-mapped assets). Each round runs
 `qdmr plan` and a 16x16 `qdmr render` of both once; the table holds the median wall time, the peak resident memory (getrusage of the
 child), the plan's mesh size, and the load average before and after (run it on a quiet machine, and under
 `flock /tmp/qdmr-build.lock` where builds share the machine).
 
-  bench/gltf_load.py [-n 5] [-B BUILD_DIR] [--resolution 708]
+  bench/gltf_load.py [-n 5] [-B BUILD_DIR] [--resolution 708] [--tangents]
 """
 import argparse
 import json
@@ -23,22 +24,23 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def grid_glb(path, resolution):
+def grid_glb(path, resolution, tangents=False):
     """The procedural grid's vertices (size 2, in glTF's XZ plane facing +Y) as one .glb."""
     n = resolution + 1
-    positions, normals, uvs = bytearray(), bytearray(), bytearray()
+    positions, normals, uvs, frame = bytearray(), bytearray(), bytearray(), bytearray()
     for j in range(n):
         for i in range(n):
             u, v = i / resolution, j / resolution
             positions += struct.pack("<3f", -1 + 2 * u, 0.0, 1 - 2 * v)
             normals += struct.pack("<3f", 0.0, 1.0, 0.0)
             uvs += struct.pack("<2f", u, 1 - v)
+            frame += struct.pack("<4f", 1.0, 0.0, 0.0, 1.0)
     indices = bytearray()
     for j in range(resolution):
         for i in range(resolution):
             a = j * n + i
             indices += struct.pack("<6I", a, a + 1, a + n + 1, a, a + n + 1, a + n)
-    blobs = [positions, normals, uvs, indices]
+    blobs = [positions, normals, uvs, indices] + ([frame] if tangents else [])
     views, offset = [], 0
     for b in blobs:
         views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
@@ -46,12 +48,14 @@ def grid_glb(path, resolution):
     count = n * n
     doc = {
         "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3}]}],
+        "meshes": [{"primitives": [{"attributes": dict({"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+                                                       **({"TANGENT": 4} if tangents else {})), "indices": 3}]}],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1]},
             {"bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3"},
             {"bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2"},
-            {"bufferView": 3, "componentType": 5125, "count": len(indices) // 4, "type": "SCALAR"}],
+            {"bufferView": 3, "componentType": 5125, "count": len(indices) // 4, "type": "SCALAR"}] +
+            ([{"bufferView": 4, "componentType": 5126, "count": count, "type": "VEC4"}] if tangents else []),
         "bufferViews": views, "buffers": [{"byteLength": offset}]}
     js = json.dumps(doc).encode()
     js += b" " * (-len(js) % 4)
@@ -85,11 +89,12 @@ def main():
     ap.add_argument("-n", type=int, default=5)
     ap.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--resolution", type=int, default=708)
+    ap.add_argument("--tangents", action="store_true", help="write TANGENT into the .glb")
     args = ap.parse_args()
     binary = os.path.join(args.B, "qdmr")
     with tempfile.TemporaryDirectory() as tmp:
         glb = os.path.join(tmp, "grid.glb")
-        grid_glb(glb, args.resolution)
+        grid_glb(glb, args.resolution, args.tangents)
         scene = os.path.join(tmp, "grid.json")
         with open(scene, "w") as f:
             json.dump({"materials": {"m": {"layers": [{"albedo": {"constant": 0.5}}]}},
@@ -104,7 +109,7 @@ def main():
                 for name, target in (("procedural grid", scene), (".glb", glb))]
         load_after = os.getloadavg()[0]
     triangles = 2 * args.resolution ** 2
-    print("| %d triangles, %d rounds | wall time (median) | peak RSS | plan's mesh size |" % (triangles, args.n))
+    print("| %d triangles%s, %d rounds | wall time (median) | peak RSS | plan's mesh size |" % (triangles, " (.glb with TANGENT)" if args.tangents else "", args.n))
     print("|---|---|---|---|")
     for what, name, (t, peak, mesh) in rows:
         print("| %s: %s | %.3f s | %.1f MiB | %.1f MiB |" % (what, name, t, peak, mesh))

@@ -347,7 +347,7 @@ AddressMode address_of(int wrap) {
 // Turns the asset into one MeshData: every primitive of the drawn nodes, in qdmr's frame.
 class Builder {
 public:
-  Builder(const tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where,
+  Builder(tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where,
           std::uint64_t max_memory_bytes)
       : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, where_),
         max_memory_bytes_(max_memory_bytes) {}
@@ -356,6 +356,7 @@ public:
     check_nodes();
     const std::vector<int> roots = drawn_roots(desc);
     check_drawn_size(roots);
+    count_buffer_reads(roots);
     for (std::size_t m = 0; m < model_.materials.size(); ++m) materials_.push_back(convert_material(int(m)));
     for (const int root : roots) visit(root, parent_world(root));
     if (mesh_.indices.empty()) throw Error(where_, "no triangles to draw in " + shown_path(file_));
@@ -421,23 +422,16 @@ private:
       return view ? std::min<std::uint64_t>(a.count, model_.bufferViews[std::size_t(a.bufferView)].byteLength) : 0;
     };
     std::uint64_t vertices = 0, corners = 0;
-    std::vector<int> stack(roots.begin(), roots.end());
-    while (!stack.empty()) {
-      const tinygltf::Node& node = model_.nodes[std::size_t(stack.back())];
-      stack.pop_back();
-      stack.insert(stack.end(), node.children.begin(), node.children.end());
-      if (node.mesh < 0 || std::size_t(node.mesh) >= model_.meshes.size()) continue;
-      for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(node.mesh)].primitives) {
-        const auto position = prim.attributes.find("POSITION");
-        const std::uint64_t v = position == prim.attributes.end() ? 0 : count(position->second);
-        const std::uint64_t c = prim.indices >= 0 ? count(prim.indices) : v;
-        vertices += std::max(v, c);  // flat normals: one vertex per corner
-        corners += c;
-      }
+    for_each_drawn_primitive(roots, [&](const tinygltf::Primitive& prim) {
+      const auto position = prim.attributes.find("POSITION");
+      const std::uint64_t v = position == prim.attributes.end() ? 0 : count(position->second);
+      const std::uint64_t c = prim.indices >= 0 ? count(prim.indices) : v;
+      vertices += std::max(v, c);  // flat normals: one vertex per corner
+      corners += c;
       if (corners / 3 > limits::kMaxTriangles)
         throw Error(where_, "the drawn nodes hold more than " + std::to_string(limits::kMaxTriangles) +
                                 " triangles (a mesh drawn by several nodes counts for each)");
-    }
+    });
     // As the plan counts a mesh: position, normal, tangent, uv per vertex; three indices and a material per triangle.
     const std::uint64_t mesh_bytes = vertices * (3 + 3 + 4 + 2) * sizeof(float) + corners / 3 * 4 * sizeof(std::uint32_t);
     const auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
@@ -450,6 +444,51 @@ private:
     if (pages > 0 && page > 0 && bytes > std::uint64_t(pages) * std::uint64_t(page))
       throw Error(where_, "the drawn meshes need " + std::to_string(bytes >> 20) +
                               " MiB while they are read, more than this machine's memory");
+  }
+
+  // The buffers a primitive reads (its attributes' and indices'; references that do not exist are refused when read).
+  std::set<int> buffers_of(const tinygltf::Primitive& prim) const {
+    std::set<int> buffers;
+    const auto add = [&](int accessor) {
+      if (accessor < 0 || std::size_t(accessor) >= model_.accessors.size()) return;
+      const int view = model_.accessors[std::size_t(accessor)].bufferView;
+      if (view >= 0 && std::size_t(view) < model_.bufferViews.size()) buffers.insert(model_.bufferViews[std::size_t(view)].buffer);
+    };
+    for (const auto& [name, accessor] : prim.attributes) add(accessor);
+    add(prim.indices);
+    return buffers;
+  }
+
+  // How many drawn primitives read each buffer (a mesh drawn by several nodes counts once per node), so that a
+  // buffer is released as soon as the last of them has read it: a large asset's bytes are not held while its
+  // mesh is converted (embedded images were taken while tinygltf read the asset).
+  void count_buffer_reads(const std::vector<int>& roots) {
+    buffer_reads_.assign(model_.buffers.size(), 0);
+    for_each_drawn_primitive(roots, [&](const tinygltf::Primitive& prim) {
+      for (const int b : buffers_of(prim))
+        if (b >= 0 && std::size_t(b) < buffer_reads_.size()) ++buffer_reads_[std::size_t(b)];
+    });
+  }
+
+  // Every primitive of the nodes below `roots` (each node once: check_nodes), a mesh drawn by several nodes once
+  // per node; mesh indices that do not exist are refused when visited.
+  template <class Visit>
+  void for_each_drawn_primitive(const std::vector<int>& roots, Visit&& visit_primitive) const {
+    std::vector<int> stack(roots.begin(), roots.end());
+    while (!stack.empty()) {
+      const tinygltf::Node& node = model_.nodes[std::size_t(stack.back())];
+      stack.pop_back();
+      stack.insert(stack.end(), node.children.begin(), node.children.end());
+      if (node.mesh < 0 || std::size_t(node.mesh) >= model_.meshes.size()) continue;
+      for (const tinygltf::Primitive& prim : model_.meshes[std::size_t(node.mesh)].primitives) visit_primitive(prim);
+    }
+  }
+
+  void primitive_read(const tinygltf::Primitive& prim) {
+    for (const int b : buffers_of(prim))
+      if (b >= 0 && std::size_t(b) < buffer_reads_.size() && buffer_reads_[std::size_t(b)] > 0 &&
+          --buffer_reads_[std::size_t(b)] == 0)
+        std::vector<unsigned char>().swap(model_.buffers[std::size_t(b)].data);
   }
 
   std::vector<int> drawn_roots(const MeshDesc& desc) {
@@ -620,6 +659,7 @@ private:
         corners.resize(count);
         for (std::size_t i = 0; i < count; ++i) corners[i] = std::uint32_t(i);
       }
+      primitive_read(prim);
       std::vector<std::uint32_t> triangles = triangle_list(std::move(corners), prim.mode, at);
       check_triangle_count(mesh_.indices.size() / 3 + triangles.size() / 3, where_);
       append(std::move(positions), std::move(normals), std::move(tangents), std::move(uvs), uv_choice, std::move(triangles),
@@ -713,15 +753,22 @@ private:
       std::vector<float>().swap(normals);
       for (const std::uint32_t s : copies) uv_of.push_back(uv_of[s]);
       part.uvs = std::move(uv_of);
-      part.tangents.reserve(vertices);
+      // The tangents, given or made, transformed in place.
+      std::vector<glm::vec4> frame = std::move(made.tangents);
+      if (frame.empty()) {
+        frame.resize(vertices);
+        for (std::size_t v = 0; v < vertices; ++v)
+          frame[v] = glm::vec4(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2], tangents[4 * v + 3]);
+        std::vector<float>().swap(tangents);
+      }
       for (std::size_t v = 0; v < vertices; ++v) {
-        const glm::vec4 t = made.tangents.empty() ? glm::vec4(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2], tangents[4 * v + 3])
-                                                  : made.tangents[v];
+        const glm::vec4 t = frame[v];
         const glm::dvec3 tw = glm::dmat3(world) * glm::dvec3(t);
         const double tl = glm::length(tw);
         const float w = (t.w < 0.0f) != mirrored ? -1.0f : 1.0f;
-        part.tangents.emplace_back(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(part.normals[v]), w);
+        frame[v] = glm::vec4(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(part.normals[v]), w);
       }
+      part.tangents = std::move(frame);
       part.indices = std::move(triangles);
     }
     if (mesh_.positions.empty()) {  // the first primitive (often the only one): moved, not copied
@@ -878,7 +925,7 @@ private:
     return m;
   }
 
-  const tinygltf::Model& model_;
+  tinygltf::Model& model_;  // its buffers are released once no drawn primitive reads them
   const Reading& reading_;
   fs::path file_;
   std::string where_;
@@ -888,6 +935,7 @@ private:
   std::vector<TextureChoice> uv_choices_;
   std::map<int, fs::path> image_files_;
   std::uint64_t max_memory_bytes_ = 0;
+  std::vector<std::size_t> buffer_reads_;  // per buffer: the drawn primitives that have yet to read it
   int default_material_ = -1;
   bool has_textures_ = false;
   std::vector<std::pair<std::string, int>> notes_;

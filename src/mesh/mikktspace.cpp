@@ -14,21 +14,6 @@
 
 namespace qdmr::mesh_detail {
 
-double deterministic_acos(double x) {
-  x = std::clamp(x, -1.0, 1.0);
-  const double half_pi = 1.57079632679489661923;
-  // asin(a) for 0 <= a <= 0.5: a + a z P(z), z = a^2 (Cephes asinf).
-  const auto asin_small = [](double a) {
-    const double z = a * a;
-    return a + a * z * ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z +
-                        1.6666752422e-1);
-  };
-  const double a = std::abs(x);
-  // asin(a) = pi/2 - 2 asin(sqrt((1 - a) / 2)) above 0.5.
-  const double asin_a = a <= 0.5 ? asin_small(a) : half_pi - 2.0 * asin_small(std::sqrt((1.0 - a) * 0.5));
-  return x < 0.0 ? half_pi + asin_a : half_pi - asin_a;
-}
-
 namespace {
 
 glm::vec3 at3(const std::vector<float>& v, std::uint32_t i) { return {v[3 * i], v[3 * i + 1], v[3 * i + 2]}; }
@@ -128,10 +113,14 @@ MikkTSpaceTangents mikktspace_tangents(const std::vector<float>& positions, cons
       const std::uint32_t v = corner[k];
       const glm::vec3 nv = normal(v);
       const glm::vec3 t = in_plane(face.along_u, nv);
+      // The corner's angle between its edges projected onto the normal's plane (a zero edge: pi / 2, as
+      // mikktspace.c's zero vectors give), from one square root instead of two normalisations.
       const glm::vec3 p = at3(positions, v);
-      const glm::vec3 e1 = in_plane(at3(positions, corner[(k + 2) % 3]) - p, nv);
-      const glm::vec3 e2 = in_plane(at3(positions, corner[(k + 1) % 3]) - p, nv);
-      const float angle = float(deterministic_acos(double(glm::dot(e1, e2))));
+      const glm::vec3 a = at3(positions, corner[(k + 2) % 3]) - p, b = at3(positions, corner[(k + 1) % 3]) - p;
+      const glm::vec3 a_in = a - nv * glm::dot(nv, a), b_in = b - nv * glm::dot(nv, b);
+      const double lengths2 = double(glm::dot(a_in, a_in)) * double(glm::dot(b_in, b_in));
+      const double cosine = lengths2 > 0.0 && std::isfinite(lengths2) ? double(glm::dot(a_in, b_in)) / std::sqrt(lengths2) : 0.0;
+      const float angle = float(deterministic_acos(cosine));
       (face.preserving ? preserving_sum : mirrored_sum)[same[v]] += angle * t;
       flags[same[v]] |= face.preserving ? 1 : 2;
     }

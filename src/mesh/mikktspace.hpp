@@ -12,6 +12,8 @@
 //   - a vertex used by corners of both orientations (a mirrored UV seam) is split: the mirrored corners get a copy.
 // Not done: mikktspace.c's grouping by edge-connected fans (corners of one vertex and orientation that are not
 // connected through shared edges share a tangent here) and its angular split threshold (off by default there too).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -32,6 +34,19 @@ MikkTSpaceTangents mikktspace_tangents(const std::vector<float>& positions, cons
 
 // acos from +, *, / and sqrt only (Cephes' asinf polynomial, in double): the same bits on every machine, where
 // libm's acos may take an FMA variant on some CPUs. Accurate to about 1e-7; x is clamped to [-1, 1].
-double deterministic_acos(double x);
+inline double deterministic_acos(double x) {
+  x = std::clamp(x, -1.0, 1.0);
+  const double half_pi = 1.57079632679489661923;
+  // asin(a) for 0 <= a <= 0.5: a + a z P(z), z = a^2 (Cephes asinf).
+  const auto asin_small = [](double a) {
+    const double z = a * a;
+    return a + a * z * ((((4.2163199048e-2 * z + 2.4181311049e-2) * z + 4.5470025998e-2) * z + 7.4953002686e-2) * z +
+                        1.6666752422e-1);
+  };
+  const double a = std::abs(x);
+  // asin(a) = pi/2 - 2 asin(sqrt((1 - a) / 2)) above 0.5.
+  const double asin_a = a <= 0.5 ? asin_small(a) : half_pi - 2.0 * asin_small(std::sqrt((1.0 - a) * 0.5));
+  return x < 0.0 ? half_pi + asin_a : half_pi - asin_a;
+}
 
 }  // namespace qdmr::mesh_detail
