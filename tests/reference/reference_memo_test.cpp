@@ -27,7 +27,8 @@ std::shared_ptr<const HeightField> random_field(std::uint32_t seed) {
   auto field = std::make_shared<HeightField>();
   field->width = 37;
   field->height = 23;
-  for (int i = 0; i < field->width * field->height; ++i) field->h.push_back(unit(random));
+  field->h = ZeroedBuffer<double>(std::size_t(field->width) * std::size_t(field->height));
+  for (double& h : field->h) h = unit(random);
   return field;
 }
 
