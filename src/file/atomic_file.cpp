@@ -7,10 +7,8 @@
 #include <sys/statvfs.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cctype>
 #include <charconv>
 #include <climits>
 #include <cstring>
