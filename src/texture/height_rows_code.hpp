@@ -40,11 +40,14 @@ inline void finish_waves(float* row, int n, float scale, float offset) {
   }
 }
 
-// make_mip_texture's quantisation: clamp to [0, 1] (NaN to 0), round to nearest, ties up (exact in double).
+// make_mip_texture's quantisation: clamp to [0, 1] (NaN to 0), round to nearest, ties up (exact in double). As
+// v Max + 0.5 clamped to [0, Max] and truncated, without a call to floor: the same code (at or below 0, or NaN, it
+// is 0; at or above 1, Max; in between the truncation of a positive number is its floor).
 template <int Max>
-inline double code_of(float v) {
-  const double q = std::floor(double(v) * double(Max) + 0.5);
-  return v >= 1.0f ? double(Max) : v > 0.0f ? q : 0.0;
+inline int code_of(float v) {
+  const double x = double(v) * double(Max) + 0.5;
+  const double above = 0.0 < x ? x : 0.0;  // std::max(0.0, x): NaN to 0
+  return int(above < double(Max) ? above : double(Max));
 }
 
 template <class Code>
@@ -62,7 +65,7 @@ inline void store_code(std::uint8_t* p, int i, Code c) {
 template <class Code, int Max>
 void quantise_n(const float* h, int n, std::uint8_t* codes, float* decoded) {
   for (int x = 0; x < n; ++x) {
-    const Code c = Code(int(code_of<Max>(h[x])));
+    const Code c = Code(code_of<Max>(h[x]));
     store_code<Code>(codes, x, c);
     decoded[x] = float(c) / float(Max);
   }
@@ -87,7 +90,7 @@ inline void decode(TexelFormat format, const std::uint8_t* codes, int n, float* 
 template <class Code, int Max>
 void box_n(const float* const* in, int rows, int in_w, int out_w, std::uint8_t* codes, float* decoded) {
   const auto put = [&](int x, float sum, float count) {
-    const Code c = Code(int(code_of<Max>(sum / count)));
+    const Code c = Code(code_of<Max>(sum / count));
     store_code<Code>(codes, x, c);
     decoded[x] = float(c) / float(Max);
   };
@@ -116,13 +119,13 @@ inline void box(TexelFormat format, const float* const* in, int rows, int in_w, 
 }
 
 // 0.5 + 0.5 n of a unit normal component, as an RGBA8 code.
-inline std::uint8_t unorm8_of_normal(float n) { return std::uint8_t(int(code_of<255>(0.5f + 0.5f * n))); }
+inline std::uint8_t unorm8_of_normal(float n) { return std::uint8_t(code_of<255>(0.5f + 0.5f * n)); }
 
 // normals_from_height and the from_height slot's normalise (a zero or non-finite length gives (0, 0, 1)).
 inline void normal_texel(float nx, float ny, std::uint8_t* rgba) {
   const float nz = 1.0f;
   const double len2 = double(nx) * nx + double(ny) * ny + double(nz) * nz;
-  const bool ok = len2 > 0.0 && len2 <= DBL_MAX;
+  const bool ok = (len2 > 0.0) & (len2 <= DBL_MAX);
   const double inv = 1.0 / std::sqrt(ok ? len2 : 1.0);
   rgba[0] = unorm8_of_normal(ok ? float(nx * inv) : 0.0f);
   rgba[1] = unorm8_of_normal(ok ? float(ny * inv) : 0.0f);
@@ -147,23 +150,25 @@ inline void box_normal_texel(const float* sum, float count, std::uint8_t* rgba) 
   rgba[0] = unorm8_of_normal(len2 > 0.0 ? float(sum[0] * inv) : 0.0f);
   rgba[1] = unorm8_of_normal(len2 > 0.0 ? float(sum[1] * inv) : 0.0f);
   rgba[2] = unorm8_of_normal(len2 > 0.0 ? float(sum[2] * inv) : 1.0f);
-  rgba[3] = std::uint8_t(int(code_of<255>(sum[3] / count)));
+  rgba[3] = std::uint8_t(code_of<255>(sum[3] / count));
 }
 
 inline float unorm8(std::uint8_t c) { return float(c) / 255.0f; }
+
+// A tap's 2v - 1.
+inline float signed_unorm8(std::uint8_t c) { return 2.0f * unorm8(c) - 1.0f; }
 
 inline void box_normals(const std::uint8_t* const* in, int rows, int in_w, int out_w, std::uint8_t* rgba) {
   int x = 0;
   if (in_w > 1 && rows == 2) {
     const std::uint8_t *a = in[0], *b = in[1];
     for (const int pairs = out_w - (in_w & 1); x < pairs; ++x) {
-      float sum[4];
-      for (int c = 0; c < 4; ++c) {
-        const float a0 = unorm8(a[8 * x + c]), a1 = unorm8(a[8 * x + 4 + c]), b0 = unorm8(b[8 * x + c]),
-                    b1 = unorm8(b[8 * x + 4 + c]);
-        sum[c] = c < 3 ? 0.0f + (2.0f * a0 - 1.0f) + (2.0f * a1 - 1.0f) + (2.0f * b0 - 1.0f) + (2.0f * b1 - 1.0f)
-                       : 0.0f + a0 + a1 + b0 + b1;
-      }
+      const std::uint8_t *a0 = a + 8 * x, *a1 = a0 + 4, *b0 = b + 8 * x, *b1 = b0 + 4;
+      const float sum[4] = {
+          0.0f + signed_unorm8(a0[0]) + signed_unorm8(a1[0]) + signed_unorm8(b0[0]) + signed_unorm8(b1[0]),
+          0.0f + signed_unorm8(a0[1]) + signed_unorm8(a1[1]) + signed_unorm8(b0[1]) + signed_unorm8(b1[1]),
+          0.0f + signed_unorm8(a0[2]) + signed_unorm8(a1[2]) + signed_unorm8(b0[2]) + signed_unorm8(b1[2]),
+          0.0f + unorm8(a0[3]) + unorm8(a1[3]) + unorm8(b0[3]) + unorm8(b1[3])};
       box_normal_texel(sum, 4.0f, rgba + 4 * x);
     }
   }
