@@ -95,8 +95,7 @@ int main(int argc, char** argv) {
       for (float radius_texels : {16.0f, 64.0f})
         for (bool jitter : {false, true}) {
           if (jitter && directions != 4) continue;  // the talk: jitter lets 4 directions do
-          qdmr::AoDesc d;
-          d.mode = qdmr::AoMode::Frame;
+          qdmr::AoParams d;
           d.coarse = coarse;
           d.directions = directions;
           d.radius = radius_texels / float(size);

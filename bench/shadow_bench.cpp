@@ -45,8 +45,7 @@ void shadow(benchmark::State& state, ShadowMode mode) {
   const Maps& m = maps();
   const HeightLayerTextures textures(m.height, &m.tree, SamplerState{}, HeightFetch::Bilinear);
   const SingleLayerSurface surface(textures);
-  ShadowDesc desc;
-  desc.mode = mode;
+  const ShadowParams desc;
   const double elevation = double(state.range(0)) * std::numbers::pi / 180.0;
   // Lanes: point (u, v) on the top of its texel (R16 heights decode to 16-bit steps; the float image's value is
   // within half a step of it, and the start texel never shadows its own point), light slope 1/tan(elevation).
@@ -68,7 +67,7 @@ void shadow(benchmark::State& state, ShadowMode mode) {
       const ShadowRay ray{simd::Float::load_unaligned(&u[i]),  simd::Float::load_unaligned(&v[i]),
                           simd::Float::load_unaligned(&s[i]),  simd::Float::load_unaligned(&du[i]),
                           simd::Float::load_unaligned(&dv[i]), simd::Float(kDepthScale)};
-      const ShadowResult r = self_shadow(surface, desc, ray, simd::Float(0.0f), all);
+      const ShadowResult r = self_shadow(surface, mode, desc, ray, simd::Float(0.0f), all);
       it += r.iterations;
       dark += simd::count(r.visibility < simd::Float(1.0f));
     }

@@ -66,7 +66,7 @@ ao::MaxPyramid::MaxPyramid(const HeightField& field) {
 ao::UniformColumns::UniformColumns(const Bake& b) : taps(b.taps.count) {
   const HeightField& f = *b.field;
   const MaxPyramid& p = *b.pyramid;
-  const int n = direction_count(b.desc), w = b.map_width;
+  const int n = direction_count(b.pattern), w = b.map_width;
   cell.resize(std::size_t(n) * std::size_t(taps) * std::size_t(w));
   left.resize(std::size_t(w));
   right.resize(std::size_t(w));
@@ -109,7 +109,8 @@ std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& des
       bytes += std::uint64_t(w) * std::uint64_t(h) * sizeof(double);
     }
     if (!desc.jitter)
-      bytes += ao::UniformColumns::bytes(size.width, ao::direction_count(desc), ao::make_taps(desc, field_width, field_height).count);
+      bytes += ao::UniformColumns::bytes(size.width, ao::direction_count(pattern_of(desc)),
+                                        ao::make_taps(pattern_of(desc), field_width, field_height).count);
   }
   return bytes;
 }
@@ -130,7 +131,8 @@ void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& de
   if (map.width != size.width || map.height != size.height || map.channels != 1 || step < 1 || first < 0)
     throw Error("ao map", "bake_ao_rows: the map or the rows do not fit the bake");
   const std::optional<ao::MaxPyramid> pyramid = desc.coarse ? std::optional<ao::MaxPyramid>(field) : std::nullopt;
-  ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, desc, ao::make_taps(desc, field.width, field.height),
+  ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, pattern_of(desc),
+                ao::make_taps(pattern_of(desc), field.width, field.height),
                 size.width, size.height};
   // The kernels' rows of a coarse bake without jitter read the columns every row shares.
   const std::optional<ao::UniformColumns> columns =
@@ -162,7 +164,7 @@ std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoD
   f.value(std::int32_t(field.address));
   f.bytes(field.h.data(), field.h.size() * sizeof(double));
   f.value(depth_scale);
-  f.value(std::int32_t(ao::direction_count(desc)));
+  f.value(std::int32_t(ao::direction_count(pattern_of(desc))));
   f.value(desc.radius);
   f.value(std::uint8_t(desc.coarse));
   f.value(std::uint8_t(desc.jitter));

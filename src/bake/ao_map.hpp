@@ -17,11 +17,17 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "bake/ao_pattern.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "qdmr/texture/image.hpp"
 
 namespace qdmr {
+
+// The directions and taps a material's AO looks along (bake/ao_pattern.hpp).
+inline ao::Pattern pattern_of(const AoDesc& desc) {
+  return {desc.directions, desc.jitter, desc.seed, desc.radius, desc.coarse};
+}
 
 namespace ao {
 struct Bake;  // what one texel reads (bake/ao_texel.hpp)

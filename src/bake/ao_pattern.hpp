@@ -19,16 +19,26 @@
 #include <array>
 #include <cstdint>
 
-#include "qdmr/scene/scene.hpp"
-
 namespace qdmr::ao {
+
+// What the pattern is made from: AoDesc's fields of the same names (bake/ao_map.hpp's pattern_of), for the baked
+// map and the programs' per-frame AO alike.
+struct Pattern {
+  int directions = 8;
+  bool jitter = false;
+  std::uint32_t seed = 1;
+  float radius = 0.05f;
+  bool coarse = true;
+};
 
 inline constexpr int kMinDirections = 4, kMaxDirections = 16;
 inline constexpr int kRotations = 16;  // jitter rotations per direction spacing (4 hash bits)
 inline constexpr int kMaxFineTaps = 64;
 inline constexpr int kMaxTaps = kMaxFineTaps;  // coarse needs at most 32 (2^31 texels)
 
-inline int direction_count(const AoDesc& desc) { return std::clamp(desc.directions, kMinDirections, kMaxDirections); }
+inline int direction_count(const Pattern& pattern) {
+  return std::clamp(pattern.directions, kMinDirections, kMaxDirections);
+}
 
 namespace detail {
 
@@ -108,19 +118,19 @@ struct Taps {
 };
 
 // The taps of one direction for a height map of width x height texels.
-inline Taps make_taps(const AoDesc& desc, int width, int height) {
+inline Taps make_taps(const Pattern& pattern, int width, int height) {
   Taps taps;
   const float texel = 1.0f / float(std::max(width, height));
   const auto add = [&](float distance, int level) {
     taps.tap[std::size_t(taps.count++)] = {distance, 1.0f / distance, level};
   };
-  if (desc.coarse) {
-    for (int k = 0; k < 31 && float(1 << k) * texel <= desc.radius; ++k) add(float(1 << k) * texel, k);
+  if (pattern.coarse) {
+    for (int k = 0; k < 31 && float(1 << k) * texel <= pattern.radius; ++k) add(float(1 << k) * texel, k);
   } else {
-    const float texels = desc.radius / texel;
+    const float texels = pattern.radius / texel;
     const bool spread = texels > float(kMaxFineTaps);
     const int count = spread ? kMaxFineTaps : int(texels);
-    const float step = spread ? desc.radius / float(kMaxFineTaps) : texel;
+    const float step = spread ? pattern.radius / float(kMaxFineTaps) : texel;
     for (int k = 1; k <= count; ++k) add(float(k) * step, 0);
   }
   return taps;

@@ -9,7 +9,6 @@
 
 #include "bake/ao_pattern.hpp"
 #include "qdmr/core/zeroed_buffer.hpp"
-#include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/heightfield.hpp"
 
 namespace qdmr::ao {
@@ -48,7 +47,7 @@ struct Bake {
   const HeightField* field;
   const MaxPyramid* pyramid;
   double depth_scale;
-  AoDesc desc;
+  Pattern pattern;
   Taps taps;
   int map_width, map_height;
   const UniformColumns* columns = nullptr;  // coarse without jitter: what every row shares (for the kernels' rows)
@@ -119,8 +118,8 @@ inline double texel_v(const Bake& b, int j) { return (j + 0.5) / b.map_height; }
 
 // The raw AO of texel (i, j) of the map.
 inline double texel_ao(const Bake& b, int i, int j) {
-  const int n = direction_count(b.desc);
-  const int r = b.desc.jitter ? rotation(std::uint32_t(i), std::uint32_t(j), b.desc.seed) : 0;
+  const int n = direction_count(b.pattern);
+  const int r = b.pattern.jitter ? rotation(std::uint32_t(i), std::uint32_t(j), b.pattern.seed) : 0;
   const double u = texel_u(b, i), v = texel_v(b, j);
   const double s = bilinear_surface_depth(*b.field, b.depth_scale, u, v);
   double visible = 0.0;

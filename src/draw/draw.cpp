@@ -178,7 +178,7 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
         inputs.reference_id = memo->field_id(field);
       }
     }
-    programs.push_back(kernel.make_program(m.desc, inputs, lights));
+    programs.push_back(kernel.make_program(m.key, m.params, inputs, lights));
   }
   return programs;
 }

@@ -9,7 +9,7 @@
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
 template <class Surface>
-simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const simd::Float& u, const simd::Float& v,
+simd::Float ambient_occlusion(const Surface& surface, const AoParams& desc, const simd::Float& u, const simd::Float& v,
                               const simd::Float& s, const simd::Float& ds, const simd::Float& pixel_x,
                               const simd::Float& pixel_y, simd::Mask active) {
   using simd::Float;
@@ -18,8 +18,9 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
   if (!xsimd::any(active)) return one;
   FetchLanes lanes(FetchPhase::Occlusion);
   lanes.narrow(active);
-  const ao::Taps taps = ao::make_taps(desc, surface.width(), surface.height());
-  const int n = ao::direction_count(desc);
+  const ao::Pattern pattern = pattern_of(desc);
+  const ao::Taps taps = ao::make_taps(pattern, surface.width(), surface.height());
+  const int n = ao::direction_count(pattern);
   const Float u0 = xsimd::select(active, u, zero), v0 = xsimd::select(active, v, zero);
   const Float s0 = xsimd::select(active, s, zero), ds0 = xsimd::select(active, ds, zero);
   const Float width(float(surface.width())), height(float(surface.height()));
@@ -53,10 +54,10 @@ simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const 
   return xsimd::select(active, apply_ao_strength(visible / Float(float(n)), desc.strength), one);
 }
 
-template simd::Float ambient_occlusion<SingleLayerSurface>(const SingleLayerSurface&, const AoDesc&, const simd::Float&,
+template simd::Float ambient_occlusion<SingleLayerSurface>(const SingleLayerSurface&, const AoParams&, const simd::Float&,
                                                            const simd::Float&, const simd::Float&, const simd::Float&,
                                                            const simd::Float&, const simd::Float&, simd::Mask);
-template simd::Float ambient_occlusion<BlendedSurface>(const BlendedSurface&, const AoDesc&, const simd::Float&,
+template simd::Float ambient_occlusion<BlendedSurface>(const BlendedSurface&, const AoParams&, const simd::Float&,
                                                        const simd::Float&, const simd::Float&, const simd::Float&,
                                                        const simd::Float&, const simd::Float&, simd::Mask);
 

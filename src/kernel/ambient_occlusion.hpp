@@ -15,7 +15,7 @@
 // A flat surface (h(tap) equal to the point's height, s = ds * (1 - h)) gives exactly 1.
 #include "bake/ao_pattern.hpp"
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -34,6 +34,11 @@ inline simd::Int ao_rotation(const simd::Float& pixel_x, const simd::Float& pixe
 }
 
 // ao' = 1 - strength * (1 - ao): strength 0 disables the darkening, 1 keeps it (for baked maps too).
+// The directions and taps of bake/ao_pattern.hpp the parameters ask for.
+inline ao::Pattern pattern_of(const AoParams& params) {
+  return {params.directions, params.jitter, params.seed, params.radius, params.coarse};
+}
+
 inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
   const simd::Float one(1.0f);
   return one - simd::Float(strength) * (one - ao);
@@ -45,7 +50,7 @@ inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
 // taps reach up to desc.radius from (u, v), so a BlendedSurface with per-pixel weights needs its UV box to cover
 // [u - radius, u + radius] x [v - radius, v + radius].
 template <class Surface>
-simd::Float ambient_occlusion(const Surface& surface, const AoDesc& desc, const simd::Float& u, const simd::Float& v,
+simd::Float ambient_occlusion(const Surface& surface, const AoParams& desc, const simd::Float& u, const simd::Float& v,
                               const simd::Float& s, const simd::Float& ds, const simd::Float& pixel_x,
                               const simd::Float& pixel_y, simd::Mask active);
 

@@ -139,13 +139,13 @@ Double fine_slope(const ao::Bake& b, const Lanes& l, const Double& dx, const Dou
 
 // The raw AO of kWidth texels from i0 on row j; false where the vector form does not hold (nothing written).
 bool batch_ao(const ao::Bake& b, int i0, int j, std::array<double, kWidth>& out) {
-  const int n = ao::direction_count(b.desc);
+  const int n = ao::direction_count(b.pattern);
   std::array<double, kWidth> u{};
   std::array<int, kWidth> rotation{};
   for (int lane = 0; lane < kWidth; ++lane) {
     u[std::size_t(lane)] = ao::texel_u(b, i0 + lane);
     rotation[std::size_t(lane)] =
-        b.desc.jitter ? ao::rotation(std::uint32_t(i0 + lane), std::uint32_t(j), b.desc.seed) : 0;
+        b.pattern.jitter ? ao::rotation(std::uint32_t(i0 + lane), std::uint32_t(j), b.pattern.seed) : 0;
   }
   bool ok = true;
   Lanes l{Double::load_unaligned(u.data()), Double(ao::texel_v(b, j)), Double(0.0)};
@@ -162,7 +162,7 @@ bool batch_ao(const ao::Bake& b, int i0, int j, std::array<double, kWidth>& out)
     const Double vdx = Double::load_unaligned(dx.data()), vdy = Double::load_unaligned(dy.data());
     Double slope;
     if (b.pyramid) {
-      const Double rise = coarse_rise(b, l, vdx, vdy, ao::texel_v(b, j), b.desc.jitter ? nullptr : &dy[0], ok);
+      const Double rise = coarse_rise(b, l, vdx, vdy, ao::texel_v(b, j), b.pattern.jitter ? nullptr : &dy[0], ok);
       if (!ok) return false;
       slope = rise / Double(double(b.taps.tap[0].distance));
       const DoubleMask by_tap = (rise != Double(0.0)) & (rise < Double(ao::kSmallestScaledRise));
@@ -197,7 +197,7 @@ void uniform_row(const ao::Bake& b, int j, float* row) {
   const HeightField& f = *b.field;
   const ao::MaxPyramid& p = *b.pyramid;
   const ao::UniformColumns& c = *b.columns;
-  const int n = ao::direction_count(b.desc), taps = c.taps;
+  const int n = ao::direction_count(b.pattern), taps = c.taps;
   const double v = ao::texel_v(b, j), ds = b.depth_scale, first = double(b.taps.tap[0].distance);
   // bilinear_surface_depth's rows.
   const double y = v * f.height - 0.5, fj = std::floor(y), fy = y - fj;

@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "qdmr/bake/cone_map.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/trace_ray.hpp"
 #include "kernel/sampler.hpp"
@@ -44,7 +44,7 @@ struct ConeTexels {
 // the hit. Relaxed cones let a step enter the surface at most once and not leave it before the step's end: a
 // step that ends below the surface brackets the first hit, found by binary search on the box surface.
 template <bool relaxed, bool Recorded>
-Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask active, const TechniqueDesc& technique) {
+Hit cone_step(const ConeTexels& texels, const Ray& ray, const Float& ds, Mask active, const TraceParams& technique) {
   const float width = float(texels.cones->width), height = float(texels.cones->height);
   const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
   const Float x0 = ray.u0 * Float(width), y0 = ray.v0 * Float(height);

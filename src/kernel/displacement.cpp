@@ -6,7 +6,6 @@
 #include <type_traits>
 
 #include "kernel/lane_compaction.hpp"
-#include "program/variant.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/reference/reference_memo.hpp"
@@ -35,22 +34,29 @@ using simd::count;
 using simd::float_mask;
 using simd::int_mask;
 
+// The key of the program that runs: the trace options of the instantiation selected, which name it as the plan
+// does (a test checks that the two agree).
+ProgramKey with_trace(ProgramKey key, const TraceOptions& ran) {
+  key.trace = ran;
+  return key;
+}
+
 }  // namespace
 
-DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
-                                         const LightRig& lights)
-    : DisplacementProgram(inputs, material, lights, select(trace_options(material))) {}
+DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const ProgramKey& key,
+                                         const ProgramParams& params, const LightRig& lights)
+    : DisplacementProgram(inputs, key, params, lights, select(key.trace)) {}
 
-DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material,
-                                         const LightRig& lights, const Variant& variant)
-    : ShadingProgram(program_variant(material, variant.options),
-                     inputs.layers.size() > 1 && material.blend.weights.mode == WeightMode::Vertex
-                         ? kWeight0 + int(inputs.layers.size())
-                         : kBaseVaryingCount),
-      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones), reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo), reference_id_(inputs.reference_id), surface_(inputs.surface),
-      sampler_(SamplerState::from(material.sampling)), lod_mode_(material.sampling.lod),
-      technique_(material.technique), lighting_(material.lighting), blend_(material.blend),
-      shadow_(material.shadow), ao_(material.ao), lights_(lights) {
+DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const ProgramKey& key,
+                                         const ProgramParams& params, const LightRig& lights, const Variant& variant)
+    : ShadingProgram(variant_name(with_trace(key, variant.options)),
+                     inputs.layers.size() > 1 && key.weights == WeightMode::Vertex ? kWeight0 + int(inputs.layers.size())
+                                                                                   : kBaseVaryingCount),
+      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones),
+      reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo),
+      reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(params.sampling)),
+      lod_mode_(params.sampling.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
+      blend_(params.blend), shadow_(params.shadow), ao_(params.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
   SamplerState ao_sampler = sampler_;
@@ -58,8 +64,8 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
   for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
     const LayerInputs& l = inputs.layers[i];
     Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_, l.twin_texels), std::nullopt, std::nullopt,
-                i < material.layers.size() ? material.layers[i].specular : SpecularFromAlbedo{}};
-    if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, technique_.height_fetch);
+                i < params.specular.size() ? params.specular[i] : SpecularFromAlbedo{}};
+    if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, trace_.height_fetch);
     if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);
     layers_.push_back(std::move(layer));
   }
@@ -67,7 +73,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     blend_ao_.emplace(*inputs.blend_ao, ao_sampler);
     blend_ao_scale_ = inputs.blend_ao_scale;
   }
-  if (ao_.mode == AoMode::Baked && !blend_ao_ &&
+  if (key_.ao == AoMode::Baked && !blend_ao_ &&
       std::any_of(layers_.begin(), layers_.end(), [](const Layer& l) { return !l.ao; }))
     throw Error("displacement program", "baked AO needs an AO map per layer or one of the blend");
   if (inputs.weights) weights_.emplace(*inputs.weights, weight_sampler_state(sampler_));
@@ -78,7 +84,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     layer_heights_ = inputs.layer_heights;
     if (layer_heights_ != nullptr) box_values_ = inputs.box_values;
   }
-  if (layers_.size() > 1 && blend_.weights.mode == WeightMode::Pixel && !weights_)
+  if (layers_.size() > 1 && key_.weights == WeightMode::Pixel && !weights_)
     throw Error("displacement program", "per-pixel blending needs a weight texture");
   const Texture* height0 = inputs.layers[0].height;
   if (cones_ && (!height0 || cones_->width != height0->width() || cones_->height != height0->height()))
@@ -126,9 +132,10 @@ void DisplacementProgram::trace_reference(const Ray& ray, const Float& ds, const
   ds.store_aligned(depth);
   const std::uint32_t lanes = simd::to_bits(covered);
   // QDM and cone stepping without refinement see the box surface; everything else the filtered surface.
-  const bool box = (technique_.kind == TechniqueKind::Qdm || technique_.kind == TechniqueKind::Csm ||
-                    technique_.kind == TechniqueKind::Rcsm) &&
-                   technique_.refinement == QdmRefinement::None;
+  const TechniqueKind technique = key_.trace.technique;
+  const bool box = (technique == TechniqueKind::Qdm || technique == TechniqueKind::Csm ||
+                    technique == TechniqueKind::Rcsm) &&
+                   trace_.refinement == QdmRefinement::None;
   const ReferenceSurface surface = box ? ReferenceSurface::Box : ReferenceSurface::Bilinear;
   // The reference may span several texture repeats (a blend's weights): its UV is the layers' / scale. The
   // ray's direction has depth component 1, so its t is the depth s.
@@ -194,26 +201,26 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
   // made the compiler keep the loop's vector values in memory.
   const bool recorded = fetch_recorder_listens();
   if constexpr (V::technique == TechniqueKind::Relief) {
-    hit = recorded ? trace::relief<true>(surface, ray, ds, setup.height_lod, active, technique_)
-                   : trace::relief<false>(surface, ray, ds, setup.height_lod, active, technique_);
+    hit = recorded ? trace::relief<true>(surface, ray, ds, setup.height_lod, active, trace_)
+                   : trace::relief<false>(surface, ray, ds, setup.height_lod, active, trace_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Pom) {
     const Float& lod = setup.height_lod;
     // Far away (high LOD) POM fades to normal mapping.
     const Float fade = xsimd::min(
-        xsimd::max((lod - Float(technique_.lod_threshold)) / Float(std::max(technique_.lod_fade, 1e-6f)), Float(0.0f)),
+        xsimd::max((lod - Float(trace_.lod_threshold)) / Float(std::max(trace_.lod_fade, 1e-6f)), Float(0.0f)),
         Float(1.0f));
     ds = ds * (Float(1.0f) - fade);
-    hit = recorded ? trace::pom<true>(surface, ray, ds, lod, setup.view_tangent.z, active, technique_)
-                   : trace::pom<false>(surface, ray, ds, lod, setup.view_tangent.z, active, technique_);
+    hit = recorded ? trace::pom<true>(surface, ray, ds, lod, setup.view_tangent.z, active, trace_)
+                   : trace::pom<false>(surface, ray, ds, lod, setup.view_tangent.z, active, trace_);
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Csm || V::technique == TechniqueKind::Rcsm) {
     const trace::ConeTexels texels{cones_, &layers_[0].height->height, sampler_.address, sampler_.fetch};
     constexpr bool relaxed = V::technique == TechniqueKind::Rcsm;
-    hit = recorded ? trace::cone_step<relaxed, true>(texels, ray, ds, active, technique_)
-                   : trace::cone_step<relaxed, false>(texels, ray, ds, active, technique_);
+    hit = recorded ? trace::cone_step<relaxed, true>(texels, ray, ds, active, trace_)
+                   : trace::cone_step<relaxed, false>(texels, ray, ds, active, trace_);
     hit.box_s = hit.s;
-    hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, technique_, surface_);
+    hit.s = trace::refine(surface, ray, ds, hit.s, hit.iterations, active, trace_, surface_);
   } else if constexpr (V::technique == TechniqueKind::Qdm) {
     const QdmBudget budget = qdm_budget(setup);
     hit = refine_qdm_hit(surface, setup, trace::qdm<V>(surface, ray, ds, budget.stop_level, budget.cap, active));
@@ -224,14 +231,14 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
 template <class Surface>
 DisplacementProgram::Hit DisplacementProgram::refine_qdm_hit(const Surface& surface, const Setup& setup, Hit hit) const {
   hit.box_s = hit.s;
-  hit.s = trace::refine(surface, setup.ray, setup.ds, hit.s, hit.iterations, setup.active, technique_, surface_);
+  hit.s = trace::refine(surface, setup.ray, setup.ds, hit.s, hit.iterations, setup.active, trace_, surface_);
   return hit;
 }
 
 // refine_qdm_hit() of two paired batches' hits (no recorder listens); the linear refinement of both at once.
 void DisplacementProgram::refine_qdm_hits(const SingleLayerSurface& surface, const Setup& setup_a, Hit& hit_a,
                                           const Setup& setup_b, Hit& hit_b) const {
-  if (technique_.refinement != QdmRefinement::Linear) {
+  if (trace_.refinement != QdmRefinement::Linear) {
     hit_a = refine_qdm_hit(surface, setup_a, hit_a);
     hit_b = refine_qdm_hit(surface, setup_b, hit_b);
     return;
@@ -244,14 +251,14 @@ void DisplacementProgram::refine_qdm_hits(const SingleLayerSurface& surface, con
 
 DisplacementProgram::QdmBudget DisplacementProgram::qdm_budget(const Setup& setup) const {
   const UvDerivatives& d = setup.d;
-  QdmBudget budget{Float(0.0f), Int(technique_.max_iterations)};
-  if (technique_.lod_stop)
+  QdmBudget budget{Float(0.0f), Int(trace_.max_iterations)};
+  if (trace_.lod_stop)
     budget.stop_level =
         xsimd::max(xsimd::floor(layers_[0].height->tree.lod(d.dudx, d.dvdx, d.dudy, d.dvdy)), Float(0.0f));
-  if (technique_.min_iterations > 0) {
+  if (trace_.min_iterations > 0) {
     const Float grazing = Float(1.0f) - xsimd::min(xsimd::max(setup.view_tangent.z, Float(0.0f)), Float(1.0f));
-    budget.cap = xsimd::to_int(Float(float(technique_.min_iterations)) +
-                               Float(float(technique_.max_iterations - technique_.min_iterations)) * grazing);
+    budget.cap = xsimd::to_int(Float(float(trace_.min_iterations)) +
+                               Float(float(trace_.max_iterations - trace_.min_iterations)) * grazing);
   }
   return budget;
 }
@@ -323,7 +330,7 @@ void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, con
   SurfaceAtHit at;
   surface_at_hit(setup, surface, hit, ds, at);
   light_hit<V>(in, setup, surface, at, ds, out);
-  if (technique_.write_depth) displaced_depth(in, setup.d, setup.frame, setup.ray, at.hit.s, out);
+  if (trace_.write_depth) displaced_depth(in, setup.d, setup.frame, setup.ray, at.hit.s, out);
 }
 
 template <class Surface>
@@ -331,7 +338,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
                                          SurfaceAtHit& at) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
-  at.hit = technique_.exact_hits ? exact_hit(ray, ds, traced, setup.active) : traced;
+  at.hit = trace_.exact_hits ? exact_hit(ray, ds, traced, setup.active) : traced;
   const Hit& hit = at.hit;
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   at.hu = hu;
@@ -357,7 +364,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
     const int count = surface.layer_count();
     Float h[BlendedSurface::kMaxLayers], w[BlendedSurface::kMaxLayers], f[BlendedSurface::kMaxLayers];
     surface.weights_at(hu, hv, w);
-    if (blend_.op != BlendOperator::Alpha) {
+    if (key_.blend != BlendOperator::Alpha) {
       // A lane whose weight of a layer is 0 gets factor 0 from it whatever its height (blend_factors): only the
       // lanes with weight fetch a layer's height (as the texture cache counts them), none where no lane has any.
       for (int i = 0; i < count; ++i) {
@@ -369,7 +376,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
         h[i] = surface.layer(i).height(hu, hv, setup.height_lod);
       }
     }
-    blend_factors(blend_.op, blend_.width, count, h, w, f);
+    blend_factors(key_.blend, blend_.width, count, h, w, f);
     for (int c = 0; c < 4; ++c) albedo[c] = Float(0.0f);
     for (int c = 0; c < 3; ++c) tangent_normal[c] = Float(0.0f);
     if (blend_ao_) {
@@ -377,7 +384,7 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
       Float a[4];
       blend_ao_->sample(hu * inv, hv * inv, Float(0.0f), a);
       ao = a[0];
-    } else if (ao_.mode == AoMode::Baked) {
+    } else if (key_.ao == AoMode::Baked) {
       ao = Float(0.0f);
     }
     for (int i = 0; i < count; ++i) {
@@ -425,13 +432,13 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
   // Hard shadows trace the box surface, so they start from the hit on it: a refined hit between texel centres
   // can lie below a neighbouring column's top and would be shadowed by it (staircase acne).
   // The bias lifts the start along the light ray (towards depth 0) by a fraction of the depth scale.
-  const Float s_hit = shadow_.mode == ShadowMode::Hard ? hit.box_s : hit.s;
+  const Float s_hit = key_.shadow == ShadowMode::Hard ? hit.box_s : hit.s;
   const Float lift = xsimd::min(Float(shadow_.bias) * ds, s_hit);
   const Float su_hit = ray.u0 + ray.du * s_hit, sv_hit = ray.v0 + ray.dv * s_hit;
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   const Float zero(0.0f);
   Float visibility[limits::kMaxDirectionalLights];
-  const bool shadows = shadow_.mode != ShadowMode::Off;
+  const bool shadows = key_.shadow != ShadowMode::Off;
   if (shadows) {
     for (std::size_t j = 0; j < lights_.directional.size(); ++j) {
       const glm::vec3& l = lights_.directional[j].direction;
@@ -444,22 +451,22 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
       const Surface towards_light =
           surface.around(xsimd::min(su, u1), xsimd::max(su, u1), xsimd::min(sv, v1), xsimd::max(sv, v1));
       const ShadowResult r =
-          self_shadow(towards_light, shadow_, ShadowRay{su, sv, s0, du, dv, ds}, setup.height_lod, setup.active & above);
+          self_shadow(towards_light, key_.shadow, shadow_, ShadowRay{su, sv, s0, du, dv, ds}, setup.height_lod, setup.active & above);
       visibility[j] = xsimd::select(above, r.visibility, zero);
     }
   }
   Float ao = baked_ao;
-  if (ao_.mode == AoMode::Frame) {
+  if (key_.ao == AoMode::Frame) {
     const Float radius(ao_.radius);
     ao = ambient_occlusion(surface.around(hu - radius, hu + radius, hv - radius, hv + radius), ao_, hu, hv, hit.s, ds,
                            in.pixel_x, in.pixel_y, setup.active);
   }
-  if (ao_.mode != AoMode::Off) ao = apply_ao_strength(ao, ao_.strength);
+  if (key_.ao != AoMode::Off) ao = apply_ao_strength(ao, ao_.strength);
   // The lighting AOVs: what the lighting model multiplies by, for the first directional light.
   out.shadow = shadows && !lights_.directional.empty() ? visibility[0] : Float(1.0f);
   out.ao = ao;
   shade_lights(shading_normal, setup.frame.n, setup.view, SurfaceSample{albedo, specular, ao},
-               shadows ? visibility : nullptr, lighting_, lights_, out.color);
+               shadows ? visibility : nullptr, key_.lighting, lighting_, lights_, out.color);
 }
 
 void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const { (this->*shade_)(in, out); }
@@ -670,7 +677,7 @@ void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setu
     // covered lanes'.
     o.iterations = xsimd::select(in[k]->covered, unpack(&ShadeOutput::iterations), Float(0.0f));
     o.executed_lane_iterations = executed[k];
-    if (technique_.write_depth)
+    if (trace_.write_depth)
       displaced_depth(*in[k], setups[k].d, setups[k].frame, setups[k].ray,
                       lanes.unpack(k, [&](int w) -> const Float& { return hit_s[w]; }), o);
   }
@@ -687,13 +694,13 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
   surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
   light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
   light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
-  if (technique_.write_depth) {
+  if (trace_.write_depth) {
     displaced_depth(a, setup_a.d, setup_a.frame, setup_a.ray, at_a.hit.s, out_a);
     displaced_depth(b, setup_b.d, setup_b.frame, setup_b.ray, at_b.hit.s, out_b);
   }
 }
 
-bool DisplacementProgram::pairs_batches() const { return pairs_technique(technique_.kind); }
+bool DisplacementProgram::pairs_batches() const { return pairs_technique(key_.trace.technique); }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
   const Float& u = in.varyings[kU];
@@ -705,10 +712,10 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
   setup.view_tangent = setup.frame.to_tangent(setup.view);
 
   // Depth scale, faded with camera distance when asked; the ray leaves the polygon along -view.
-  setup.ds = Float(technique_.depth_scale);
-  if (technique_.fade_end > 0.0f) {
-    const Float range(std::max(technique_.fade_end - technique_.fade_start, 1e-6f));
-    const Float fade = xsimd::min(xsimd::max((in.view_depth - Float(technique_.fade_start)) / range, Float(0.0f)), Float(1.0f));
+  setup.ds = Float(trace_.depth_scale);
+  if (trace_.fade_end > 0.0f) {
+    const Float range(std::max(trace_.fade_end - trace_.fade_start, 1e-6f));
+    const Float fade = xsimd::min(xsimd::max((in.view_depth - Float(trace_.fade_start)) / range, Float(0.0f)), Float(1.0f));
     setup.ds = setup.ds * (Float(1.0f) - fade);
   }
   const Float vz = xsimd::max(setup.view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
@@ -739,18 +746,18 @@ DisplacementProgram::LayerSurfaces DisplacementProgram::layer_surfaces() const {
 BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers, const Fragments& in,
                                                     const Setup& setup) const {
   const int count = int(layers_.size());
-  if (blend_.weights.mode == WeightMode::Vertex) {
+  if (key_.weights == WeightMode::Vertex) {
     const Float w[BlendedSurface::kMaxLayers] = {in.varyings[kWeight0], in.varyings[kWeight1],
                                                  count > 2 ? in.varyings[kWeight2] : Float(0.0f),
                                                  count > 3 ? in.varyings[kWeight3] : Float(0.0f)};
-    return BlendedSurface(layers.data(), count, blend_.op, w);
+    return BlendedSurface(layers.data(), count, key_.blend, w);
   }
   // Per-pixel weights: bounded over the UV box the view ray crosses down to depth_scale.
   const Ray& ray = setup.ray;
   const Float u1 = ray.u0 + ray.du * setup.ds, v1 = ray.v0 + ray.dv * setup.ds;
-  const WeightTexture weights{&*weights_, blend_.weights.scale, combined_ ? &*combined_ : nullptr, combined_period_u_,
+  const WeightTexture weights{&*weights_, blend_.weights_scale, combined_ ? &*combined_ : nullptr, combined_period_u_,
                               combined_period_v_, layer_heights_, box_values_};
-  return BlendedSurface(layers.data(), count, blend_.op, weights, xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1),
+  return BlendedSurface(layers.data(), count, key_.blend, weights, xsimd::min(ray.u0, u1), xsimd::max(ray.u0, u1),
                         xsimd::min(ray.v0, v1), xsimd::max(ray.v0, v1));
 }
 
@@ -760,7 +767,7 @@ DisplacementProgram::Variant DisplacementProgram::variant() {
           &DisplacementProgram::shade_group_variant<V>, V::options()};
 }
 
-// Every combination of the trace options is instantiated (program/variant.hpp): 5 techniques, and for qdm
+// Every combination of the trace options is instantiated (TraceOptions, qdmr/program/program_key.hpp): 5 techniques, and for qdm
 // 3 math modes x 2 max fetches x 3 level-up rules.
 DisplacementProgram::Variant DisplacementProgram::select(const TraceOptions& o) {
   using K = TechniqueKind;

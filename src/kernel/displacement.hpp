@@ -16,14 +16,15 @@
 #include "kernel/lighting_models.hpp"
 #include "kernel/batch.hpp"
 #include "program/inputs.hpp"
-#include "program/variant.hpp"
+#include "qdmr/program/program_key.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "kernel/shading_math.hpp"
 #include "kernel/trace_ray.hpp"
 #include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
-// A trace variant: the options of program/variant.hpp as compile-time constants of the inner loops.
+// A trace variant: the TraceOptions of a ProgramKey as compile-time constants of the inner loops.
 template <TechniqueKind T, MathMode Math = MathMode::Sm4, bool FilteredMax = false,
           QdmLevelUp LevelUp = QdmLevelUp::One>
 struct Trace {
@@ -36,7 +37,8 @@ struct Trace {
 
 class DisplacementProgram final : public ShadingProgram {
 public:
-  DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material, const LightRig& lights);
+  DisplacementProgram(const DisplacementInputs& inputs, const ProgramKey& key, const ProgramParams& params,
+                      const LightRig& lights);
   void shade(const Fragments& in, ShadeOutput& out) const override;
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
   bool pairs_batches() const override;
@@ -75,8 +77,8 @@ private:
   static Variant select(const TraceOptions& options);
   template <class V>
   static Variant variant();
-  DisplacementProgram(const DisplacementInputs& inputs, const MaterialDesc& material, const LightRig& lights,
-                      const Variant& variant);
+  DisplacementProgram(const DisplacementInputs& inputs, const ProgramKey& key, const ProgramParams& params,
+                      const LightRig& lights, const Variant& variant);
 
   SingleLayerSurface layer_surface(int i) const;
   // A blend's layers (the last one repeated past the layer count) and its surface for one batch.
@@ -161,11 +163,12 @@ private:
   const HeightField* surface_;
   SamplerState sampler_;
   LodMode lod_mode_;
-  TechniqueDesc technique_;
-  LightingDesc lighting_;
-  BlendDesc blend_;
-  ShadowDesc shadow_;
-  AoDesc ao_;
+  ProgramKey key_;
+  TraceParams trace_;
+  LightingParams lighting_;
+  BlendParams blend_;
+  ShadowParams shadow_;
+  AoParams ao_;
   LightRig lights_;
 };
 

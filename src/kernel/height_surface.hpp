@@ -11,7 +11,7 @@
 #include <cstdint>
 
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/scene/material_modes.hpp"
 #include "kernel/sampler.hpp"
 #include "kernel/sampling_code.hpp"
 

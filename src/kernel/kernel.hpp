@@ -11,9 +11,10 @@
 #include "program/inputs.hpp"
 #include "program/light_rig.hpp"
 #include "program/program.hpp"
+#include "qdmr/program/program_key.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
-#include "qdmr/scene/scene.hpp"
 #include "texture/blend_box_values.hpp"
 #include "qdmr/texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
@@ -33,9 +34,10 @@ public:
   virtual ~Kernel() = default;
   virtual Isa isa() const = 0;
   virtual int lanes() const = 0;  // pixels per batch: 4, 8 or 16 (one, two or four quads)
-  // The shading program of one material (normal mapping, or a displacement technique), for this kernel.
-  virtual std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
-                                                 const LightRig& lights) const = 0;
+  // The shading program of one material (normal mapping, or a displacement technique) for this kernel, made from
+  // the plan's key and parameters (MaterialPlan::key, ::params).
+  virtual std::unique_ptr<Program> make_program(const ProgramKey& key, const ProgramParams& params,
+                                                 const DisplacementInputs& inputs, const LightRig& lights) const = 0;
   // Clears and draws one tile (see kernel/tile_raster.hpp); the context's programs must come from this kernel.
   virtual void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,
                            TileCounters& counters) const = 0;

@@ -7,7 +7,8 @@
 #include "kernel/preparation.hpp"
 #include "kernel/tile_raster.hpp"
 #include "kernel/ao_rows.hpp"
-#include "program/variant.hpp"
+#include "qdmr/core/error.hpp"
+#include "qdmr/program/program_key.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 namespace {
@@ -17,16 +18,18 @@ public:
   Isa isa() const override { return Isa::QDMR_ISA_ENUM; }
   int lanes() const override { return simd::kLanes; }
 
-  std::unique_ptr<Program> make_program(const MaterialDesc& material, const DisplacementInputs& inputs,
-                                        const LightRig& lights) const override {
+  std::unique_ptr<Program> make_program(const ProgramKey& key, const ProgramParams& params,
+                                        const DisplacementInputs& inputs, const LightRig& lights) const override {
     kernel_calls.programs.fetch_add(1, std::memory_order_relaxed);
-    if (material.technique.kind == TechniqueKind::Normal && inputs.layers.size() == 1) {
+    if (key.normal_mapping()) {
+      if (inputs.layers.size() != 1 || params.specular.size() != 1)
+        throw Error("normal mapping program", "needs one layer");
       const LayerInputs& l = inputs.layers[0];
-      return std::make_unique<NormalMappingProgram>(program_variant(material), *l.albedo, *l.normal, l.twin_texels,
-                                                    material.sampling, material.lighting, material.layers[0].specular,
-                                                    lights);
+      return std::make_unique<NormalMappingProgram>(variant_name(key), *l.albedo, *l.normal, l.twin_texels,
+                                                    params.sampling, key.lighting, params.lighting,
+                                                    params.specular[0], lights);
     }
-    return std::make_unique<DisplacementProgram>(inputs, material, lights);
+    return std::make_unique<DisplacementProgram>(inputs, key, params, lights);
   }
 
   void raster_tile(const RasterContext& context, int tile_index, const PixelRect& tile, const TileBins& bins,

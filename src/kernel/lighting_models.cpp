@@ -24,12 +24,13 @@ Float cook_torrance(const Float& n_dot_l, const Float& n_dot_v, const Float& n_d
 }  // namespace
 
 void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
-                  const Float* light_visibility, const LightingDesc& lighting, const LightRig& lights, Float* color) {
+                  const Float* light_visibility, LightingModel model, const LightingParams& lighting, const LightRig& lights,
+                  Float* color) {
   const Float zero(0.0f);
   Float diffuse[3] = {Float(lights.ambient.x) * surface.ambient_occlusion, Float(lights.ambient.y) * surface.ambient_occlusion,
                       Float(lights.ambient.z) * surface.ambient_occlusion};
   Float specular[3] = {zero, zero, zero};
-  const bool cook_torrance_model = lighting.model == LightingModel::CookTorrance;
+  const bool cook_torrance_model = model == LightingModel::CookTorrance;
   const Float n_dot_v = xsimd::max(dot(shading_normal, view), zero);
   for (std::size_t i = 0; i < lights.directional.size(); ++i) {
     const LightRig::Directional& light = lights.directional[i];

@@ -1,5 +1,5 @@
 #pragma once
-// The lighting models of a material (LightingDesc::model), lit by a LightRig, per lane:
+// The lighting models of a material (ProgramKey::lighting), lit by a LightRig, per lane:
 //   color = albedo * (ambient * ao + sum_i radiance_i * visibility_i * n.l_i) + sum_i radiance_i * visibility_i * spec_i
 // with n.l_i = max(dot(shading normal, l_i), 0) and spec_i gated to 0 when the light is below the polygon
 // (dot(geometric normal, l_i) <= 0). The diffuse term is Lambert with the 1/pi folded into the radiance
@@ -12,7 +12,7 @@
 //     where n.v, n.h and v.h are clamped to >= 0. Single scattering: the specular energy never exceeds 1.
 // Lane-wise IEEE only; pow through detmath.
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "program/light_rig.hpp"
 #include "kernel/shading_math.hpp"
 
@@ -25,13 +25,14 @@ struct SurfaceSample {
 };
 
 // light_visibility: one factor per directional light of the rig (1 = lit, 0 = shadowed), or nullptr for all lit.
-// LightingDesc::specular is not read: the caller puts it (or specular_from_albedo) into surface.specular.
+// LightingParams::specular is not read: the caller puts it (or specular_from_albedo) into surface.specular.
 void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
-                  const Float* light_visibility, const LightingDesc& lighting, const LightRig& lights, Float* color);
+                  const Float* light_visibility, LightingModel model, const LightingParams& lighting, const LightRig& lights,
+                  Float* color);
 
 // The specular reflectance of SpecularFromAlbedo: scale * pow(x, power) with x the Rec. 709 luminance
 // 0.2126 r + 0.7152 g + 0.0722 b of the albedo clamped to [0, 1], or 1 - that when inverted (x = 0 gives 0).
-// `fallback` (the material's lighting.specular) when coeffs.enabled is false.
+// `fallback` (the material's LightingParams::specular) when coeffs.enabled is false.
 Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs, float fallback);
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE::shading

@@ -83,7 +83,7 @@ void NormalMappingProgram::light(const Fragments& in, const Samples& s, const Ta
                                  const Vec3& shading_normal, const Vec3& view, ShadeOutput& out) const {
   shade_lights(shading_normal, frame.n, view,
                SurfaceSample{s.albedo, specular_from_albedo(s.albedo, specular_, lighting_.specular), Float(1.0f)},
-               nullptr, lighting_, lights_, out.color);
+               nullptr, lighting_model_, lighting_, lights_, out.color);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;

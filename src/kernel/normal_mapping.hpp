@@ -4,6 +4,7 @@
 #include "kernel/lane_packing.hpp"
 #include "program/light_rig.hpp"
 #include "kernel/batch.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "kernel/shading_math.hpp"
 #include "kernel/sampler.hpp"
 
@@ -14,11 +15,11 @@ public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
   // twin_texels: the two maps interleaved (texture/twin_texels.hpp), or null.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const float* twin_texels,
-                       const SamplingDesc& sampling, const LightingDesc& lighting, const SpecularFromAlbedo& specular,
-                       const LightRig& lights)
+                       const SamplingDesc& sampling, LightingModel lighting_model, const LightingParams& lighting,
+                       const SpecularFromAlbedo& specular, const LightRig& lights)
       : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling), twin_texels),
-        lod_mode_(sampling.lod),
-        lighting_(lighting), specular_(specular), lights_(lights) {}
+        lod_mode_(sampling.lod), lighting_model_(lighting_model), lighting_(lighting), specular_(specular),
+        lights_(lights) {}
   void shade(const Fragments& in, ShadeOutput& out) const override;
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
   bool pairs_batches() const override { return true; }
@@ -44,7 +45,8 @@ private:
 
   TwinSampler textures_;  // albedo first, normal map second
   LodMode lod_mode_;
-  LightingDesc lighting_;
+  LightingModel lighting_model_;
+  LightingParams lighting_;
   SpecularFromAlbedo specular_;
   LightRig lights_;
 };

@@ -1,6 +1,6 @@
 #pragma once
 // Parallax occlusion mapping: view-dependent step count, linear intersection of the last two samples.
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
@@ -10,7 +10,7 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 template <bool Recorded, class Surface>
 Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
                                                  const Float& lod, const Float& cos_view, Mask active,
-        const TechniqueDesc& technique) {
+        const TraceParams& technique) {
   const Float lerp = xsimd::min(xsimd::max(cos_view, Float(0.0f)), Float(1.0f));
   const Float n = xsimd::floor(Float(float(technique.max_steps)) +
                                (Float(float(technique.min_steps)) - Float(float(technique.max_steps))) * lerp +

@@ -2,7 +2,7 @@
 // Quadtree displacement mapping over a max-quadtree; V is the trace variant (kernel/displacement.hpp).
 #include <limits>
 
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/scene/material_modes.hpp"
 #include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {

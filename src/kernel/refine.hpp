@@ -1,6 +1,6 @@
 #pragma once
 // Refinement of a box-surface hit (qdm, csm, rcsm) against the filtered surface.
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "kernel/trace_ray.hpp"
 
@@ -34,7 +34,7 @@ Float bracket_start(const Surface& surface, const Ray& ray, const Float& s) {
 // Recorded false: no texture-cache recorder listens (refine() picks).
 template <bool Recorded, class Surface>
 Float refine_as(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
-                Mask active, const TechniqueDesc& technique, const HeightField* patches) {
+                Mask active, const TraceParams& technique, const HeightField* patches) {
   if (technique.refinement == QdmRefinement::None) return s_hit;
   LoopLanes<Recorded> lanes(FetchPhase::Refine);
   lanes.narrow(active);
@@ -88,7 +88,7 @@ void refine_linear_pair(const Surface& surface, const Ray& ray_a, const Float& d
 // refinement's vector values in memory (as in POM's and relief's loops).
 template <class Surface>
 Float refine(const Surface& surface, const Ray& ray, const Float& ds, const Float& s_hit, Float& iterations,
-             Mask active, const TechniqueDesc& technique, const HeightField* patches) {
+             Mask active, const TraceParams& technique, const HeightField* patches) {
   return fetch_recorder_listens()
              ? refine_as<true>(surface, ray, ds, s_hit, iterations, active, technique, patches)
              : refine_as<false>(surface, ray, ds, s_hit, iterations, active, technique, patches);

@@ -1,6 +1,6 @@
 #pragma once
 // Relief mapping: linear search, then binary search.
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
@@ -10,7 +10,7 @@ namespace qdmr::QDMR_ISA_NAMESPACE::trace {
 template <bool Recorded, class Surface>
 Hit relief(const Surface& surface, const Ray& ray, const Float& ds,
                                                     const Float& lod, Mask active,
-           const TechniqueDesc& technique) {
+           const TraceParams& technique) {
   const int steps = technique.linear_steps;
   const Float step = ds / Float(float(steps));
   Float lo(0.0f), hi = ds, iterations(0.0f);

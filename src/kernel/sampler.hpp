@@ -9,7 +9,7 @@
 #include "core/det_math.hpp"
 #include "kernel/gather.hpp"
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/core/sampling.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "kernel/fetch_trace.hpp"
 

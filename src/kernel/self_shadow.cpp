@@ -69,7 +69,7 @@ struct RepeatOrigin {
 };
 
 template <class Surface>
-ShadowResult hard(const Surface& surface, const ShadowDesc& desc, const Prepared& p) {
+ShadowResult hard(const Surface& surface, const ShadowParams& desc, const Prepared& p) {
   const int top = surface.top_level();
   const Float zero(0.0f), inf(std::numeric_limits<float>::infinity());
   const Float width(float(surface.width())), height(float(surface.height()));
@@ -168,14 +168,14 @@ Float occlusion(const Prepared& p, const Float& c, const Float& surface_depth, f
 }
 
 // The longest climb sampled: to the polygon, or `length` UV units of horizontal reach when length > 0.
-Float shadow_reach(const ShadowDesc& desc, const Prepared& p) {
+Float shadow_reach(const ShadowParams& desc, const Prepared& p) {
   if (desc.length <= 0.0f) return p.s;
   const Float slope = xsimd::sqrt(p.du * p.du + p.dv * p.dv);  // 0 (light overhead): length / 0 = inf
   return xsimd::min(p.s, Float(desc.length) / slope);
 }
 
 template <class Surface>
-ShadowResult horizon(const Surface& surface, const ShadowDesc& desc, const Prepared& p, const Float& lod) {
+ShadowResult horizon(const Surface& surface, const ShadowParams& desc, const Prepared& p, const Float& lod) {
   const Float c_max = shadow_reach(desc, p);
   const Mask taken = p.active & (c_max > Float(0.0f));
   Profile profile(desc.profile);
@@ -191,7 +191,7 @@ ShadowResult horizon(const Surface& surface, const ShadowDesc& desc, const Prepa
 }
 
 template <class Surface>
-ShadowResult qdm_soft(const Surface& surface, const ShadowDesc& desc, const Prepared& p) {
+ShadowResult qdm_soft(const Surface& surface, const ShadowParams& desc, const Prepared& p) {
   const Float zero(0.0f);
   const Float width(float(surface.width())), height(float(surface.height()));
   const Float x0 = (p.u - xsimd::floor(p.u)) * width, y0 = (p.v - xsimd::floor(p.v)) * height;
@@ -222,15 +222,15 @@ ShadowResult qdm_soft(const Surface& surface, const ShadowDesc& desc, const Prep
 }  // namespace
 
 template <class Surface>
-ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const ShadowRay& ray, const Float& lod,
-                         Mask active) {
+ShadowResult self_shadow(const Surface& surface, ShadowMode mode, const ShadowParams& desc, const ShadowRay& ray,
+                         const Float& lod, Mask active) {
   ShadowResult r{Float(1.0f), Float(0.0f)};
-  if (desc.mode == ShadowMode::Off) return r;
+  if (mode == ShadowMode::Off) return r;
   const Prepared p = prepare(ray, active);
   if (!xsimd::any(p.active)) return r;
   FetchLanes lanes(FetchPhase::Shadow);
   lanes.narrow(p.active);
-  switch (desc.mode) {
+  switch (mode) {
     case ShadowMode::Off: break;
     case ShadowMode::Hard: r = hard(surface, desc, p); break;
     case ShadowMode::Horizon: r = horizon(surface, desc, p, lod); break;
@@ -239,9 +239,9 @@ ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const S
   return {xsimd::select(p.active, r.visibility, Float(1.0f)), xsimd::select(p.active, r.iterations, Float(0.0f))};
 }
 
-template ShadowResult self_shadow<SingleLayerSurface>(const SingleLayerSurface&, const ShadowDesc&, const ShadowRay&,
+template ShadowResult self_shadow<SingleLayerSurface>(const SingleLayerSurface&, ShadowMode, const ShadowParams&, const ShadowRay&,
                                                       const Float&, Mask);
-template ShadowResult self_shadow<BlendedSurface>(const BlendedSurface&, const ShadowDesc&, const ShadowRay&,
+template ShadowResult self_shadow<BlendedSurface>(const BlendedSurface&, ShadowMode, const ShadowParams&, const ShadowRay&,
                                                  const simd::Float&, simd::Mask);
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

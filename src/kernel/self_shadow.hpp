@@ -7,7 +7,7 @@
 //   (u + du c, v + dv c, s - c),
 // so it reaches the polygon (depth 0), above which nothing can occlude, at c = s.
 //
-// Modes (ShadowDesc, scene.hpp):
+// Modes (ShadowMode; the numbers are ShadowParams, scene.hpp's ShadowDesc documents them):
 // - Off: visibility 1, 0 iterations.
 // - Hard: the box surface (each level-0 texel a closed column down from depth ds (1 - h); texel indices wrap)
 //   as the exact reference light_visibility() (qdmr/reference/reference.hpp) defines it: visibility 0 iff the
@@ -43,7 +43,7 @@
 // Input guards: (du, dv) longer than kMaxLightSlope (light below ~0.22 degrees elevation) is scaled down to
 // it; s is clamped to [0, ds]. Lanes with a non-finite input, or ds <= 0, are lit with 0 iterations.
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/program/program_params.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
@@ -64,7 +64,7 @@ inline constexpr float kMaxLightSlope = 256.0f;
 
 // Inactive lanes return visibility 1 and 0 iterations.
 template <class Surface>
-ShadowResult self_shadow(const Surface& surface, const ShadowDesc& desc, const ShadowRay& ray, const simd::Float& lod,
-                         simd::Mask active);
+ShadowResult self_shadow(const Surface& surface, ShadowMode mode, const ShadowParams& desc, const ShadowRay& ray,
+                         const simd::Float& lod, simd::Mask active);
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -3,7 +3,7 @@
 // varyings and UV derivatives (lighting: lighting_models.hpp). Lane-wise IEEE only, so SSE and AVX2 agree.
 #include "core/det_math.hpp"
 #include "core/simd.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/core/sampling.hpp"
 #include "program/light_rig.hpp"
 #include "kernel/batch.hpp"
 #include "kernel/sampler.hpp"

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "codec/native_reader.hpp"
-#include "program/variant.hpp"
+#include "plan/program_choice.hpp"
 #include "raster/framebuffer.hpp"
 #include "bake/ao_map.hpp"
 #include "qdmr/core/error.hpp"
@@ -503,7 +503,9 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
   // The max-quadtree serves QDM, and self-shadowing and AO queries that read coarse levels.
   const bool hierarchy = kind == TechniqueKind::Qdm || material.shadow.mode == ShadowMode::QdmSoft ||
                          (material.ao.mode != AoMode::Off && material.ao.coarse);
-  plan.variant = program_variant(material);
+  plan.key = program_key(material);
+  plan.params = program_params(material);
+  plan.variant = variant_name(plan.key);
 
   if (plan.blend && (kind == TechniqueKind::Csm || kind == TechniqueKind::Rcsm))
     throw Error(where + "/technique/name", std::string("'") + technique_name(kind) +

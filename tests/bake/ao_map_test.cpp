@@ -135,9 +135,9 @@ double defined_texel_ao(const HeightField& f, double ds, const AoDesc& d, int i,
       for (std::int64_t tx = x0; tx < x1; ++tx) m = std::max(m, f.h[std::size_t(ty * f.width + tx)]);
     return m;
   };
-  const int n = ao::direction_count(d);
+  const int n = ao::direction_count(pattern_of(d));
   const int rotation = d.jitter ? ao::rotation(std::uint32_t(i), std::uint32_t(j), d.seed) : 0;
-  const ao::Taps taps = ao::make_taps(d, f.width, f.height);
+  const ao::Taps taps = ao::make_taps(pattern_of(d), f.width, f.height);
   const double s = bilinear_depth(u, v);
   double visible = 0.0;
   for (int k = 0; k < n; ++k) {

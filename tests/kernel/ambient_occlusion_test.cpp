@@ -16,6 +16,7 @@
 #include "kernel/ambient_occlusion.hpp"
 #include "bake/ao_pattern.hpp"
 #include "kernel/height_surface.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr {
 namespace {
@@ -38,7 +39,7 @@ public:
   AoHarness& operator=(const AoHarness&) = delete;
 
   // One AO value per point; lanes past the end of `points` are inactive.
-  std::vector<float> run(const AoDesc& desc, const std::vector<AoPoint>& points) const {
+  std::vector<float> run(const AoParams& desc, const std::vector<AoPoint>& points) const {
     std::vector<float> out;
     for (std::size_t first = 0; first < points.size(); first += simd::kLanes) {
       alignas(64) float lane[6][simd::kLanes] = {};
@@ -95,9 +96,8 @@ double visibility(double rise, double distance) {
   return 1.0 - slope / std::sqrt(1.0 + slope * slope);
 }
 
-AoDesc frame_desc(int directions, float radius, bool coarse) {
-  AoDesc d;
-  d.mode = AoMode::Frame;
+AoParams frame_params(int directions, float radius, bool coarse) {
+  AoParams d;
   d.directions = directions;
   d.radius = radius;
   d.coarse = coarse;
@@ -123,24 +123,24 @@ TEST(AmbientOcclusion, DirectionTableIsTheUnitCircle) {
 }
 
 TEST(AmbientOcclusion, TapDistances) {
-  AoDesc d = frame_desc(8, 20.0f / 64.0f, true);
-  ao::Taps taps = ao::make_taps(d, 64, 32);  // one texel = 1/64 UV (the larger side)
+  AoParams d = frame_params(8, 20.0f / 64.0f, true);
+  ao::Taps taps = ao::make_taps(pattern_of(d), 64, 32);  // one texel = 1/64 UV (the larger side)
   ASSERT_EQ(taps.count, 5);                  // 1, 2, 4, 8, 16 texels
   for (int k = 0; k < 5; ++k) {
     EXPECT_EQ(taps.tap[std::size_t(k)].distance, float(1 << k) / 64.0f);
     EXPECT_EQ(taps.tap[std::size_t(k)].level, k);
   }
   d.coarse = false;
-  taps = ao::make_taps(d, 64, 32);
+  taps = ao::make_taps(pattern_of(d), 64, 32);
   ASSERT_EQ(taps.count, 20);
   EXPECT_EQ(taps.tap[19].distance, 20.0f / 64.0f);
   d.radius = 1.0f;  // 256 texels of a 256 map: capped at 64 evenly spread taps
-  taps = ao::make_taps(d, 256, 256);
+  taps = ao::make_taps(pattern_of(d), 256, 256);
   ASSERT_EQ(taps.count, ao::kMaxFineTaps);
   EXPECT_EQ(taps.tap[0].distance, 1.0f / 64.0f);
   EXPECT_EQ(taps.tap[63].distance, 1.0f);
   d.radius = 0.5f / 256.0f;  // below one texel: nothing to look at
-  EXPECT_EQ(ao::make_taps(d, 256, 256).count, 0);
+  EXPECT_EQ(ao::make_taps(pattern_of(d), 256, 256).count, 0);
 }
 
 TEST(AmbientOcclusion, FlatSurfaceIsExactlyOpen) {
@@ -154,7 +154,7 @@ TEST(AmbientOcclusion, FlatSurfaceIsExactlyOpen) {
     }
     for (bool coarse : {true, false})
       for (bool jitter : {false, true}) {
-        AoDesc d = frame_desc(7, 0.4f, coarse);
+        AoParams d = frame_params(7, 0.4f, coarse);
         d.jitter = jitter;
         for (float ao : harness.run(d, points)) EXPECT_EQ(ao, 1.0f);
       }
@@ -182,7 +182,7 @@ TEST(AmbientOcclusion, PitCentreMatchesTheClosedForm) {
   // the distance grows) is at t in [r - sqrt(2)/2, r + sqrt(2)/2 + 1) texels in every direction.
   const double half_diagonal = std::sqrt(0.5);
   for (int directions : {4, 8, 16}) {
-    const float ao = harness.run(frame_desc(directions, 0.5f, false), centre)[0];
+    const float ao = harness.run(frame_params(directions, 0.5f, false), centre)[0];
     EXPECT_GE(ao, visibility(depth, (r - half_diagonal) / n)) << directions;
     EXPECT_LE(ao, visibility(depth, (r + half_diagonal + 1) / n)) << directions;
     EXPECT_NEAR(ao, exact, 0.03) << directions;  // the bounds above are exact +-0.026
@@ -191,7 +191,7 @@ TEST(AmbientOcclusion, PitCentreMatchesTheClosedForm) {
   // sqrt(2) 2^k of the tap: it sees the rim only once (1 + sqrt(2)) 2^k >= r (k >= 4 for r = 24), and surely at
   // 2^k >= r + sqrt(2)/2 (k = 5). So each direction's horizon distance is 16 or 32 texels.
   for (int directions : {4, 8, 16}) {
-    const float ao = harness.run(frame_desc(directions, 0.5f, true), centre)[0];
+    const float ao = harness.run(frame_params(directions, 0.5f, true), centre)[0];
     EXPECT_GE(ao, visibility(depth, 16.0 / n)) << directions;
     EXPECT_LE(ao, visibility(depth, 32.0 / n)) << directions;
   }
@@ -218,10 +218,10 @@ TEST(AmbientOcclusion, VGrooveBottomMatchesTheClosedForm) {
     // UV) move it along a wall of slope ds / (8/64) = 0.4, so the rise is off by <= 5e-8 and the slope
     // rise / t (t >= 1/64) by <= 3.2e-6; a visibility's derivative in the slope is at most 1. 1e-5 covers that
     // and the few roundings of the weights and the average.
-    EXPECT_NEAR(harness.run(frame_desc(directions, 0.25f, false), bottom)[0], expected, 1e-5) << directions;
+    EXPECT_NEAR(harness.run(frame_params(directions, 0.25f, false), bottom)[0], expected, 1e-5) << directions;
   }
   // Strength blends towards open: 1 - strength * (1 - ao).
-  AoDesc half = frame_desc(8, 0.25f, false);
+  AoParams half = frame_params(8, 0.25f, false);
   const float full = harness.run(half, bottom)[0];
   half.strength = 0.5f;
   EXPECT_EQ(harness.run(half, bottom)[0], 1.0f - 0.5f * (1.0f - full));
@@ -248,7 +248,7 @@ TEST(AmbientOcclusion, JitterRotationIsAHashOfPixelAndSeed) {
 
 TEST(AmbientOcclusion, JitterIsDeterministicPerPixel) {
   const AoHarness harness(bumps(64), HeightFetch::Bilinear);
-  AoDesc d = frame_desc(4, 0.2f, false);
+  AoParams d = frame_params(4, 0.2f, false);
   d.jitter = true;
   d.seed = 5;
   std::vector<AoPoint> points;
@@ -270,7 +270,7 @@ TEST(AmbientOcclusion, JitterIsDeterministicPerPixel) {
   for (std::size_t k = 0; k < a.size(); ++k) differ += a[k] != c[k];
   EXPECT_GE(differ, 30);  // 15/16 of 40 pixels get another rotation; a few may coincide in value
   // A pixel whose rotation is 0 sees the unjittered directions.
-  AoDesc plain = d;
+  AoParams plain = d;
   plain.jitter = false;
   const std::vector<float> unjittered = harness.run(plain, points);
   for (std::size_t k = 0; k < points.size(); ++k)
@@ -294,11 +294,14 @@ TEST(AmbientOcclusion, FrameMatchesTheBakeAtTexelCentres) {
                         float(i) + 0.5f, float(j) + 0.5f});
   for (bool coarse : {false, true})
     for (bool jitter : {false, true}) {
-      AoDesc d = frame_desc(jitter ? 5 : 8, 0.3f, coarse);
+      AoDesc d;  // one AO asked of a material, baked and traced per frame
+      d.directions = jitter ? 5 : 8;
+      d.radius = 0.3f;
+      d.coarse = coarse;
       d.jitter = jitter;
       d.seed = 3;
       const Image baked = bake_ao_map(field, ds, d);
-      const std::vector<float> frame = harness.run(d, points);
+      const std::vector<float> frame = harness.run(ao_params(d), points);
       double worst = 0.0;
       for (int k = 0; k < n * n; ++k) worst = std::max(worst, std::abs(double(frame[std::size_t(k)]) - baked.texels[std::size_t(k)]));
       // fp32 against fp64 on the same heights. The fp32 tap position u0 + d t is off by <= 2e-7 UV; the bumps'

@@ -16,6 +16,7 @@
 #include "qdmr/texture/texture_level0.hpp"
 #include "kernel/displacement.hpp"
 #include "support/test_support.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr::test {
 
@@ -186,7 +187,7 @@ public:
     // positions instead (see trace_rays).
     LightRig rig;
     rig.camera_position = glm::vec3(0.0f);
-    return trace_rays(DisplacementProgram(inputs, material_, rig), rays);
+    return trace_rays(DisplacementProgram(inputs, program_key(material_), program_params(material_), rig), rays);
   }
 
 private:

@@ -14,6 +14,7 @@
 #include "kernel/self_shadow.hpp"
 #include "texture/blend_box_values.hpp"
 #include "texture/blend_weights.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -65,7 +66,7 @@ public:
     }
     LightRig rig;
     rig.camera_position = glm::vec3(0.0f);
-    return trace_rays(DisplacementProgram(inputs, material_, rig), rays, vertex_weights);
+    return trace_rays(DisplacementProgram(inputs, program_key(material_), program_params(material_), rig), rays, vertex_weights);
   }
 
 private:
@@ -359,7 +360,7 @@ TEST(HeightBlend, HardShadowOverABlendIsTheExactShadowOfTheCombinedSurface) {
         const WeightTexture w{&weight_view, 2.0f, precomputed ? &combined_view : nullptr, 2 * n, 2 * n};
         const BlendedSurface surface(layers.data(), kLayers, BlendOperator::Height, w,
                                      xsimd::min(fu, u1), xsimd::max(fu, u1), xsimd::min(fv, v1), xsimd::max(fv, v1));
-        const ShadowResult r = self_shadow(surface, desc, ShadowRay{fu, fv, fs, fdu, fdv, simd::Float(float(ds))}, simd::Float(0.0f),
+        const ShadowResult r = self_shadow(surface, desc.mode, shadow_params(desc), ShadowRay{fu, fv, fs, fdu, fdv, simd::Float(float(ds))}, simd::Float(0.0f),
                                            simd::Float(0.0f) == simd::Float(0.0f));
         alignas(64) float vis[simd::kLanes];
         r.visibility.store_aligned(vis);

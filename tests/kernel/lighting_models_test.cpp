@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "kernel/lighting_models.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr::shading {
 namespace {
@@ -114,10 +115,10 @@ TEST(LightingModels, BlinnPhongIsShadingMathBitForBit) {
     Float expected[3], got[3], got_lit[3];
     blinn_phong(n.batch, g.batch, v.batch, albedo.data(), lighting, rig, expected);
     const SurfaceSample surface{albedo.data(), Float(lighting.specular), Float(1.0f)};
-    shade_lights(n.batch, g.batch, v.batch, surface, nullptr, lighting, rig, got);
+    shade_lights(n.batch, g.batch, v.batch, surface, nullptr, lighting.model, lighting_params(lighting), rig, got);
     EXPECT_TRUE(same_bits(expected, got)) << round;
     const std::vector<Float> all_lit(rig.directional.size(), Float(1.0f));
-    shade_lights(n.batch, g.batch, v.batch, surface, all_lit.data(), lighting, rig, got_lit);
+    shade_lights(n.batch, g.batch, v.batch, surface, all_lit.data(), lighting.model, lighting_params(lighting), rig, got_lit);
     EXPECT_TRUE(same_bits(expected, got_lit)) << round;
   }
 }
@@ -137,7 +138,7 @@ TEST(LightingModels, AoScalesAmbientAndVisibilityRemovesLights) {
       LightRig ambient_only = rig;
       ambient_only.directional.clear();
       Float color[3];
-      shade_lights(n.batch, n.batch, v.batch, surface, nullptr, lighting, ambient_only, color);
+      shade_lights(n.batch, n.batch, v.batch, surface, nullptr, lighting.model, lighting_params(lighting), ambient_only, color);
       const float ambient[3] = {rig.ambient.x, rig.ambient.y, rig.ambient.z};
       for (int c = 0; c < 3; ++c) {
         const Float expected = albedo[std::size_t(c)] * (Float(ambient[c]) * ao) + Float(0.0f);
@@ -148,8 +149,8 @@ TEST(LightingModels, AoScalesAmbientAndVisibilityRemovesLights) {
       LightRig two = rig;
       two.directional.erase(two.directional.begin() + 1);
       Float shadowed[3], removed[3];
-      shade_lights(n.batch, n.batch, v.batch, surface, visibility, lighting, rig, shadowed);
-      shade_lights(n.batch, n.batch, v.batch, surface, nullptr, lighting, two, removed);
+      shade_lights(n.batch, n.batch, v.batch, surface, visibility, lighting.model, lighting_params(lighting), rig, shadowed);
+      shade_lights(n.batch, n.batch, v.batch, surface, nullptr, lighting.model, lighting_params(lighting), two, removed);
       EXPECT_TRUE(same_bits(shadowed, removed)) << round;
     }
 }
@@ -187,7 +188,7 @@ TEST(LightingModels, CookTorranceMatchesDoublePrecision) {
         lighting.roughness = roughness;
         const Vec3 up{Float(0.0f), Float(0.0f), Float(1.0f)};
         Float color[3];
-        shade_lights(n.batch, up, v.batch, {black, Float(f0), Float(1.0f)}, nullptr, lighting, rig, color);
+        shade_lights(n.batch, up, v.batch, {black, Float(f0), Float(1.0f)}, nullptr, lighting.model, lighting_params(lighting), rig, color);
         const Lanes got = lanes(color[0]);
         for (int lane = 0; lane < simd::kLanes; ++lane) {
           const glm::dvec3 nd(n.lane[std::size_t(lane)]), vd(v.lane[std::size_t(lane)]), ld(l);
@@ -236,7 +237,7 @@ TEST(LightingModels, CookTorranceWhiteFurnace) {
         const double sine = std::sqrt(1.0 - mu * mu);
         rig.directional[0].direction = {float(sine * std::cos(phi)), float(sine * std::sin(phi)), float(mu)};
         Float color[3];
-        shade_lights(up, up, view, {black, Float(1.0f), Float(1.0f)}, nullptr, lighting, rig, color);
+        shade_lights(up, up, view, {black, Float(1.0f), Float(1.0f)}, nullptr, lighting.model, lighting_params(lighting), rig, color);
         const Lanes c = lanes(color[0]);
         for (int l = 0; l < simd::kLanes; ++l) energy[std::size_t(l)] += double(c[std::size_t(l)]);
       }

@@ -10,6 +10,7 @@
 #include "kernel/lane_packing.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "kernel/normal_mapping.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr {
 namespace {
@@ -85,7 +86,8 @@ void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbed
   lights.directional.push_back({glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)), glm::vec3(1.0f, 0.9f, 0.8f)});
   lights.ambient = glm::vec3(0.1f);
   lights.camera_position = glm::vec3(0.2f, -0.4f, 3.0f);
-  const NormalMappingProgram program("test", albedo, normal, nullptr, SamplingDesc{}, lighting, specular, lights);
+  const NormalMappingProgram program("test", albedo, normal, nullptr, SamplingDesc{}, lighting.model,
+                                     lighting_params(lighting), specular, lights);
   ASSERT_TRUE(program.pairs_batches());
   const std::uint32_t all = (1u << kLanes) - 1u;
   int packed = 0, side_by_side = 0;

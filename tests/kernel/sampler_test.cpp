@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "program/variant.hpp"
+#include "qdmr/program/program_key.hpp"
 #include "texture/twin_texels.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/sampler.hpp"

@@ -20,6 +20,7 @@
 #include "kernel/height_surface.hpp"
 #include "kernel/self_shadow.hpp"
 #include "reference/shadow_shapes.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -68,7 +69,7 @@ public:
       }
       const ShadowRay ray{simd::Float::load_aligned(u),  simd::Float::load_aligned(v),  simd::Float::load_aligned(s),
                           simd::Float::load_aligned(du), simd::Float::load_aligned(dv), simd::Float(ds)};
-      const ShadowResult r = self_shadow(surface, desc, ray, simd::Float(0.0f), simd::from_bits(bits));
+      const ShadowResult r = self_shadow(surface, desc.mode, shadow_params(desc), ray, simd::Float(0.0f), simd::from_bits(bits));
       alignas(64) float vis[simd::kLanes], it[simd::kLanes];
       r.visibility.store_aligned(vis);
       r.iterations.store_aligned(it);

@@ -179,7 +179,7 @@ TEST(Renderer, StatsNameTheVariantThePlanPicked) {
   }
 }
 
-// Every trace variant (program/variant.hpp): the instantiation the program runs, named from its template
+// Every trace variant (qdmr/program/program_key.hpp): the instantiation the program runs, named from its template
 // arguments, is the one the plan picked from the material.
 TEST(Renderer, EveryTraceVariantRunsTheInstantiationThePlanNames) {
   int checked = 0;

@@ -23,4 +23,16 @@ enum class LodMode { PerQuad, PerPixel };
 // (SM4); fp32 addresses and cells found from fp32 positions (SM3); as SM4 with QDM's wall crossings in fp64.
 enum class MathMode { Sm4, Sm3, Exact };
 
+// What a material asks of its texture sampling; the kernels' samplers run it (kernel/sampler.hpp).
+struct SamplingDesc {
+  Filter filter = Filter::Trilinear;
+  AddressMode address = AddressMode::Wrap;
+  SamplePrecision precision = SamplePrecision::Exact;
+  LodMode lod = LodMode::PerQuad;
+  float lod_bias = 0.0f;
+  float min_lod = 0.0f;    // LOD clamp, in levels
+  float max_lod = 16.0f;
+  MathMode math = MathMode::Sm4;
+};
+
 }  // namespace qdmr

@@ -11,6 +11,8 @@
 
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/aov.hpp"
+#include "qdmr/program/program_key.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/format.hpp"
 #include "qdmr/texture/mip_texture.hpp"
@@ -96,8 +98,10 @@ struct LayerPlan {
 struct MaterialPlan {
   std::string name;
   std::string where;         // the scene field it comes from (an OBJ's MTL material: the object's mesh file)
-  MaterialDesc desc;         // what the scene says; the program reads its knobs
-  std::string variant;       // the shading program variant (the instantiated program type's name)
+  MaterialDesc desc;         // what the scene says; preparation reads it
+  ProgramKey key;            // what the shading program runs, and what it reads: the kernel makes the program
+  ProgramParams params;      // from these (Kernel::make_program), never from desc
+  std::string variant;       // the key printed (variant_name): the program reports the instantiation it runs
   TechniqueKind technique = TechniqueKind::Normal;
   std::vector<LayerPlan> layers;  // one per material layer
   bool blend = false;        // more than one layer

@@ -14,6 +14,7 @@
 
 #include "qdmr/core/sampling.hpp"
 #include "qdmr/core/texture_cache.hpp"
+#include "qdmr/scene/material_modes.hpp"
 
 namespace qdmr {
 
@@ -155,16 +156,6 @@ bool time_dependent(const TextureDesc& texture);
 
 enum class NormalConvention { GL, DX };  // DX: green channel points down (-Y)
 
-// Specular reflectance generated from the albedo instead of stored (the talk's terrain saves the texture):
-// specular = scale * pow(invert ? 1 - luminance : luminance, power), luminance = Rec. 709 weights of the linear
-// albedo, clamped to [0, 1].
-struct SpecularFromAlbedo {
-  bool enabled = false;  // off: the material's lighting.specular constant
-  float power = 1.0f;
-  float scale = 0.5f;
-  bool invert = false;
-};
-
 struct LayerDesc {
   TextureDesc albedo;            // default: constant white
   TextureDesc normal;            // default: from_height when a height exists, else flat
@@ -175,16 +166,6 @@ struct LayerDesc {
   float height_offset = 0.0f;
   SpecularFromAlbedo specular;
 };
-
-enum class TechniqueKind { Normal, Relief, Pom, Csm, Rcsm, Qdm };
-// QDM: where to continue after the ray crosses into a neighbouring cell.
-enum class QdmLevelUp { Stay, One, Aligned };
-// QDM: how the level-0 hit is refined between texels.
-enum class QdmRefinement { None, Linear, Binary, BilinearPatch };
-// How techniques fetch heights: the nearest or the bilinear level-0 texel (the box and bilinear surfaces the
-// exact reference knows), or trilinear with the pixel's LOD. QDM walks its max-quadtree with point fetches
-// unless trilinear (the talk: LinearMipMapLinear "possible but may introduce some artifacts").
-enum class HeightFetch { Point, Bilinear, Trilinear };
 
 // The intersection technique and its speed/accuracy knobs. Depth is in UV units of one texture repeat:
 // the surface lies between depth 0 (the polygon) and depth_scale.
@@ -215,30 +196,12 @@ struct TechniqueDesc {
   float fade_end = 0.0f;
 };
 
-struct SamplingDesc {
-  Filter filter = Filter::Trilinear;
-  AddressMode address = AddressMode::Wrap;
-  SamplePrecision precision = SamplePrecision::Exact;
-  LodMode lod = LodMode::PerQuad;
-  float lod_bias = 0.0f;
-  float min_lod = 0.0f;    // LOD clamp, in levels
-  float max_lod = 16.0f;
-  MathMode math = MathMode::Sm4;
-};
-
-enum class LightingModel { BlinnPhong, CookTorrance };
-
 struct LightingDesc {
   LightingModel model = LightingModel::BlinnPhong;
   float specular = 0.25f;    // specular reflectance scale (Blinn-Phong), F0 at normal incidence (Cook-Torrance)
   float shininess = 32.0f;   // Blinn-Phong exponent
   float roughness = 0.5f;    // Cook-Torrance: GGX roughness (alpha = roughness^2)
 };
-
-// Self-shadowing of the displaced surface towards each directional light (the talk's "Self-shadowing").
-enum class ShadowMode { Off, Hard, Horizon, QdmSoft };
-// How the horizon shadow combines the occlusion of its samples along the light direction.
-enum class ProfileOperator { Max, Min, Average };
 
 struct ShadowDesc {
   ShadowMode mode = ShadowMode::Off;
@@ -252,9 +215,6 @@ struct ShadowDesc {
   float bias = 0.0f;              // the light ray starts this fraction of the depth scale above the hit (acne on
                                   // smooth slopes, where the box surface's terraces shadow each other)
 };
-
-// Ambient occlusion of the displaced surface from horizon queries (applied to the ambient light).
-enum class AoMode { Off, Frame, Baked };
 
 struct AoDesc {
   AoMode mode = AoMode::Off;
@@ -272,11 +232,6 @@ struct AoDesc {
   static constexpr int kMaxAmortizeFrames = 64;
 };
 
-// Height blending of up to 4 layers (the talk's "Surface Blending" / "Height Blending").
-enum class BlendOperator { Alpha, Height, HeightWidth };
-// Where blend weights come from: the vertices (interpolated, constant along each view ray), or a per-pixel
-// weight texture sampled where the ray hits.
-enum class WeightMode { Vertex, Pixel };
 enum class WeightSource { Noise, Terrain, File };
 
 struct WeightsDesc {

@@ -1,4 +1,4 @@
-#include "program/variant.hpp"
+#include "qdmr/program/program_key.hpp"
 
 namespace qdmr {
 
@@ -60,17 +60,6 @@ const char* level_up_name(QdmLevelUp l) {
 
 }  // namespace
 
-TraceOptions trace_options(const MaterialDesc& material) {
-  TraceOptions o;
-  o.technique = material.technique.kind;
-  if (o.technique == TechniqueKind::Qdm) {
-    o.math = material.sampling.math;
-    o.filtered_max = material.technique.height_fetch == HeightFetch::Trilinear;
-    o.level_up = material.technique.level_up;
-  }
-  return o;
-}
-
 std::string trace_variant_name(const TraceOptions& o) {
   std::string name = technique_name(o.technique);
   if (o.technique == TechniqueKind::Qdm)
@@ -80,18 +69,15 @@ std::string trace_variant_name(const TraceOptions& o) {
   return name;
 }
 
-std::string program_variant(const MaterialDesc& material, const TraceOptions& trace) {
-  const std::size_t layer_count = material.layers.size();
-  const bool blend = layer_count > 1;
-  std::string variant = trace.technique == TechniqueKind::Normal && !blend
-                            ? std::string("normal_mapping")
-                            : std::string("displacement:") + trace_variant_name(trace);
-  if (blend)
-    variant += std::string(" | blend ") + blend_name(material.blend.op) + " x" + std::to_string(layer_count) +
-               (material.blend.weights.mode == WeightMode::Vertex ? " per vertex" : " per pixel");
-  if (material.shadow.mode != ShadowMode::Off) variant += std::string(" | shadow ") + shadow_name(material.shadow.mode);
-  if (material.ao.mode != AoMode::Off) variant += std::string(" | ao ") + (material.ao.mode == AoMode::Baked ? "baked" : "frame");
-  variant += std::string(" | ") + lighting_name(material.lighting.model) + " | " + filter_name(material.sampling.filter);
+std::string variant_name(const ProgramKey& key) {
+  std::string variant = key.normal_mapping() ? std::string("normal_mapping")
+                                             : std::string("displacement:") + trace_variant_name(key.trace);
+  if (key.layers > 1)
+    variant += std::string(" | blend ") + blend_name(key.blend) + " x" + std::to_string(key.layers) +
+               (key.weights == WeightMode::Vertex ? " per vertex" : " per pixel");
+  if (key.shadow != ShadowMode::Off) variant += std::string(" | shadow ") + shadow_name(key.shadow);
+  if (key.ao != AoMode::Off) variant += std::string(" | ao ") + (key.ao == AoMode::Baked ? "baked" : "frame");
+  variant += std::string(" | ") + lighting_name(key.lighting) + " | " + filter_name(key.filter);
   return variant;
 }
 
