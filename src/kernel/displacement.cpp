@@ -186,15 +186,16 @@ struct DisplacementProgram::Setup {
   UvDerivatives d;
   TangentFrame frame;
   Vec3 view, view_tangent;
-  Float ds;  // depth scale after the distance fade
+  Float ds;  // the depth range the ray is traced through: the depth scale after the distance fade and POM's LOD fade
   Ray ray;
   Mask active;  // the covered lanes (helper lanes are not traced)
   Float height_lod = Float(0.0f);  // mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows
 };
 
 template <class V, class Surface>
-DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup, Float& ds) const {
+DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, const Setup& setup) const {
   const Ray& ray = setup.ray;
+  const Float& ds = setup.ds;
   const Mask active = setup.active;
   Hit hit{Float(0.0f), Float(0.0f), Float(0.0f)};
   // Relief, POM and cone-step loops without the texture-cache recorder's tests when none listens: their calls
@@ -206,11 +207,6 @@ DisplacementProgram::Hit DisplacementProgram::trace(const Surface& surface, cons
     hit.box_s = hit.s;
   } else if constexpr (V::technique == TechniqueKind::Pom) {
     const Float& lod = setup.height_lod;
-    // Far away (high LOD) POM fades to normal mapping.
-    const Float fade = xsimd::min(
-        xsimd::max((lod - Float(trace_.lod_threshold)) / Float(std::max(trace_.lod_fade, 1e-6f)), Float(0.0f)),
-        Float(1.0f));
-    ds = ds * (Float(1.0f) - fade);
     hit = recorded ? trace::pom<true>(surface, ray, ds, lod, setup.view_tangent.z, active, trace_)
                    : trace::pom<false>(surface, ray, ds, lod, setup.view_tangent.z, active, trace_);
     hit.box_s = hit.s;
@@ -312,9 +308,7 @@ void blend_factors(BlendOperator op, float width, int count, const Float* h, con
 template <class V, class Surface>
 void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup, const Surface& surface,
                                         ShadeOutput& out) const {
-  Float ds = setup.ds;
-  const Hit hit = trace<V>(surface, setup, ds);
-  shade_hit<V>(in, setup, surface, hit, ds, out);
+  shade_hit<V>(in, setup, surface, trace<V>(surface, setup), out);
 }
 
 // The surface at the hit: where it is, its colour, normal, specular and baked AO.
@@ -326,19 +320,19 @@ struct DisplacementProgram::SurfaceAtHit {
 
 template <class V, class Surface>
 void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
-                                    const Float& ds, ShadeOutput& out) const {
+                                    ShadeOutput& out) const {
   SurfaceAtHit at;
-  surface_at_hit(setup, surface, hit, ds, at);
-  light_hit<V>(in, setup, surface, at, ds, out);
+  surface_at_hit(setup, surface, hit, at);
+  light_hit<V>(in, setup, surface, at, out);
   if (trace_.write_depth) displaced_depth(in, setup.d, setup.frame, setup.ray, at.hit.s, out);
 }
 
 template <class Surface>
-void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surface, const Hit& traced, const Float& ds,
+void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surface, const Hit& traced,
                                          SurfaceAtHit& at) const {
   const UvDerivatives& d = setup.d;
   const Ray& ray = setup.ray;
-  at.hit = trace_.exact_hits ? exact_hit(ray, ds, traced, setup.active) : traced;
+  at.hit = trace_.exact_hits ? exact_hit(ray, setup.ds, traced, setup.active) : traced;
   const Hit& hit = at.hit;
   const Float hu = ray.u0 + ray.du * hit.s, hv = ray.v0 + ray.dv * hit.s;
   at.hu = hu;
@@ -405,12 +399,12 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
 // Everything after the surface: the shading normal, lighting, AOVs, errors against the reference, depth.
 template <class V, class Surface>
 void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, const Surface& surface,
-                                    const SurfaceAtHit& at, const Float& ds, ShadeOutput& out) const {
+                                    const SurfaceAtHit& at, ShadeOutput& out) const {
   const Hit& hit = at.hit;
   const TangentFrame& frame = setup.frame;
   const Vec3 shading_normal =
       normalize(frame.to_world({at.tangent_normal[0], at.tangent_normal[1], at.tangent_normal[2]}));
-  light(in, setup, surface, hit, ds, at.albedo, at.specular, at.ao, shading_normal, out);
+  light(in, setup, surface, hit, at.albedo, at.specular, at.ao, shading_normal, out);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
@@ -420,15 +414,16 @@ void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, con
   out.hit_depth = hit.s;
   out.error_texels = out.missed = Float(0.0f);
   if constexpr (V::technique != TechniqueKind::Normal)
-    if (reference_) reference_errors(setup.ray, ds, hit, in.covered, out);
+    if (reference_) reference_errors(setup.ray, setup.ds, hit, in.covered, out);
 }
 
 // Self-shadowing per light and ambient occlusion at the hit, then the lighting model.
 template <class Surface>
 void DisplacementProgram::light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
-                                const Float& ds, const Float* albedo, const Float& specular, const Float& baked_ao,
+                                const Float* albedo, const Float& specular, const Float& baked_ao,
                                 const Vec3& shading_normal, ShadeOutput& out) const {
   const Ray& ray = setup.ray;
+  const Float& ds = setup.ds;
   // Hard shadows trace the box surface, so they start from the hit on it: a refined hit between texel centres
   // can lie below a neighbouring column's top and would be shadowed by it (staircase acne).
   // The bias lifts the start along the light ray (towards depth 0) by a fraction of the depth scale.
@@ -514,12 +509,11 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
       Hit hit_a, hit_b;
       walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
       refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
-      shade_hits<V>(a, setup_a, hit_a, setup_a.ds, out_a, b, setup_b, hit_b, setup_b.ds, out_b);
+      shade_hits<V>(a, setup_a, hit_a, out_a, b, setup_b, hit_b, out_b);
     } else {  // relief and POM: their loops run at the core's throughput already; one after the other
-      Float ds_a = setup_a.ds, ds_b = setup_b.ds;
-      const Hit hit_a = trace<V>(surface, setup_a, ds_a);
-      const Hit hit_b = trace<V>(surface, setup_b, ds_b);
-      shade_hits<V>(a, setup_a, hit_a, ds_a, out_a, b, setup_b, hit_b, ds_b, out_b);
+      const Hit hit_a = trace<V>(surface, setup_a);
+      const Hit hit_b = trace<V>(surface, setup_b);
+      shade_hits<V>(a, setup_a, hit_a, out_a, b, setup_b, hit_b, out_b);
     }
     return;
   }
@@ -545,8 +539,8 @@ void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeO
         shade_compacted<V>(in, setups, out, lanes);
         return;
       }
-      trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit, const Float& ds) {
-        shade_hit<V>(*in[k], setups[k], surface, hit, ds, *out[k]);
+      trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit) {
+        shade_hit<V>(*in[k], setups[k], surface, hit, *out[k]);
       });
       return;
     }
@@ -568,31 +562,29 @@ void DisplacementProgram::walk_pair(const Surface& surface_a, const Setup& setup
 }
 
 // Traces batches 0 .. n - 1 over their blended surfaces, two at a time (QDM's walks interleaved, relief and POM
-// one after the other), and calls shade(k, surface, hit, ds) for each.
+// one after the other), and calls shade(k, surface, hit) for each.
 template <class V, class Shade>
 void DisplacementProgram::trace_blended(const Fragments* const* in, const Setup* setups, int n,
                                         const Shade& shade) const {
   const LayerSurfaces layers = layer_surfaces();
   for (int k = 0; k < n; k += 2) {
     const BlendedSurface surface_a = blended_surface(layers, *in[k], setups[k]);
-    Float ds_a = setups[k].ds;  // POM fades it with distance
     if (k + 1 == n) {
-      shade(k, surface_a, trace<V>(surface_a, setups[k], ds_a), ds_a);
+      shade(k, surface_a, trace<V>(surface_a, setups[k]));
       return;
     }
     const BlendedSurface surface_b = blended_surface(layers, *in[k + 1], setups[k + 1]);
-    Float ds_b = setups[k + 1].ds;
     Hit hit_a, hit_b;
     if constexpr (V::technique == TechniqueKind::Qdm) {
       walk_pair<V>(surface_a, setups[k], hit_a, surface_b, setups[k + 1], hit_b);
       hit_a = refine_qdm_hit(surface_a, setups[k], hit_a);
       hit_b = refine_qdm_hit(surface_b, setups[k + 1], hit_b);
     } else {
-      hit_a = trace<V>(surface_a, setups[k], ds_a);
-      hit_b = trace<V>(surface_b, setups[k + 1], ds_b);
+      hit_a = trace<V>(surface_a, setups[k]);
+      hit_b = trace<V>(surface_b, setups[k + 1]);
     }
-    shade(k, surface_a, hit_a, ds_a);
-    shade(k + 1, surface_b, hit_b, ds_b);
+    shade(k, surface_a, hit_a);
+    shade(k + 1, surface_b, hit_b);
   }
 }
 
@@ -645,10 +637,10 @@ void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setu
   ShadeOutput lit[kMax];
   Float hit_s[kMax];
   trace_blended<V>(packed_of, packed_setup, packed,
-                   [&](int w, const BlendedSurface& surface, const Hit& hit, const Float& ds) {
+                   [&](int w, const BlendedSurface& surface, const Hit& hit) {
                      SurfaceAtHit at;
-                     surface_at_hit(packed_setup[w], surface, hit, ds, at);
-                     light_hit<V>(packed_in[w], packed_setup[w], surface, at, ds, lit[w]);
+                     surface_at_hit(packed_setup[w], surface, hit, at);
+                     light_hit<V>(packed_in[w], packed_setup[w], surface, at, lit[w]);
                      hit_s[w] = at.hit.s;
                    });
   // What the packed batches' loops executed: each one's longest lane times the lanes, counted with the batch its
@@ -685,15 +677,15 @@ void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setu
 
 // shade_hit() of two single-layer batches, stage by stage: the surface at each hit, then the lighting of each.
 template <class V>
-void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const Float& ds_a,
-                                     ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
-                                     const Float& ds_b, ShadeOutput& out_b) const {
+void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, ShadeOutput& out_a,
+                                     const Fragments& b, const Setup& setup_b, const Hit& hit_b,
+                                     ShadeOutput& out_b) const {
   const SingleLayerSurface surface = layer_surface(0);
   SurfaceAtHit at_a, at_b;
-  surface_at_hit(setup_a, surface, hit_a, ds_a, at_a);
-  surface_at_hit(setup_b, surface, hit_b, ds_b, at_b);
-  light_hit<V>(a, setup_a, surface, at_a, ds_a, out_a);
-  light_hit<V>(b, setup_b, surface, at_b, ds_b, out_b);
+  surface_at_hit(setup_a, surface, hit_a, at_a);
+  surface_at_hit(setup_b, surface, hit_b, at_b);
+  light_hit<V>(a, setup_a, surface, at_a, out_a);
+  light_hit<V>(b, setup_b, surface, at_b, out_b);
   if (trace_.write_depth) {
     displaced_depth(a, setup_a.d, setup_a.frame, setup_a.ray, at_a.hit.s, out_a);
     displaced_depth(b, setup_b.d, setup_b.frame, setup_b.ray, at_b.hit.s, out_b);
@@ -723,6 +715,14 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
   setup.active = in.covered;
   if (layers_[0].height)
     setup.height_lod = layers_[0].height->height.lod(setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
+  if (key_.trace.technique == TechniqueKind::Pom) {
+    // Far away (high LOD) POM fades to normal mapping.
+    const Float fade = xsimd::min(xsimd::max((setup.height_lod - Float(trace_.lod_threshold)) /
+                                                 Float(std::max(trace_.lod_fade, 1e-6f)),
+                                             Float(0.0f)),
+                                  Float(1.0f));
+    setup.ds = setup.ds * (Float(1.0f) - fade);
+  }
   return setup;
 }
 

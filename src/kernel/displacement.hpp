@@ -56,7 +56,7 @@ private:
     std::optional<TextureSampler> ao;          // bilinear
     SpecularFromAlbedo specular;
   };
-  // What shade() computes before the surface is known: the frame, the ray and the depth scale.
+  // What shade() computes before the surface is known: the frame, the ray and its depth range (the only one).
   struct Setup;
   // The instantiation of shade_variant for a material's trace options, and the options of the type it runs.
   using ShadeFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&) const;
@@ -101,10 +101,9 @@ private:
   struct SurfaceAtHit;
   template <class V, class Surface>
   void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
-                 const simd::Float& ds, ShadeOutput& out) const;
+                 ShadeOutput& out) const;
   template <class Surface>
-  void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
-                      SurfaceAtHit& at) const;
+  void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, SurfaceAtHit& at) const;
   template <class V, class Surface>
   void walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
                  const Setup& setup_b, Hit& hit_b) const;
@@ -116,15 +115,14 @@ private:
   void shade_compacted(const Fragments* const* in, const Setup* setups, ShadeOutput* const* out,
                        const simd::LaneCompaction& lanes) const;
   template <class V>
-  void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, const simd::Float& ds_a,
-                  ShadeOutput& out_a, const Fragments& b, const Setup& setup_b, const Hit& hit_b,
-                  const simd::Float& ds_b, ShadeOutput& out_b) const;
+  void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, ShadeOutput& out_a,
+                  const Fragments& b, const Setup& setup_b, const Hit& hit_b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void light_hit(const Fragments& in, const Setup& setup, const Surface& surface, const SurfaceAtHit& at,
-                 const simd::Float& ds, ShadeOutput& out) const;
+                 ShadeOutput& out) const;
   QdmBudget qdm_budget(const Setup& setup) const;
   template <class V, class Surface>
-  Hit trace(const Surface& surface, const Setup& setup, simd::Float& ds) const;
+  Hit trace(const Surface& surface, const Setup& setup) const;
   // A QDM walk's hit on the box surface, refined on the filtered one as the technique asks.
   template <class Surface>
   Hit refine_qdm_hit(const Surface& surface, const Setup& setup, Hit hit) const;
@@ -133,7 +131,7 @@ private:
   void displaced_depth(const Fragments& in, const shading::UvDerivatives& d, const shading::TangentFrame& frame,
                        const Ray& ray, const simd::Float& s, ShadeOutput& out) const;
   template <class Surface>
-  void light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit, const simd::Float& ds,
+  void light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
              const simd::Float* albedo, const simd::Float& specular, const simd::Float& baked_ao,
              const shading::Vec3& shading_normal, ShadeOutput& out) const;
   // Calls per_lane(lane, ray in the reference's UV, its hit) for each covered lane.
