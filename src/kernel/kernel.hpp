@@ -16,7 +16,7 @@
 #include "bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
 #include "texture/blend_box_values.hpp"
-#include "qdmr/texture/height_rows.hpp"
+#include "texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "raster/raster_context.hpp"
 

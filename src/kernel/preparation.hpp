@@ -5,7 +5,7 @@
 #include "core/isa_namespace.hpp"
 #include "texture/blend_box_values.hpp"
 #include "qdmr/texture/format.hpp"
-#include "qdmr/texture/height_rows.hpp"
+#include "texture/height_rows.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/texture/height_rows.hpp"
+#include "texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
 namespace qdmr {

@@ -1,5 +1,5 @@
 #pragma once
-// The code of HeightRows (qdmr/texture/height_rows.hpp): plain loops over a row, written so that the compiler
+// The code of HeightRows (texture/height_rows.hpp): plain loops over a row, written so that the compiler
 // vectorises them (one lane per texel, the generic builders' IEEE operations in their order: the same bits on any
 // vector width). In the ISA namespace: kernel/height_rows.cpp compiles it per ISA, texture/height_family.cpp for
 // the baseline.
@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "core/isa_namespace.hpp"
-#include "qdmr/texture/height_rows.hpp"
+#include "texture/height_rows.hpp"
 #include "texture/mip_reduce.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::height_row_code {
