@@ -81,3 +81,19 @@ def test_set_frame_draws_the_commands_frame(cli, tmp_path):
     assert numpy.array_equal(bits(renderer.draw().color), bits(qdmr.read_image(tmp_path / "f_03.exr")))
     with pytest.raises(ValueError, match="outside the animation's frames 0 to 119"):
         renderer.set_frame(120)
+
+
+def test_an_amortized_frame_alone_is_the_frame_of_the_sequence(cli, tmp_path):
+    """Baked AO amortized over 3 frames: `--frame 4` replays frames 2 and 3 first, so it draws the bits of frame 4
+    of `--frames 0:4`, on another thread count too; and so does set_frame."""
+    sets = ["--set", "/materials/water/layers/0/height/size=64",
+            "--set", '/materials/water/ao={"mode": "baked", "amortize_frames": 3}', "--width", "96", "--height", "54"]
+    run_cli(cli, "render", WATER, "--frames", "0:4", "-o", str(tmp_path / "s_%02d.exr"), "--threads", "2", *sets)
+    run_cli(cli, "render", WATER, "--frame", "4", "-o", str(tmp_path / "one.exr"), "--threads", "1", *sets)
+    sequence = bits(qdmr.read_image(tmp_path / "s_04.exr"))
+    assert numpy.array_equal(sequence, bits(qdmr.read_image(tmp_path / "one.exr")))
+    renderer = qdmr.Renderer(threads=1)
+    renderer.set_scene(qdmr.load_scene(WATER, {**SMALL, "/materials/water/layers/0/height/size": 64,
+                                               "/materials/water/ao": {"mode": "baked", "amortize_frames": 3}}))
+    renderer.set_frame(4)
+    assert numpy.array_equal(bits(renderer.draw().color), sequence)
