@@ -2,7 +2,8 @@
 // 0, its R16 codes and decoded copy, the Box chain with wrap footprints, the max-quadtree, the from_height normals
 // and their BoxNormal chain, refilling the previous-but-one frame's textures as the Renderer does (so no page is
 // allocated or cleared in the loop). Each iteration is the next frame of the animation. Arguments: the rows (0: the
-// baseline's, 1: the best kernel's), thread count.
+// baseline's, 1: the best kernel's), thread count, and whether the max-quadtree is among the textures (1) or not (0:
+// the difference is the quadtree's part of the rebuild, its level 0 copy included).
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
@@ -21,16 +22,18 @@ using namespace qdmr;
 void water_rebuild(benchmark::State& state) {
   const bool kernel_rows = state.range(0) != 0;
   const int threads = int(state.range(1));
+  const bool quadtree = state.range(2) != 0;
   const SceneDesc scene = load_scene(std::string(QDMR_SOURCE_DIR) + "/scenes/water.json", {});
   const Kernel& kernel = kernel_for(resolve_isa(Isa::Auto));
   const HeightRows& rows = kernel_rows ? kernel.height_rows() : baseline_height_rows();
   // The members prepare makes for the water layer: heights (box, wrap footprints), the max-quadtree, normals.
-  const auto members = [] {
+  const auto members = [quadtree] {
     std::vector<HeightFamilyMember> m(3);
     m[0].wrap_footprints = true;
     m[1].reduce = MipReduce::Max;
     m[2].normals = true;
     m[2].normal_strength = 0.6f;
+    if (!quadtree) m.erase(m.begin() + 1);
     return m;
   };
   std::vector<HeightFamilyMember> frames[2] = {members(), members()};
@@ -48,8 +51,8 @@ void water_rebuild(benchmark::State& state) {
 }
 
 BENCHMARK(water_rebuild)
-    ->ArgsProduct({{0, 1}, {1, 2}})
-    ->ArgNames({"kernel", "threads"})
+    ->ArgsProduct({{0, 1}, {1, 2}, {1, 0}})
+    ->ArgNames({"kernel", "threads", "quadtree"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -147,6 +147,25 @@ TEST(HeightFamily, EveryTextureHasTheGenericBuildersBits) {
     }
 }
 
+// The normals and their BoxNormal levels are made in float first and the texels whose float codes might differ
+// from the exact ones redone exactly (texture/height_rows_code.hpp): about 0.6 % of the texels of a 512 x 384 field
+// of random heights (so thousands, of which a margin too small would get hundreds wrong), at strengths whose float
+// scale is subnormal (1e-40), ordinary (0.6, 40), makes the float squares overflow (1e17) or exceeds a float's range
+// (3e38: the exact texel's infinite length gives (0, 0, 1)).
+TEST(HeightFamily, FloatNormalsAreRedoneExactlyWhereTheirCodesMightDiffer) {
+  const LayerDesc layer = pixels_layer(512, 384, TextureFormatChoice::R16, 7);
+  for (const Rows& rows : every_rows()) {
+    std::vector<HeightFamilyMember> built(1);
+    for (float strength : {1e-40f, 0.6f, 40.0f, 1e17f, 3e38f}) {
+      HeightFamilyMember m;
+      m.normals = true;
+      m.normal_strength = strength;
+      built.push_back(std::move(m));
+    }
+    expect_generic_bits(layer, built, rows, "random 512x384");
+  }
+}
+
 TEST(HeightFamily, RefillingAnEarlierFramesTexturesGivesTheSameBits) {
   for (const Rows& rows : every_rows()) {
     // Frame 1's textures refilled with frame 2's heights, and textures of another size (reallocated).
