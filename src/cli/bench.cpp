@@ -90,9 +90,10 @@ int run_bench(const BenchArgs& args) {
   renderer.set_scene(scene, options.aovs);
   const bool tty = ::isatty(STDERR_FILENO);
   std::vector<double> draw_ms, geometry_ms, binning_ms, raster_ms;
-  // A dynamic scene steps through its animation: each draw is of the next frame (1, 2, ... wrapping to 0), after a
-  // warm rebuild of its dynamic items (set_frame), so every timed frame is a frame of the sequence.
-  const bool dynamic = scene.time_dependent();
+  // An animated scene (a texture that changes with time, or a camera on keyframes) steps through its animation:
+  // each draw is of the next frame (1, 2, ... wrapping to 0), after a warm rebuild of its dynamic items (set_frame;
+  // none for a moving camera), so every timed frame is a frame of the sequence.
+  const bool animated = scene.time_dependent() || !scene.camera.keyframes.empty();
   std::vector<double> rebuild_ms, frame_ms;
   std::vector<int> sequence_frames;
   double plan_ms = 0, prepare_ms = 0;
@@ -101,7 +102,7 @@ int run_bench(const BenchArgs& args) {
   for (int i = 0; i < total; ++i) {
     const int sequence_frame = (i + 1) % scene.animation.frames;
     const auto rebuild_start = Clock::now();
-    if (dynamic) renderer.set_frame(sequence_frame);
+    if (animated) renderer.set_frame(sequence_frame);
     const double rebuild = ms_since(rebuild_start);
     const RenderStats& stats = renderer.draw().stats;
     if (i == 0) {
@@ -113,7 +114,7 @@ int run_bench(const BenchArgs& args) {
       geometry_ms.push_back(stats.geometry_ms);
       binning_ms.push_back(stats.binning_ms);
       raster_ms.push_back(stats.raster_shade_ms);
-      if (dynamic) {
+      if (animated) {
         rebuild_ms.push_back(rebuild);
         frame_ms.push_back(rebuild + stats.draw_ms());
         sequence_frames.push_back(sequence_frame);
@@ -146,7 +147,7 @@ int run_bench(const BenchArgs& args) {
   j["geometry_ms"] = summary(geometry_ms);
   j["binning_ms"] = summary(binning_ms);
   j["raster_shade_ms"] = summary(raster_ms);
-  if (dynamic) {
+  if (animated) {
     j["rebuild_ms"] = summary(rebuild_ms);
     j["frame_ms"] = summary(frame_ms);  // rebuild + draw of each timed frame
     j["sequence_frames"] = sequence_frames;
@@ -178,7 +179,7 @@ int run_bench(const BenchArgs& args) {
               write_ms, image.extension().string().c_str());
   std::printf("  draw: median %.2f ms, min %.2f, p10 %.2f, p90 %.2f\n", d["median"].get<double>(), d["min"].get<double>(),
               d["p10"].get<double>(), d["p90"].get<double>());
-  if (dynamic)
+  if (animated)
     std::printf("  frames of the animation (rebuild + draw): median %.2f ms, rebuild median %.2f ms\n",
                 j["frame_ms"]["median"].get<double>(), j["rebuild_ms"]["median"].get<double>());
   if (traced)

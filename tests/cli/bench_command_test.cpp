@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -72,6 +73,34 @@ TEST(BenchCommand, TimesWarmFramesOfADynamicScene) {
   const nlohmann::json still = bench(dir, "qdm", output);
   EXPECT_FALSE(still.contains("rebuild_ms"));
   EXPECT_FALSE(still.contains("sequence_frames"));
+}
+
+// A scene whose only animation is its camera's keyframes is timed frame by frame of its sequence too: the image
+// bench writes is the last timed frame (4), which `render --frame 4` draws and which differs from frame 0.
+TEST(BenchCommand, TimesFramesOfACameraOnKeyframes) {
+  TempDir dir;
+  const std::string scene = (source_dir() / "bench" / "llvmpipe" / "canonical.json").string();
+  const std::vector<std::string> sets = {
+      "--width", "64", "--height", "36", "--set", R"(/animation={"frames": 6, "fps": 24})", "--set",
+      R"(/camera={"up": [0, 0, 1], "near": 0.05, "far": 50, "keyframes": [
+          {"frame": 0, "position": [0, -1.5, 2.6], "target": [0, 0, 0], "fov_deg": 50},
+          {"frame": 5, "position": [1.2, -0.8, 1.4], "target": [0.3, 0.2, 0]}]})"};
+  const auto command = [&](std::vector<std::string> args) {
+    args.insert(args.end(), sets.begin(), sets.end());
+    const CommandResult r = run(cli(), args);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  };
+  const std::string json = (dir / "camera.json").string();
+  command({"bench", scene, "--frames", "3", "--warmup", "1", "--threads", "2", "--json", json, "--image",
+           (dir / "bench.png").string()});
+  command({"render", scene, "--frame", "4", "-o", (dir / "frame4.png").string()});
+  command({"render", scene, "--frame", "0", "-o", (dir / "frame0.png").string()});
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("sequence_frames"), nlohmann::json::array({2, 3, 4}));
+  const std::uint64_t bench_image = pixel_hash(read_float_image(dir / "bench.png"));
+  EXPECT_EQ(bench_image, pixel_hash(read_float_image(dir / "frame4.png")));
+  EXPECT_NE(bench_image, pixel_hash(read_float_image(dir / "frame0.png")));
 }
 
 }  // namespace
