@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Issue #55's targets for glTF input: loading and planning a 1-million-triangle .glb against the same mesh as
 qdmr's procedural grid (time: at most 1.5 x), and the peak memory of that plan against the mesh's own size as the
-plan counts it (at most 1.3 x; the asset has no textures).
+plan counts it (at most 1.3 x; the asset has no textures). The peak counted is what the asset adds to the command's
+own: the peak of `qdmr plan` of the same .glb at resolution 1 (2 triangles) is taken off.
 
 The .glb is written here: the grid of `{"type": "grid", "resolution": R}` (R = 708: 1,002,528 triangles) with
 POSITION, NORMAL, TEXCOORD_0 and 32-bit indices, and no TANGENT (qdmr generates them, MikkTSpace's way), or with
@@ -95,6 +96,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         glb = os.path.join(tmp, "grid.glb")
         grid_glb(glb, args.resolution, args.tangents)
+        tiny = os.path.join(tmp, "tiny.glb")
+        grid_glb(tiny, 1, args.tangents)
         scene = os.path.join(tmp, "grid.json")
         with open(scene, "w") as f:
             json.dump({"materials": {"m": {"layers": [{"albedo": {"constant": 0.5}}]}},
@@ -107,6 +110,7 @@ def main():
         load = os.getloadavg()[0]
         rows = [(what, name, measure(binary, target, args.n, command)) for what, command in commands.items()
                 for name, target in (("procedural grid", scene), (".glb", glb))]
+        empty = measure(binary, tiny, args.n, commands["plan"])[1]
         load_after = os.getloadavg()[0]
     triangles = 2 * args.resolution ** 2
     print("| %d triangles%s, %d rounds | wall time (median) | peak RSS | plan's mesh size |" % (triangles, " (.glb with TANGENT)" if args.tangents else "", args.n))
@@ -115,8 +119,9 @@ def main():
         print("| %s: %s | %.3f s | %.1f MiB | %.1f MiB |" % (what, name, t, peak, mesh))
     for what in commands:
         grid, gltf = [r[2] for r in rows if r[0] == what]
-        print("| %s: .glb / grid | %.2f (target <= 1.5) | .glb peak / mesh: %.2f (target <= 1.3) | |" %
-              (what, gltf[0] / grid[0], gltf[1] / gltf[2]))
+        print("| %s: .glb / grid | %.2f (target <= 1.5) | | |" % (what, gltf[0] / grid[0]))
+    gltf = [r[2] for r in rows if r[0] == "plan" and r[1] == ".glb"][0]
+    print("| plan: (.glb peak - %.1f MiB) / mesh | | %.2f (target <= 1.3) | |" % (empty, (gltf[1] - empty) / gltf[2]))
     print("load average: %.2f before, %.2f after" % (load, load_after))
 
 

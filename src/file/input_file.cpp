@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <mutex>
+#include <utility>
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/core/limits.hpp"
@@ -113,19 +114,37 @@ std::uint64_t check_input_file(const std::filesystem::path& file, const std::str
   return std::uint64_t(st.st_size);
 }
 
-std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
+namespace {
+
+// Opens a checked file without blocking and checks it again on the descriptor (a FIFO swapped in after the check
+// cannot block). Returns the descriptor; `st` holds its status.
+int open_checked(const std::filesystem::path& file, const std::string& where, InputKind kind, struct stat& st) {
   check_input_file(file, where, kind);
   const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
   if (fd < 0) throw FileError(where, "cannot open " + shown_path(file) + ": " + std::strerror(errno));
+  if (::fstat(fd, &st) != 0) {
+    const std::string error = std::strerror(errno);
+    ::close(fd);
+    throw FileError(where, "cannot read " + shown_path(file) + ": " + error);
+  }
+  std::string reason = type_reason(st.st_mode);
+  if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
+  if (!reason.empty()) {
+    ::close(fd);
+    throw FileError(where, about(file, where, reason));
+  }
+  return fd;
+}
+
+}  // namespace
+
+std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind) {
+  struct stat st {};
+  const int fd = open_checked(file, where, kind, st);
   struct Closer {
     int fd;
     ~Closer() { ::close(fd); }
   } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw FileError(where, "cannot read " + shown_path(file) + ": " + std::strerror(errno));
-  std::string reason = type_reason(st.st_mode);
-  if (reason.empty()) reason = size_reason(std::uint64_t(st.st_size), kind);
-  if (!reason.empty()) throw FileError(where, about(file, where, reason));
   // The size fstat gave, then a probe for more through a small buffer: a file that grew while it is read is
   // still read to its end, bounded by the limit + 1, and a file that did not grow costs no larger buffer.
   const std::uint64_t limit = input_size_limit(kind);
@@ -150,6 +169,40 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
   text.resize(have);
   if (have > limit || have == 0) throw FileError(where, about(file, where, size_reason(have, kind)));
   return text;
+}
+
+InputFile::InputFile(const std::filesystem::path& file, const std::string& where, InputKind kind) : file_(file), where_(where) {
+  struct stat st {};
+  fd_ = open_checked(file, where, kind, st);
+  size_ = std::uint64_t(st.st_size);
+}
+
+InputFile::InputFile(InputFile&& other) noexcept
+    : fd_(std::exchange(other.fd_, -1)), size_(other.size_), file_(std::move(other.file_)), where_(std::move(other.where_)) {}
+
+InputFile::~InputFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void InputFile::read(std::uint64_t offset, std::size_t n, void* out) const {
+  auto* into = static_cast<char*>(out);
+  while (n > 0) {
+    const ssize_t got = ::pread(fd_, into, n, off_t(offset));
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw FileError(where_, "cannot read " + shown_path(file_) + ": " + std::strerror(errno));
+    if (got == 0)
+      throw FileError(where_, shown_path(file_) + " ended at byte " + std::to_string(offset) + ", before the " +
+                                  std::to_string(n) + " bytes to read there (did it change while it was read?)");
+    into += got;
+    offset += std::uint64_t(got);
+    n -= std::size_t(got);
+  }
+}
+
+std::string InputFile::read(std::uint64_t offset, std::size_t n) const {
+  std::string bytes(n, '\0');
+  read(offset, n, bytes.data());
+  return bytes;
 }
 
 void note_input(const std::filesystem::path& file) {

@@ -33,6 +33,29 @@ std::uint64_t check_input_file(const std::filesystem::path& file, const std::str
 // descriptor, so a FIFO swapped in after the check cannot block either; reads at most the limit.
 std::string read_input_file(const std::filesystem::path& file, const std::string& where, InputKind kind);
 
+// An input file held open to read parts of it (a .glb's chunks, the accessors of a glTF buffer) without holding
+// all of it: checked as check_input_file checks it, then again on the open descriptor, as read_input_file does.
+class InputFile {
+ public:
+  InputFile(const std::filesystem::path& file, const std::string& where, InputKind kind);
+  InputFile(InputFile&& other) noexcept;
+  InputFile& operator=(InputFile&&) = delete;
+  InputFile(const InputFile&) = delete;
+  ~InputFile();
+
+  std::uint64_t size() const { return size_; }
+  // `n` bytes from `offset` into `out`. Throws qdmr::Error(where, ...) when they are not all there (the file
+  // changed since it was checked) or cannot be read.
+  void read(std::uint64_t offset, std::size_t n, void* out) const;
+  std::string read(std::uint64_t offset, std::size_t n) const;
+
+ private:
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+  std::filesystem::path file_;
+  std::string where_;
+};
+
 struct FileIdentity {
   dev_t device = 0;
   ino_t inode = 0;

@@ -9,8 +9,15 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <span>
 #include <set>
 #include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -44,6 +51,15 @@ const std::set<std::string> kSupportedExtensions = {"KHR_texture_transform", "KH
 // are exactly 0 and +-1, so a vertex is moved without rounding.
 const glm::dmat4 kZUp(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);
 
+// Where a buffer's bytes are: in a file (the .glb's BIN chunk, or a .bin beside the asset), read an accessor at a
+// time, or in memory (a data: URI, which tinygltf decodes).
+struct BufferSource {
+  std::uint64_t size = 0;
+  const InputFile* file = nullptr;
+  std::uint64_t offset = 0;  // of the buffer's first byte in `file`
+  const unsigned char* memory = nullptr;
+};
+
 // What the file callbacks and the image callback share with the loader.
 struct Reading {
   fs::path folder;                       // the asset's folder, lexically normal and absolute
@@ -51,8 +67,12 @@ struct Reading {
   std::set<fs::path> image_files;        // external images: checked, never read by tinygltf
   std::string error;                     // the first qdmr error raised inside a callback
   Error::Kind error_kind = Error::Kind::Value;  // ... and its kind
-  const tinygltf::Model* model = nullptr;
-  std::vector<std::string> embedded;     // per image: its bytes when stored in the asset (data: URI or buffer view)
+  std::vector<std::string> embedded;     // per image: its bytes when stored in a data: URI
+  std::map<int, int> image_views;        // image -> the buffer view that holds it (not handed to tinygltf)
+  // The asset's files that hold buffers, open (the .glb first), and per buffer where its bytes are: tinygltf gets a
+  // one-byte stand-in for each buffer in a file, so no buffer is ever held whole.
+  std::map<fs::path, std::unique_ptr<InputFile>> files;
+  std::vector<BufferSource> buffers;
 };
 
 bool inside(const Reading& r, const fs::path& file) {
@@ -97,33 +117,16 @@ bool write_whole_file(std::string* err, const std::string&, const std::vector<un
   return false;
 }
 
-// tinygltf hands over the bytes of an embedded image (and one placeholder byte for an external one); the bytes
-// of a buffer view are handed over unchecked, so the view is checked here first.
+// tinygltf hands over the bytes of an image in a data: URI (and one placeholder byte for an external one; an image
+// in a buffer view is not handed to tinygltf, see Reading::image_views).
 bool keep_image(tinygltf::Image* image, const int index, std::string* err, std::string*, int, int,
                 const unsigned char* bytes, int size, void* user) {
   auto& r = *static_cast<Reading*>(user);
   const std::string at = r.where + ": /images/" + std::to_string(index);
   if (!image->uri.empty()) return true;  // external: read from its file
-  if (image->bufferView >= 0) {
-    const auto& views = r.model->bufferViews;
-    const auto& buffers = r.model->buffers;
-    const std::string problem =
-        std::size_t(image->bufferView) >= views.size() ? "names buffer view " + std::to_string(image->bufferView) + ", which does not exist"
-        : std::size_t(views[std::size_t(image->bufferView)].buffer) >= buffers.size() ? "its buffer view names a buffer that does not exist"
-        : views[std::size_t(image->bufferView)].byteOffset > buffers[std::size_t(views[std::size_t(image->bufferView)].buffer)].data.size() ||
-                  views[std::size_t(image->bufferView)].byteLength >
-                      buffers[std::size_t(views[std::size_t(image->bufferView)].buffer)].data.size() -
-                          views[std::size_t(image->bufferView)].byteOffset
-              ? "its buffer view runs past the end of its buffer"
-              : "";
-    if (!problem.empty()) {
-      if (r.error.empty()) r.error = at + ": " + problem;
-      if (err) *err += problem;
-      return false;
-    }
-  }
   if (size <= 0) {
     if (r.error.empty()) r.error = at + ": the image is empty";
+    if (err) *err += "the image is empty";
     return false;
   }
   if (std::size_t(index) >= r.embedded.size()) r.embedded.resize(std::size_t(index) + 1);
@@ -158,15 +161,17 @@ fs::path store_embedded_image(const std::string& bytes, const std::string& where
 
 // One accessor's elements, checked against its buffer view and buffer.
 struct Elements {
-  const unsigned char* first = nullptr;
-  std::size_t count = 0, stride = 0;
+  const BufferSource* source = nullptr;
+  std::uint64_t first = 0;  // the first element's byte in its buffer
+  std::size_t count = 0, stride = 0, bytes = 0;  // bytes: of one element
   int components = 0, component_type = 0;
   bool normalized = false;
 };
 
 class Asset {
 public:
-  Asset(const tinygltf::Model& model, std::string where) : model_(model), where_(std::move(where)) {}
+  Asset(const tinygltf::Model& model, const std::vector<BufferSource>& buffers, std::string where)
+      : model_(model), buffers_(buffers), where_(std::move(where)) {}
 
   [[noreturn]] void fail(const std::string& pointer, const std::string& what) const {
     throw Error(where_ + ": " + pointer, what);
@@ -188,72 +193,108 @@ public:
       fail(at + "/bufferView", "buffer view " + std::to_string(a.bufferView) + " does not exist");
     const tinygltf::BufferView& view = model_.bufferViews[std::size_t(a.bufferView)];
     const std::string view_at = "/bufferViews/" + std::to_string(a.bufferView);
-    if (view.buffer < 0 || std::size_t(view.buffer) >= model_.buffers.size())
-      fail(view_at + "/buffer", "buffer " + std::to_string(view.buffer) + " does not exist");
-    const std::size_t buffer_size = model_.buffers[std::size_t(view.buffer)].data.size();
-    if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
-      fail(view_at, "bytes " + std::to_string(view.byteOffset) + " + " + std::to_string(view.byteLength) +
-                        " run past the end of buffer " + std::to_string(view.buffer) + " (" + std::to_string(buffer_size) +
-                        " bytes)");
+    const BufferSource* source = view_source(view, view_at);
     Elements e;
     e.components = tinygltf::GetNumComponentsInType(std::uint32_t(a.type));
     const int size = tinygltf::GetComponentSizeInBytes(std::uint32_t(a.componentType));
-    const std::size_t element = std::size_t(e.components) * std::size_t(size);
-    e.stride = view.byteStride ? view.byteStride : element;
-    if (e.stride < element)
-      fail(view_at + "/byteStride", std::to_string(e.stride) + " is less than an element (" + std::to_string(element) +
+    e.bytes = std::size_t(e.components) * std::size_t(size);
+    e.stride = view.byteStride ? view.byteStride : e.bytes;
+    if (e.stride < e.bytes)
+      fail(view_at + "/byteStride", std::to_string(e.stride) + " is less than an element (" + std::to_string(e.bytes) +
                                         " bytes): the elements overlap");
     if (a.count == 0) fail(at + "/count", "must be at least 1");
     if (a.byteOffset > view.byteLength || a.count > view.byteLength ||
-        (a.count - 1) * e.stride + element > view.byteLength - a.byteOffset || e.stride > view.byteLength)
-      fail(at + "/count", std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes every " +
+        (a.count - 1) * e.stride + e.bytes > view.byteLength - a.byteOffset || e.stride > view.byteLength)
+      fail(at + "/count", std::to_string(a.count) + " elements of " + std::to_string(e.bytes) + " bytes every " +
                               std::to_string(e.stride) + " from byte " + std::to_string(a.byteOffset) +
                               " do not fit buffer view " + std::to_string(a.bufferView) + " (" +
                               std::to_string(view.byteLength) + " bytes)");
-    e.first = model_.buffers[std::size_t(view.buffer)].data.data() + view.byteOffset + a.byteOffset;
+    e.source = source;
+    e.first = view.byteOffset + a.byteOffset;
     e.count = a.count;
     e.component_type = a.componentType;
     e.normalized = a.normalized;
     return e;
   }
 
-  // Every component as float (float, or a normalised unsigned byte or short); `what` names the attribute.
-  std::vector<float> floats(int index, const std::string& pointer, int type, bool normalized_ok) const {
-    const Elements e = normalized_ok
-                           ? elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                                                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT})
-                           : elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  // The buffer of a view, which the view must fit.
+  const BufferSource* view_source(const tinygltf::BufferView& view, const std::string& view_at) const {
+    if (view.buffer < 0 || std::size_t(view.buffer) >= buffers_.size())
+      fail(view_at + "/buffer", "buffer " + std::to_string(view.buffer) + " does not exist");
+    const BufferSource& source = buffers_[std::size_t(view.buffer)];
+    if (view.byteOffset > source.size || view.byteLength > source.size - view.byteOffset)
+      fail(view_at, "bytes " + std::to_string(view.byteOffset) + " + " + std::to_string(view.byteLength) +
+                        " run past the end of buffer " + std::to_string(view.buffer) + " (" + std::to_string(source.size) +
+                        " bytes)");
+    return &source;
+  }
+
+  // `n` bytes of a buffer from `offset` (checked to be inside it) into `out`.
+  static void read(const BufferSource& source, std::uint64_t offset, std::size_t n, unsigned char* out) {
+    if (source.file) {
+      source.file->read(source.offset + offset, n, out);
+    } else {
+      std::memcpy(out, source.memory + offset, n);
+    }
+  }
+
+  // visit(element bytes, i) for every element in order; a file is read a block of elements at a time, so no
+  // accessor is held whole beside what it becomes.
+  template <class Visit>
+  void for_each_element(const Elements& e, Visit&& visit) const {
+    if (e.source->memory) {
+      for (std::size_t i = 0; i < e.count; ++i) visit(e.source->memory + e.first + i * e.stride, i);
+      return;
+    }
+    const std::size_t per_block = std::max<std::size_t>(1, kBlockBytes / e.stride);
+    for (std::size_t first = 0; first < e.count; first += per_block) {
+      const std::size_t n = std::min(per_block, e.count - first);
+      block_.resize((n - 1) * e.stride + e.bytes);
+      read(*e.source, e.first + first * e.stride, block_.size(), block_.data());
+      for (std::size_t k = 0; k < n; ++k) visit(block_.data() + k * e.stride, first + k);
+    }
+  }
+
+  // Every component as float (float, or a normalised unsigned byte or short), into set(i, components).
+  template <class Set>
+  void floats(const Elements& e, int index, Set&& set) const {
     if (e.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT && !e.normalized)
       fail("/accessors/" + std::to_string(index) + "/normalized", "integer texture coordinates must be normalized");
-    std::vector<float> out(e.count * std::size_t(e.components));
-    for (std::size_t i = 0; i < e.count; ++i) {
-      const unsigned char* p = e.first + i * e.stride;
-      for (int c = 0; c < e.components; ++c) {
-        float v = 0.0f;
+    const int components = std::min(e.components, 4);  // VEC2, VEC3 or VEC4
+    for_each_element(e, [&](const unsigned char* p, std::size_t i) {
+      float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      for (int c = 0; c < components; ++c) {
         if (e.component_type == TINYGLTF_COMPONENT_TYPE_FLOAT) {
-          std::memcpy(&v, p + 4 * c, 4);
-          if (!std::isfinite(v))
-            fail("/accessors/" + std::to_string(index), "element " + std::to_string(i) + " is not finite");
+          std::memcpy(&v[c], p + 4 * c, 4);
+          if (!std::isfinite(v[c])) fail("/accessors/" + std::to_string(index), "element " + std::to_string(i) + " is not finite");
         } else if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
-          v = float(p[c]) / 255.0f;
+          v[c] = float(p[c]) / 255.0f;
         } else {
           std::uint16_t s = 0;
           std::memcpy(&s, p + 2 * c, 2);
-          v = float(s) / 65535.0f;
+          v[c] = float(s) / 65535.0f;
         }
-        out[i * std::size_t(e.components) + std::size_t(c)] = v;
       }
-    }
-    return out;
+      set(i, v);
+    });
   }
 
-  std::vector<std::uint32_t> indices(int index, const std::string& pointer, std::size_t vertices) const {
-    const Elements e = elements(index, pointer, {TINYGLTF_TYPE_SCALAR},
-                                {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
-    std::vector<std::uint32_t> out(e.count);
-    for (std::size_t i = 0; i < e.count; ++i) {
-      const unsigned char* p = e.first + i * e.stride;
+  // The elements of a float attribute (of one type; `normalized_ok`: also normalised unsigned bytes or shorts).
+  Elements float_elements(int index, const std::string& pointer, int type, bool normalized_ok) const {
+    return normalized_ok ? elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT})
+                         : elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  }
+
+  Elements index_elements(int index, const std::string& pointer) const {
+    return elements(index, pointer, {TINYGLTF_TYPE_SCALAR},
+                    {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+  }
+
+  // The indices, each checked against the vertex count, into out[0, e.count).
+  void indices(const Elements& e, int index, std::size_t vertices, std::uint32_t* out) const {
+    for_each_element(e, [&](const unsigned char* p, std::size_t i) {
       std::uint32_t v = 0;
       if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
         v = p[0];
@@ -268,13 +309,15 @@ public:
         fail("/accessors/" + std::to_string(index), "index " + std::to_string(i) + " is " + std::to_string(v) +
                                                         ", past the primitive's " + std::to_string(vertices) + " vertices");
       out[i] = v;
-    }
-    return out;
+    });
   }
 
 private:
+  static constexpr std::size_t kBlockBytes = std::size_t(64) << 10;
   const tinygltf::Model& model_;
+  const std::vector<BufferSource>& buffers_;
   std::string where_;
+  mutable std::vector<unsigned char> block_;  // the block of a file being read
 };
 
 glm::dmat4 local_matrix(const tinygltf::Node& node) {
@@ -347,9 +390,9 @@ AddressMode address_of(int wrap) {
 // Turns the asset into one MeshData: every primitive of the drawn nodes, in qdmr's frame.
 class Builder {
 public:
-  Builder(tinygltf::Model& model, const Reading& reading, const fs::path& file, std::string where,
+  Builder(tinygltf::Model& model, Reading& reading, const fs::path& file, std::string where,
           std::uint64_t max_memory_bytes)
-      : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, where_),
+      : model_(model), reading_(reading), file_(file), where_(std::move(where)), asset_(model, reading.buffers, where_),
         max_memory_bytes_(max_memory_bytes) {}
 
   MeshData build(const MeshDesc& desc) {
@@ -357,6 +400,14 @@ public:
     const std::vector<int> roots = drawn_roots(desc);
     check_drawn_size(roots);
     count_buffer_reads(roots);
+    // Every primitive is read straight into the mesh's arrays, reserved once (only the copies of vertices on
+    // mirrored UV seams, which MikkTSpace makes, can grow them). The triangles' materials, written last, grow as
+    // they come: a single primitive's then take the memory MikkTSpace worked in.
+    mesh_.positions.reserve(reserve_vertices_);
+    mesh_.normals.reserve(reserve_vertices_);
+    mesh_.tangents.reserve(reserve_vertices_);
+    mesh_.uvs.reserve(reserve_vertices_);
+    mesh_.indices.reserve(3 * reserve_triangles_);
     for (std::size_t m = 0; m < model_.materials.size(); ++m) materials_.push_back(convert_material(int(m)));
     for (const int root : roots) visit(root, parent_world(root));
     if (mesh_.indices.empty()) throw Error(where_, "no triangles to draw in " + shown_path(file_));
@@ -414,7 +465,8 @@ private:
   // A mesh drawn by several nodes is copied for each: the copies' size, from the accessors' counts (each at most
   // the bytes of its buffer view: a count that lies is refused later, by name), is bounded before anything is read,
   // by the triangle limit, by the memory limit (--max-memory) and by the machine's memory.
-  void check_drawn_size(const std::vector<int>& roots) const {
+  // It also counts the vertices and triangles the mesh will have, if the asset is as it says.
+  void check_drawn_size(const std::vector<int>& roots) {
     const auto count = [&](int accessor) -> std::uint64_t {
       if (accessor < 0 || std::size_t(accessor) >= model_.accessors.size()) return 0;
       const tinygltf::Accessor& a = model_.accessors[std::size_t(accessor)];
@@ -428,6 +480,9 @@ private:
       const std::uint64_t c = prim.indices >= 0 ? count(prim.indices) : v;
       vertices += std::max(v, c);  // flat normals: one vertex per corner
       corners += c;
+      const std::uint64_t triangles = prim.mode == TINYGLTF_MODE_TRIANGLES ? c / 3 : c >= 3 ? c - 2 : 0;
+      reserve_vertices_ += prim.attributes.count("NORMAL") ? v : 3 * triangles;
+      reserve_triangles_ += triangles;
       if (corners / 3 > limits::kMaxTriangles)
         throw Error(where_, "the drawn nodes hold more than " + std::to_string(limits::kMaxTriangles) +
                                 " triangles (a mesh drawn by several nodes counts for each)");
@@ -460,8 +515,7 @@ private:
   }
 
   // How many drawn primitives read each buffer (a mesh drawn by several nodes counts once per node), so that a
-  // buffer is released as soon as the last of them has read it: a large asset's bytes are not held while its
-  // mesh is converted (embedded images were taken while tinygltf read the asset).
+  // buffer in memory is released as soon as the last of them has read it (the materials' images are read before).
   void count_buffer_reads(const std::vector<int>& roots) {
     buffer_reads_.assign(model_.buffers.size(), 0);
     for_each_drawn_primitive(roots, [&](const tinygltf::Primitive& prim) {
@@ -484,11 +538,14 @@ private:
     }
   }
 
+  // A buffer tinygltf holds (a data: URI's) is released once the last drawn primitive has read it.
   void primitive_read(const tinygltf::Primitive& prim) {
     for (const int b : buffers_of(prim))
       if (b >= 0 && std::size_t(b) < buffer_reads_.size() && buffer_reads_[std::size_t(b)] > 0 &&
-          --buffer_reads_[std::size_t(b)] == 0)
+          --buffer_reads_[std::size_t(b)] == 0 && reading_.buffers[std::size_t(b)].memory) {
+        reading_.buffers[std::size_t(b)] = BufferSource{};
         std::vector<unsigned char>().swap(model_.buffers[std::size_t(b)].data);
+      }
   }
 
   std::vector<int> drawn_roots(const MeshDesc& desc) {
@@ -620,166 +677,200 @@ private:
         const auto it = prim.attributes.find(name);
         return it == prim.attributes.end() ? -1 : it->second;
       };
-      const int position_accessor = attribute("POSITION");
-      if (position_accessor < 0) asset_.fail(at + "/attributes", "no POSITION");
-      std::vector<float> positions = asset_.floats(position_accessor, at + "/attributes/POSITION", TINYGLTF_TYPE_VEC3, false);
-      const std::size_t count = positions.size() / 3;
-      const auto same_count = [&](const std::vector<float>& values, int components, const char* name) {
-        if (values.size() / std::size_t(components) != count)
-          asset_.fail(at + "/attributes/" + name, std::to_string(values.size() / std::size_t(components)) +
-                                                     " elements, but POSITION has " + std::to_string(count));
+      Primitive in;
+      in.mode = prim.mode;
+      in.position_accessor = attribute("POSITION");
+      if (in.position_accessor < 0) asset_.fail(at + "/attributes", "no POSITION");
+      in.positions = asset_.float_elements(in.position_accessor, at + "/attributes/POSITION", TINYGLTF_TYPE_VEC3, false);
+      const std::size_t count = in.positions.count;
+      const auto same_count = [&](const Elements& e, const std::string& name) {
+        if (e.count != count)
+          asset_.fail(at + "/attributes/" + name, std::to_string(e.count) + " elements, but POSITION has " + std::to_string(count));
       };
       const int slot = material_slot(prim.material, at);
-      const TextureChoice& uv_choice = slot < int(uv_choices_.size()) ? uv_choices_[std::size_t(slot)] : TextureChoice{};
-      std::vector<float> normals, tangents, uvs;
+      in.uv_choice = slot < int(uv_choices_.size()) ? uv_choices_[std::size_t(slot)] : TextureChoice{};
       if (const int a = attribute("NORMAL"); a >= 0) {
-        normals = asset_.floats(a, at + "/attributes/NORMAL", TINYGLTF_TYPE_VEC3, false);
-        same_count(normals, 3, "NORMAL");
+        in.normal_accessor = a;
+        in.normals = asset_.float_elements(a, at + "/attributes/NORMAL", TINYGLTF_TYPE_VEC3, false);
+        same_count(in.normals, "NORMAL");
         if (const int t = attribute("TANGENT"); t >= 0) {
-          tangents = asset_.floats(t, at + "/attributes/TANGENT", TINYGLTF_TYPE_VEC4, false);
-          same_count(tangents, 4, "TANGENT");
+          in.tangent_accessor = t;
+          in.tangents = asset_.float_elements(t, at + "/attributes/TANGENT", TINYGLTF_TYPE_VEC4, false);
+          same_count(in.tangents, "TANGENT");
         }
       } else {
         note("flat normals generated (a primitive has no NORMAL)");
       }
-      const std::string uv_name = "TEXCOORD_" + std::to_string(uv_choice.tex_coord);
+      const std::string uv_name = "TEXCOORD_" + std::to_string(in.uv_choice.tex_coord);
       if (const int a = attribute(uv_name); a >= 0) {
-        uvs = asset_.floats(a, at + "/attributes/" + uv_name, TINYGLTF_TYPE_VEC2, true);
-        same_count(uvs, 2, uv_name.c_str());
-      } else if (uv_choice.base) {
+        in.uv_accessor = a;
+        in.uvs = asset_.float_elements(a, at + "/attributes/" + uv_name, TINYGLTF_TYPE_VEC2, true);
+        same_count(in.uvs, uv_name);
+      } else if (in.uv_choice.base) {
         asset_.fail(at + "/attributes", "no " + uv_name + ", which the material's textures use");
       }
       for (const auto& [name, accessor] : prim.attributes)
         if (name.starts_with("JOINTS_") || name.starts_with("WEIGHTS_")) note("skinning attributes ignored");
 
-      std::vector<std::uint32_t> corners;
+      in.corners = count;
       if (prim.indices >= 0) {
-        corners = asset_.indices(prim.indices, at + "/indices", count);
+        in.index_accessor = prim.indices;
+        in.indices = asset_.index_elements(prim.indices, at + "/indices");
+        in.corners = in.indices.count;
+      }
+      if (prim.mode == TINYGLTF_MODE_TRIANGLES && in.corners % 3 != 0)
+        asset_.fail(at, std::to_string(in.corners) + " corners are not whole triangles");
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES && in.corners < 3) asset_.fail(at, "a strip or fan needs at least 3 corners");
+      in.triangles = prim.mode == TINYGLTF_MODE_TRIANGLES ? in.corners / 3 : in.corners - 2;
+      check_triangle_count(mesh_.indices.size() / 3 + in.triangles, where_);
+      if (in.normal_accessor >= 0) {
+        add_smooth(in, world, normal_matrix, mirrored, std::uint32_t(slot));
       } else {
-        corners.resize(count);
-        for (std::size_t i = 0; i < count; ++i) corners[i] = std::uint32_t(i);
+        add_flat(in, world, std::uint32_t(slot));
       }
       primitive_read(prim);
-      std::vector<std::uint32_t> triangles = triangle_list(std::move(corners), prim.mode, at);
-      check_triangle_count(mesh_.indices.size() / 3 + triangles.size() / 3, where_);
-      append(std::move(positions), std::move(normals), std::move(tangents), std::move(uvs), uv_choice, std::move(triangles),
-             world, normal_matrix, mirrored, std::uint32_t(slot));
     }
   }
 
-  std::vector<std::uint32_t> triangle_list(std::vector<std::uint32_t> c, int mode, const std::string& at) {
-    std::vector<std::uint32_t> out;
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
-      if (c.size() % 3 != 0) asset_.fail(at, std::to_string(c.size()) + " corners are not whole triangles");
-      return c;
-    }
-    if (c.size() < 3) asset_.fail(at, "a strip or fan needs at least 3 corners");
-    out.reserve((c.size() - 2) * 3);
-    for (std::size_t i = 2; i < c.size(); ++i) {
-      if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
-        out.insert(out.end(), {c[0], c[i - 1], c[i]});
-      } else if (i % 2 == 0) {
-        out.insert(out.end(), {c[i - 2], c[i - 1], c[i]});
-      } else {
-        out.insert(out.end(), {c[i - 1], c[i - 2], c[i]});
-      }
-    }
-    return out;
+  // One primitive's accessors, checked, before they are read.
+  struct Primitive {
+    int mode = TINYGLTF_MODE_TRIANGLES;
+    int position_accessor = -1, normal_accessor = -1, tangent_accessor = -1, uv_accessor = -1, index_accessor = -1;
+    Elements positions, normals, tangents, uvs, indices;
+    TextureChoice uv_choice;
+    std::size_t corners = 0, triangles = 0;
+  };
+
+  // qdmr's UV of a glTF UV: the texture transform, then v up (glTF's v runs down the image, qdmr's up).
+  static glm::vec2 qdmr_uv(glm::dvec2 uv, const TextureChoice& choice, double cosine, double sine) {
+    uv *= choice.scale;
+    if (choice.rotation != 0.0) uv = glm::dvec2(cosine * uv.x - sine * uv.y, sine * uv.x + cosine * uv.y);
+    uv += choice.offset;
+    return glm::vec2(float(uv.x), float(1.0 - uv.y));
   }
 
-  // The attributes as read, each freed once it is converted, so that a large primitive is not held twice.
-  void append(std::vector<float> positions, std::vector<float> normals, std::vector<float> tangents, std::vector<float> uvs,
-              const TextureChoice& uv_choice, std::vector<std::uint32_t> triangles, const glm::dmat4& world,
-              const glm::dmat3& normal_matrix, bool mirrored, std::uint32_t material) {
-    // Without normals each triangle gets its own corners, flat-shaded (glTF 2.0, "Meshes").
-    const bool flat = normals.empty();
-    MeshData part;
-    const std::size_t count = positions.size() / 3;
-    // qdmr's UVs: the texture transform, then v up.
-    std::vector<glm::vec2> uv_of(count);
-    for (std::size_t v = 0; v < count; ++v) {
-      glm::dvec2 uv(0.0);
-      if (!uvs.empty()) uv = glm::dvec2(uvs[2 * v], uvs[2 * v + 1]);
-      uv *= uv_choice.scale;
-      if (uv_choice.rotation != 0.0) {
-        const double c = std::cos(uv_choice.rotation), s = std::sin(uv_choice.rotation);
-        uv = glm::dvec2(c * uv.x - s * uv.y, s * uv.x + c * uv.y);
-      }
-      uv += uv_choice.offset;
-      uv_of[v] = glm::vec2(float(uv.x), float(1.0 - uv.y));  // glTF's v runs down the image, qdmr's up
-    }
-    std::vector<float>().swap(uvs);
-    const auto position = [&](std::size_t v) {
-      return glm::vec3(world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0));
-    };
-    if (flat) {
-      for (std::size_t k = 0; k < triangles.size(); ++k) {
-        part.positions.push_back(position(triangles[k]));
-        part.uvs.push_back(uv_of[triangles[k]]);
-        part.indices.push_back(std::uint32_t(k));
-      }
-      for (std::size_t k = 0; k < triangles.size(); k += 3) {
-        const glm::dvec3 a(part.positions[k]), b(part.positions[k + 1]), c(part.positions[k + 2]);
-        const glm::dvec3 face = glm::cross(b - a, c - a);
-        const double len = glm::length(face);
-        const glm::vec3 n = len > 0.0 && std::isfinite(len) ? glm::vec3(face / len) : glm::vec3(0, 0, 1);
-        part.normals.insert(part.normals.end(), {n, n, n});
-      }
-      // Each corner its own vertex: the per-triangle tangent (what MikkTSpace gives a corner alone), from qdmr's
-      // generator.
-      compute_tangents(part);
-      if (has_textures_) note("tangents generated per flat triangle (a primitive has no NORMAL nor TANGENT)");
-    } else {
-      // Missing tangents: MikkTSpace's, in the mesh's own space as glTF defines them, then transformed as given ones
-      // are. A vertex on a mirrored UV seam is split: copies_of[k] is vertex count + k.
-      MikkTSpaceTangents made;
-      if (tangents.empty()) {
-        made = mikktspace_tangents(positions, normals, uv_of, triangles);
-        if (has_textures_) note("tangents generated (a primitive has no TANGENT; MikkTSpace's essentials: see docs/scene-format.md)");
-      }
-      const std::vector<std::uint32_t>& copies = made.copies_of;
-      const std::size_t vertices = count + copies.size();
-      const auto source = [&](std::size_t v) { return v < count ? v : copies[v - count]; };
-      part.positions.reserve(vertices);
-      for (std::size_t v = 0; v < vertices; ++v) part.positions.push_back(position(source(v)));
-      std::vector<float>().swap(positions);
-      part.normals.reserve(vertices);
-      for (std::size_t v = 0; v < vertices; ++v) {
-        const std::size_t s = source(v);
-        const glm::dvec3 n = normal_matrix * glm::dvec3(normals[3 * s], normals[3 * s + 1], normals[3 * s + 2]);
-        const double len = glm::length(n);
-        part.normals.push_back(len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1));
-      }
-      std::vector<float>().swap(normals);
-      for (const std::uint32_t s : copies) uv_of.push_back(uv_of[s]);
-      part.uvs = std::move(uv_of);
-      // The tangents, given or made, transformed in place.
-      std::vector<glm::vec4> frame = std::move(made.tangents);
-      if (frame.empty()) {
-        frame.resize(vertices);
-        for (std::size_t v = 0; v < vertices; ++v)
-          frame[v] = glm::vec4(tangents[4 * v], tangents[4 * v + 1], tangents[4 * v + 2], tangents[4 * v + 3]);
-        std::vector<float>().swap(tangents);
-      }
-      for (std::size_t v = 0; v < vertices; ++v) {
-        const glm::vec4 t = frame[v];
-        const glm::dvec3 tw = glm::dmat3(world) * glm::dvec3(t);
-        const double tl = glm::length(tw);
-        const float w = (t.w < 0.0f) != mirrored ? -1.0f : 1.0f;
-        frame[v] = glm::vec4(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(part.normals[v]), w);
-      }
-      part.tangents = std::move(frame);
-      part.indices = std::move(triangles);
-    }
-    if (mesh_.positions.empty()) {  // the first primitive (often the only one): moved, not copied
-      mesh_.positions = std::move(part.positions);
-      mesh_.normals = std::move(part.normals);
-      mesh_.tangents = std::move(part.tangents);
-      mesh_.uvs = std::move(part.uvs);
-      mesh_.indices = std::move(part.indices);
-      mesh_.triangle_materials.assign(mesh_.indices.size() / 3, material);
+  void read_uvs(const Primitive& in, glm::vec2* out) const {
+    const double c = std::cos(in.uv_choice.rotation), s = std::sin(in.uv_choice.rotation);
+    if (in.uv_accessor < 0) {
+      std::fill(out, out + in.positions.count, qdmr_uv(glm::dvec2(0.0), in.uv_choice, c, s));
       return;
     }
+    asset_.floats(in.uvs, in.uv_accessor,
+                  [&](std::size_t i, const float* v) { out[i] = qdmr_uv(glm::dvec2(v[0], v[1]), in.uv_choice, c, s); });
+  }
+
+  // The primitive's triangles, 3 corners each (from its indices, else its vertices in order), into `out`.
+  void read_triangles(const Primitive& in, std::uint32_t* out) const {
+    const std::size_t vertices = in.positions.count;
+    const auto corners = [&](std::uint32_t* c) {
+      if (in.index_accessor >= 0) {
+        asset_.indices(in.indices, in.index_accessor, vertices, c);
+      } else {
+        for (std::size_t i = 0; i < vertices; ++i) c[i] = std::uint32_t(i);
+      }
+    };
+    if (in.mode == TINYGLTF_MODE_TRIANGLES) {
+      corners(out);
+      return;
+    }
+    std::vector<std::uint32_t> c(in.corners);
+    corners(c.data());
+    for (std::size_t i = 2; i < c.size(); ++i, out += 3) {
+      if (in.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+        out[0] = c[0], out[1] = c[i - 1], out[2] = c[i];
+      } else if (i % 2 == 0) {
+        out[0] = c[i - 2], out[1] = c[i - 1], out[2] = c[i];
+      } else {
+        out[0] = c[i - 1], out[1] = c[i - 2], out[2] = c[i];
+      }
+    }
+  }
+
+  // A primitive with normals, read straight into the mesh's arrays in its own space (where MikkTSpace makes missing
+  // tangents, as glTF defines them), then moved into qdmr's frame in place.
+  void add_smooth(const Primitive& in, const glm::dmat4& world, const glm::dmat3& normal_matrix, bool mirrored,
+                  std::uint32_t material) {
+    const std::size_t count = in.positions.count, base = mesh_.positions.size(), first = mesh_.indices.size();
+    mesh_.positions.resize(base + count);
+    asset_.floats(in.positions, in.position_accessor,
+                  [&](std::size_t i, const float* v) { mesh_.positions[base + i] = glm::vec3(v[0], v[1], v[2]); });
+    mesh_.normals.resize(base + count);
+    asset_.floats(in.normals, in.normal_accessor,
+                  [&](std::size_t i, const float* v) { mesh_.normals[base + i] = glm::vec3(v[0], v[1], v[2]); });
+    mesh_.uvs.resize(base + count);
+    read_uvs(in, mesh_.uvs.data() + base);
+    mesh_.tangents.resize(base + count);
+    if (in.tangent_accessor >= 0)
+      asset_.floats(in.tangents, in.tangent_accessor,
+                    [&](std::size_t i, const float* v) { mesh_.tangents[base + i] = glm::vec4(v[0], v[1], v[2], v[3]); });
+    mesh_.indices.resize(first + 3 * in.triangles);
+    read_triangles(in, mesh_.indices.data() + first);
+    if (in.tangent_accessor < 0) {
+      // Missing tangents: MikkTSpace's. A vertex on a mirrored UV seam is split: copy k is vertex count + k.
+      const std::span<std::uint32_t> triangles(mesh_.indices.data() + first, 3 * in.triangles);
+      const MikkTSpaceCopies copies =
+          mikktspace_tangents({mesh_.positions.data() + base, count}, {mesh_.normals.data() + base, count},
+                              {mesh_.uvs.data() + base, count}, triangles, {mesh_.tangents.data() + base, count});
+      if (has_textures_) note("tangents generated (a primitive has no TANGENT; MikkTSpace's essentials: see docs/scene-format.md)");
+      if (!copies.of.empty()) {
+        const std::size_t grown = base + count + copies.of.size();
+        for (auto* v : {&mesh_.positions, &mesh_.normals}) v->reserve(std::max(v->capacity(), grown));
+        mesh_.uvs.reserve(std::max(mesh_.uvs.capacity(), grown));
+        mesh_.tangents.reserve(std::max(mesh_.tangents.capacity(), grown));
+        for (const std::uint32_t s : copies.of) {
+          mesh_.positions.push_back(mesh_.positions[base + s]);
+          mesh_.normals.push_back(mesh_.normals[base + s]);
+          mesh_.uvs.push_back(mesh_.uvs[base + s]);
+        }
+        mesh_.tangents.insert(mesh_.tangents.end(), copies.tangents.begin(), copies.tangents.end());
+      }
+    }
+    // Into qdmr's frame, each vertex alone (the same bits in any order).
+    const glm::dmat3 linear(world);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(base, mesh_.positions.size(), 16384), [&](const auto& range) {
+      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+        mesh_.positions[v] = glm::vec3(world * glm::dvec4(glm::dvec3(mesh_.positions[v]), 1.0));
+        const glm::dvec3 n = normal_matrix * glm::dvec3(mesh_.normals[v]);
+        const double len = glm::length(n);
+        mesh_.normals[v] = len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1);
+        const glm::vec4 t = mesh_.tangents[v];
+        const glm::dvec3 tw = linear * glm::dvec3(t);
+        const double tl = glm::length(tw);
+        const float w = (t.w < 0.0f) != mirrored ? -1.0f : 1.0f;
+        mesh_.tangents[v] = glm::vec4(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(mesh_.normals[v]), w);
+      }
+    });
+    if (base > 0)
+      for (std::size_t i = first; i < mesh_.indices.size(); ++i) mesh_.indices[i] += std::uint32_t(base);
+    mesh_.triangle_materials.resize(mesh_.triangle_materials.size() + in.triangles, material);
+  }
+
+  // A primitive without normals: each triangle gets its own corners, flat-shaded (glTF 2.0, "Meshes"), with the
+  // per-triangle tangent (what MikkTSpace gives a corner alone) from qdmr's generator.
+  void add_flat(const Primitive& in, const glm::dmat4& world, std::uint32_t material) {
+    const std::size_t count = in.positions.count;
+    std::vector<glm::vec3> positions(count);
+    asset_.floats(in.positions, in.position_accessor,
+                  [&](std::size_t i, const float* v) { positions[i] = glm::vec3(v[0], v[1], v[2]); });
+    std::vector<glm::vec2> uvs(count);
+    read_uvs(in, uvs.data());
+    std::vector<std::uint32_t> triangles(3 * in.triangles);
+    read_triangles(in, triangles.data());
+    MeshData part;
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+      part.positions.push_back(glm::vec3(world * glm::dvec4(glm::dvec3(positions[triangles[k]]), 1.0)));
+      part.uvs.push_back(uvs[triangles[k]]);
+      part.indices.push_back(std::uint32_t(k));
+    }
+    for (std::size_t k = 0; k < triangles.size(); k += 3) {
+      const glm::dvec3 a(part.positions[k]), b(part.positions[k + 1]), c(part.positions[k + 2]);
+      const glm::dvec3 face = glm::cross(b - a, c - a);
+      const double len = glm::length(face);
+      const glm::vec3 n = len > 0.0 && std::isfinite(len) ? glm::vec3(face / len) : glm::vec3(0, 0, 1);
+      part.normals.insert(part.normals.end(), {n, n, n});
+    }
+    compute_tangents(part);
+    if (has_textures_) note("tangents generated per flat triangle (a primitive has no NORMAL nor TANGENT)");
     const auto base = std::uint32_t(mesh_.positions.size());
     mesh_.positions.insert(mesh_.positions.end(), part.positions.begin(), part.positions.end());
     mesh_.normals.insert(mesh_.normals.end(), part.normals.begin(), part.normals.end());
@@ -826,6 +917,12 @@ private:
       const auto relative = relative_uri(image.uri, image_at);
       if (!relative) throw Error(image_at, "a data: URI that is not base64 data of a known media type");
       file = (reading_.folder / *relative).lexically_normal();
+    } else if (const auto view = reading_.image_views.find(source); view != reading_.image_views.end()) {
+      // In a buffer view (checked when the asset was read).
+      const tinygltf::BufferView& v = model_.bufferViews[std::size_t(view->second)];
+      std::string bytes(v.byteLength, '\0');
+      Asset::read(reading_.buffers[std::size_t(v.buffer)], v.byteOffset, bytes.size(), reinterpret_cast<unsigned char*>(bytes.data()));
+      file = store_embedded_image(bytes, image_at);
     } else {
       if (std::size_t(source) >= reading_.embedded.size() || reading_.embedded[std::size_t(source)].empty())
         throw Error(image_at, "the image has no data");
@@ -926,7 +1023,7 @@ private:
   }
 
   tinygltf::Model& model_;  // its buffers are released once no drawn primitive reads them
-  const Reading& reading_;
+  Reading& reading_;
   fs::path file_;
   std::string where_;
   Asset asset_;
@@ -936,6 +1033,7 @@ private:
   std::map<int, fs::path> image_files_;
   std::uint64_t max_memory_bytes_ = 0;
   std::vector<std::size_t> buffer_reads_;  // per buffer: the drawn primitives that have yet to read it
+  std::uint64_t reserve_vertices_ = 0, reserve_triangles_ = 0;  // check_drawn_size's count
   int default_material_ = -1;
   bool has_textures_ = false;
   std::vector<std::pair<std::string, int>> notes_;
@@ -944,8 +1042,7 @@ private:
 
 // What the document says before tinygltf reads it: the URIs it names (checked), the extensions it requires
 // (refused unless qdmr reads them), and what qdmr ignores (the plan's notes).
-std::vector<std::string> prescan(const std::string& json_text, Reading& reading) {
-  nlohmann::json doc;
+std::vector<std::string> prescan(const std::string& json_text, Reading& reading, nlohmann::json& doc) {
   try {
     doc = scene_detail::parse_json_bounded(json_text);
   } catch (const Error& e) {
@@ -982,38 +1079,127 @@ std::vector<std::string> prescan(const std::string& json_text, Reading& reading)
   return notes;
 }
 
+// Takes the buffers whose bytes are in files (the .glb's BIN chunk, a .bin beside the asset) out of tinygltf's
+// hands: each becomes a one-byte data: URI in the document, and its place in its file is kept in
+// reading.buffers, so the accessors are read from the file straight into the mesh. Images in buffer views are
+// kept out likewise (reading.image_views). Returns the document for tinygltf, or "" when nothing was changed.
+// What tinygltf would refuse anyway (a byteLength that is not a count, a uri that is not a string in a .gltf) is
+// left to it.
+std::string stand_in_buffers(nlohmann::json& doc, Reading& reading, const fs::path& file, const GlbChunks* glb) {
+  bool changed = false;
+  if (const auto it = doc.find("buffers"); it != doc.end() && it->is_array()) {
+    reading.buffers.resize(it->size());
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      nlohmann::json& item = (*it)[i];
+      if (!item.is_object() || !item.contains("byteLength") || !item["byteLength"].is_number_unsigned()) continue;
+      const std::uint64_t length = item["byteLength"].get<std::uint64_t>();
+      const std::string at = reading.where + ": /buffers/" + std::to_string(i);
+      const bool has_uri = item.contains("uri") && item["uri"].is_string();
+      BufferSource& source = reading.buffers[i];
+      if (has_uri) {
+        const auto relative = relative_uri(item["uri"].get_ref<const std::string&>(), at + "/uri");
+        if (!relative) continue;  // data: tinygltf decodes it
+        const fs::path path = (reading.folder / *relative).lexically_normal();
+        if (!inside(reading, path)) throw Error(at + "/uri", "refused to read " + shown_path(path) + ": outside the asset's folder");
+        auto& open = reading.files[path];
+        if (!open) open = std::make_unique<InputFile>(path, at + "/uri", InputKind::GltfBuffer);
+        if (open->size() != length)
+          throw Error(at + "/byteLength", std::to_string(length) + " bytes, but " + shown_path(path) + " has " +
+                                              std::to_string(open->size()));
+        source = BufferSource{length, open.get(), 0, nullptr};
+      } else if (glb) {
+        // A .glb's buffer without a uri is its BIN chunk.
+        if (!glb->has_bin) throw Error(at, "a buffer without a uri is the .glb's BIN chunk, and this .glb has none");
+        if (length > glb->bin_length)
+          throw Error(at + "/byteLength", std::to_string(length) + " bytes, more than the .glb's BIN chunk (" +
+                                              std::to_string(glb->bin_length) + " bytes)");
+        source = BufferSource{length, reading.files.at(file).get(), glb->bin_offset, nullptr};
+      } else {
+        continue;
+      }
+      item["uri"] = "data:application/octet-stream;base64,AA==";
+      item["byteLength"] = 1;
+      changed = true;
+    }
+  }
+  if (const auto it = doc.find("images"); it != doc.end() && it->is_array())
+    for (std::size_t i = 0; i < it->size(); ++i) {
+      nlohmann::json& item = (*it)[i];
+      if (!item.is_object() || item.contains("uri") || !item.contains("bufferView") || !item["bufferView"].is_number_integer() ||
+          item["bufferView"].get<std::int64_t>() < 0 || item["bufferView"].get<std::int64_t>() > std::numeric_limits<int>::max())
+        continue;
+      reading.image_views[int(i)] = item["bufferView"].get<int>();
+      item["bufferView"] = -1;  // tinygltf then hands over no bytes
+      changed = true;
+    }
+  return changed ? doc.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) : "";
+}
+
+// The images in buffer views, checked as tinygltf would hand them over: their view and its buffer exist, and the
+// view fits its buffer.
+void check_image_views(const tinygltf::Model& model, const Reading& reading) {
+  for (const auto& [image, view] : reading.image_views) {
+    const std::string at = reading.where + ": /images/" + std::to_string(image);
+    if (std::size_t(view) >= model.bufferViews.size())
+      throw Error(at, "names buffer view " + std::to_string(view) + ", which does not exist");
+    const tinygltf::BufferView& v = model.bufferViews[std::size_t(view)];
+    if (v.buffer < 0 || std::size_t(v.buffer) >= reading.buffers.size())
+      throw Error(at, "its buffer view names a buffer that does not exist");
+    const std::uint64_t size = reading.buffers[std::size_t(v.buffer)].size;
+    if (v.byteOffset > size || v.byteLength > size - v.byteOffset) throw Error(at, "its buffer view runs past the end of its buffer");
+    if (v.byteLength == 0) throw Error(at, "the image is empty");
+  }
+}
+
 }  // namespace
 
 MeshData load_gltf(const MeshDesc& desc, const std::string& where, std::uint64_t max_memory_bytes) {
   const fs::path file = fs::absolute(desc.file).lexically_normal();
-  std::string bytes = read_input_file(file, where, InputKind::Gltf);
   Reading reading;
   reading.folder = file.parent_path();
   reading.where = where.empty() ? shown_path(file) : where + ": " + shown_path(file);
-  const bool binary = looks_like_glb(bytes);
-  std::vector<std::string> notes = prescan(binary ? std::string(glb_json_chunk(bytes, reading.where)) : bytes, reading);
+  // The asset is read in parts: a .glb's JSON chunk now, its BIN chunk an accessor at a time while the mesh is
+  // built; a .gltf's text whole.
+  const InputFile& asset = *(reading.files[file] = std::make_unique<InputFile>(file, where, InputKind::Gltf));
+  const bool binary = looks_like_glb(asset.read(0, std::size_t(std::min<std::uint64_t>(asset.size(), 4))));
+  GlbChunks glb;
+  std::string text;
+  if (binary) {
+    glb = glb_chunks(asset.size(), [&](std::uint64_t at, std::size_t n) { return asset.read(at, n); }, reading.where);
+    text = asset.read(glb.json_offset, std::size_t(glb.json_length));
+  } else {
+    text = asset.read(0, std::size_t(asset.size()));
+  }
+  std::vector<std::string> notes;
+  {
+    nlohmann::json doc;
+    notes = prescan(text, reading, doc);
+    if (std::string changed = stand_in_buffers(doc, reading, file, binary ? &glb : nullptr); !changed.empty()) text = std::move(changed);
+  }
 
   tinygltf::Model model;
-  reading.model = &model;
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&file_exists, &expand_file_path, &read_whole_file, &write_whole_file, &reading});
   loader.SetImageLoader(&keep_image, &reading);
   std::string err, warn;
   bool ok = false;
   try {
-    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
-                                              unsigned(bytes.size()), reading.folder.string())
-                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), reading.folder.string());
+    ok = loader.LoadASCIIFromString(&model, &err, &warn, text.data(), unsigned(text.size()), reading.folder.string());
   } catch (const std::exception& e) {
     throw Error(reading.where, std::string("tinygltf: ") + e.what());
   }
-  std::string().swap(bytes);  // tinygltf holds its own copy of every buffer: the file is no longer needed
+  std::string().swap(text);
   if (!reading.error.empty()) throw Error(reading.error, reading.error_kind);
   if (!ok || !err.empty()) {
     std::string first = err.substr(0, err.find('\n'));
     if (first.empty()) first = "tinygltf could not read the asset";
     throw Error(reading.where, first);
   }
+  // The buffers tinygltf holds (data: URIs) are read from it.
+  reading.buffers.resize(model.buffers.size());
+  for (std::size_t b = 0; b < model.buffers.size(); ++b)
+    if (!reading.buffers[b].file) reading.buffers[b] = BufferSource{model.buffers[b].data.size(), nullptr, 0, model.buffers[b].data.data()};
+  check_image_views(model, reading);
   MeshData mesh = Builder(model, reading, file, reading.where, max_memory_bytes).build(desc);
   notes.insert(notes.end(), mesh.notes.begin(), mesh.notes.end());
   mesh.notes = std::move(notes);

@@ -57,30 +57,33 @@ std::optional<std::filesystem::path> relative_uri(std::string_view uri, const st
 
 bool looks_like_glb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
 
-std::string_view glb_json_chunk(std::string_view bytes, const std::string& where) {
-  if (bytes.size() < 20) throw Error(where, "a .glb file needs a 12-byte header and a chunk; it has " + std::to_string(bytes.size()) + " bytes");
-  if (!looks_like_glb(bytes)) throw Error(where, "not a .glb file (its first bytes are not 'glTF')");
-  if (const std::uint32_t version = le32(bytes, 4); version != 2)
+GlbChunks glb_chunks(std::uint64_t size, const std::function<std::string(std::uint64_t, std::size_t)>& read,
+                     const std::string& where) {
+  if (size < 20) throw Error(where, "a .glb file needs a 12-byte header and a chunk; it has " + std::to_string(size) + " bytes");
+  const std::string header = read(0, 12);
+  if (!looks_like_glb(header)) throw Error(where, "not a .glb file (its first bytes are not 'glTF')");
+  if (const std::uint32_t version = le32(header, 4); version != 2)
     throw Error(where, ".glb header: version " + std::to_string(version) + " (qdmr reads glTF 2)");
-  if (const std::uint32_t length = le32(bytes, 8); length != bytes.size())
-    throw Error(where, ".glb header: length " + std::to_string(length) + " but the file has " +
-                           std::to_string(bytes.size()) + " bytes");
-  std::string_view json;
-  std::size_t at = 12;
-  for (int chunk = 0; at < bytes.size(); ++chunk) {
+  if (const std::uint32_t length = le32(header, 8); length != size)
+    throw Error(where, ".glb header: length " + std::to_string(length) + " but the file has " + std::to_string(size) + " bytes");
+  GlbChunks chunks;
+  std::uint64_t at = 12;
+  for (int chunk = 0; at < size; ++chunk) {
     const std::string name = ".glb chunk " + std::to_string(chunk);
-    if (bytes.size() - at < 8) throw Error(where, name + ": a chunk header needs 8 bytes, " + std::to_string(bytes.size() - at) + " are left");
-    const std::uint64_t length = le32(bytes, at), type = le32(bytes, at + 4);
-    if (length > bytes.size() - at - 8)
+    if (size - at < 8) throw Error(where, name + ": a chunk header needs 8 bytes, " + std::to_string(size - at) + " are left");
+    const std::string chunk_header = read(at, 8);
+    const std::uint64_t length = le32(chunk_header, 0), type = le32(chunk_header, 4);
+    if (length > size - at - 8)
       throw Error(where, name + ": length " + std::to_string(length) + " runs past the end of the file (" +
-                             std::to_string(bytes.size() - at - 8) + " bytes are left)");
+                             std::to_string(size - at - 8) + " bytes are left)");
     if (length % 4 != 0) throw Error(where, name + ": length " + std::to_string(length) + " is not a multiple of 4");
     if (chunk == 0 && type != kChunkJson) throw Error(where, name + ": the first chunk must be JSON");
     if (chunk == 1 && type != kChunkBin) throw Error(where, name + ": the second chunk must be BIN");
-    if (chunk == 0) json = bytes.substr(at + 8, length);
+    if (chunk == 0) chunks.json_offset = at + 8, chunks.json_length = length;
+    if (chunk == 1) chunks.has_bin = true, chunks.bin_offset = at + 8, chunks.bin_length = length;
     at += 8 + length;
   }
-  return json;
+  return chunks;
 }
 
 }  // namespace qdmr::mesh_detail

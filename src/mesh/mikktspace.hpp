@@ -15,22 +15,30 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 namespace qdmr::mesh_detail {
 
-struct MikkTSpaceTangents {
-  std::vector<glm::vec4> tangents;        // per vertex, then per appended copy: xyz unit, w = +-1
-  std::vector<std::uint32_t> copies_of;   // per appended copy, the vertex it copies
+// The vertices a mirrored UV seam splits: copy k of a mesh of n vertices is vertex n + k, a copy of vertex of[k]
+// with the tangent tangents[k].
+struct MikkTSpaceCopies {
+  std::vector<std::uint32_t> of;
+  std::vector<glm::vec4> tangents;
 };
 
-// positions and normals: 3 floats per vertex (normals need not be unit length), uvs one per vertex (qdmr's: v up),
-// `indices` 3 per triangle, rewritten where a corner moves to a copy of its vertex.
-MikkTSpaceTangents mikktspace_tangents(const std::vector<float>& positions, const std::vector<float>& normals,
-                                       const std::vector<glm::vec2>& uvs, std::vector<std::uint32_t>& indices);
+// positions and normals per vertex (normals need not be unit length), uvs one per vertex (qdmr's: v up),
+// `indices` 3 per triangle, rewritten where a corner moves to a copy of its vertex; `tangents` (one per vertex) is
+// written. The work over triangles runs on threads, each summing the corners of its own vertices in triangle
+// order: the same bits for any thread count. Working memory beside the result: 4 bytes a vertex (its kind), 6
+// more while welding (a hash table), 1 (flags); where UVs are mirrored 16 more (the mirrored sums, the copies).
+MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                                     std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
+                                     std::span<glm::vec4> tangents);
 
 // acos from +, *, / and sqrt only (Cephes' asinf polynomial, in double): the same bits on every machine, where
 // libm's acos may take an FMA variant on some CPUs. Accurate to about 1e-7; x is clamped to [-1, 1].

@@ -1,9 +1,11 @@
 // file/input_file.hpp: a regular file is read whole and byte for byte, whatever its size relative to the read
 // buffers (the size fstat gives, then a 4 KiB probe for more); what is not a regular file, or is empty, is refused
-// before anything is read; every file checked is remembered as an input of the job.
+// before anything is read; every file checked is remembered as an input of the job; a file held open is read in
+// parts.
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <fstream>
@@ -61,6 +63,27 @@ TEST(InputFile, RefusesEmptyFilesFifosAndDirectoriesByName) {
   EXPECT_NE(error_of(fifo).find("is a FIFO"), std::string::npos) << error_of(fifo);
   EXPECT_NE(error_of(dir.path()).find("is a directory"), std::string::npos) << error_of(dir.path());
   EXPECT_NE(error_of(dir.path() / "missing.obj").find("file not found"), std::string::npos);
+}
+
+TEST(InputFile, ReadsPartsAndNamesAFileThatShrank) {
+  TempDir dir;
+  const fs::path file = dir.path() / "model.glb";
+  const std::string bytes = pattern(100000);
+  write_bytes(file, bytes);
+  const InputFile open(file, "test", InputKind::Gltf);
+  EXPECT_EQ(open.size(), bytes.size());
+  EXPECT_EQ(open.read(70000, 30000), bytes.substr(70000));
+  EXPECT_EQ(open.read(3, 5), bytes.substr(3, 5));
+  // The file loses its end after it was opened: the missing bytes are an error, not zeros.
+  ASSERT_EQ(::truncate(file.c_str(), 50000), 0);
+  try {
+    open.read(40000, 20000);
+    ADD_FAILURE() << "read past the end";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ended at byte 50000"), std::string::npos) << e.what();
+  }
+  write_bytes(dir.path() / "empty.glb", "");
+  EXPECT_THROW(InputFile(dir.path() / "empty.glb", "test", InputKind::Gltf), Error);
 }
 
 TEST(InputFile, RemembersWhatItReadAsAnInputOfTheJob) {

@@ -318,7 +318,8 @@ TEST(Gltf, InstancesAreCountedAgainstTheMemoryLimit) {
 
 std::string glb_error(std::string bytes) {
   try {
-    static_cast<void>(mesh_detail::glb_json_chunk(bytes, "a.glb"));
+    static_cast<void>(mesh_detail::glb_chunks(
+        bytes.size(), [&](std::uint64_t at, std::size_t n) { return bytes.substr(std::size_t(at), n); }, "a.glb"));
   } catch (const Error& e) {
     return e.what();
   }
@@ -330,6 +331,13 @@ void put32(std::string& s, std::size_t at, std::uint32_t v) { std::memcpy(s.data
 TEST(Gltf, GlbChunkLengthsThatLieAreRefused) {
   const std::string good = test::read_file(asset("quad.glb"));
   EXPECT_EQ(glb_error(good), "no error");
+  // Where the chunks are: the JSON right after the two headers, the BIN after the JSON and its own header.
+  const mesh_detail::GlbChunks chunks = mesh_detail::glb_chunks(
+      good.size(), [&](std::uint64_t at, std::size_t n) { return good.substr(std::size_t(at), n); }, "a.glb");
+  EXPECT_EQ(chunks.json_offset, 20u);
+  EXPECT_TRUE(chunks.has_bin);
+  EXPECT_EQ(chunks.bin_offset, 20 + chunks.json_length + 8);
+  EXPECT_EQ(chunks.bin_offset + chunks.bin_length, good.size());
   std::string s = good;
   put32(s, 8, std::uint32_t(good.size() + 4));
   EXPECT_NE(glb_error(s).find(".glb header: length"), std::string::npos) << glb_error(s);
