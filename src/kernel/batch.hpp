@@ -28,39 +28,37 @@ struct ShadeOutput {
   // view axis for the depth AOV); the rasterizer then tests it again before writing (a late depth test).
   bool writes_depth = false;
   // The lane-iterations the SIMD loops executed for this batch where its lanes ran packed with other batches'
-  // (ShadingProgram::shade_group; each packed batch counted once, with one of its batches); -1: the batch ran as
+  // (ShadingProgram::shade of a group; each packed batch counted once, with one of its batches); -1: the batch ran as
   // itself, its longest lane's iterations times the lanes.
   int executed_lane_iterations = -1;
   simd::Float depth, view_depth;
 };
 
-// The most batches a program's group (ShadingProgram::shade_group) may hold.
+// The most batches a program's group (ShadingProgram::shade) may hold.
 inline constexpr int kMaxGroupBatches = 8;
+
+// How many batches a program shades at once: up to `batches` that write no pixel in common, with at most `lanes`
+// covered lanes in all. A program that gains from interleaving batches (its loops wait on their own fetches, or
+// its stages are chains of dependent operations the core can overlap with another batch's) asks for two; one that
+// packs sparse batches' covered lanes into fewer asks for more. The rasterizer then hands it groups, except while
+// the texture-cache recorder listens (it attributes fetches to the batch in flight).
+struct BatchGrouping {
+  int batches = 1;  // 1 .. kMaxGroupBatches
+  int lanes = simd::kLanes;
+};
 
 class ShadingProgram : public Program {
 public:
   using Program::Program;
-  virtual void shade(const Fragments& in, ShadeOutput& out) const = 0;
-  // Two batches that write no pixel in common, at once, with the same results as shade() of each. A program
-  // that gains from interleaving the two (its loops wait on their own fetches, or its stages are chains of
-  // dependent operations the core can overlap with the other batch's) says so in pairs_batches(); the rasterizer
-  // then hands it batches in pairs, except while the texture-cache recorder listens (it attributes fetches to the
-  // batch in flight).
-  virtual void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const {
-    shade(a, out_a);
-    shade(b, out_b);
+  virtual BatchGrouping grouping() const { return {}; }
+  // Batches in[0 .. n-1] into out[0 .. n-1], 1 <= n <= grouping().batches, each with the same results as alone.
+  virtual void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const = 0;
+  // One batch: a group of one.
+  void shade_one(const Fragments& in, ShadeOutput& out) const {
+    const Fragments* const one_in[1] = {&in};
+    ShadeOutput* const one_out[1] = {&out};
+    shade(one_in, one_out, 1);
   }
-  virtual bool pairs_batches() const { return false; }
-  // Up to group_batches() batches (of a pairs_batches() program) that write no pixel in common, with at most
-  // group_lanes() covered lanes in all, at once, with the same results as shade() of each: a program that packs
-  // sparse batches' covered lanes into fewer batches asks for more than a pair. By default, in pairs.
-  virtual void shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-    int k = 0;
-    for (; k + 1 < n; k += 2) shade_pair(*in[k], *out[k], *in[k + 1], *out[k + 1]);
-    if (k < n) shade(*in[k], *out[k]);
-  }
-  virtual int group_batches() const { return 2; }  // at most kMaxGroupBatches
-  virtual int group_lanes() const { return 2 * simd::kLanes; }
 };
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

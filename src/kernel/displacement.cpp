@@ -464,15 +464,13 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
                shadows ? visibility : nullptr, key_.lighting, lighting_, lights_, out.color);
 }
 
-void DisplacementProgram::shade(const Fragments& in, ShadeOutput& out) const { (this->*shade_)(in, out); }
-
-void DisplacementProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
-                                     ShadeOutput& out_b) const {
-  (this->*shade_pair_)(a, out_a, b, out_b);
-}
-
-void DisplacementProgram::shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  (this->*shade_group_)(in, out, n);
+void DisplacementProgram::shade(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  if (n == 1)
+    (this->*shade_)(*in[0], *out[0]);
+  else if (n == 2)
+    (this->*shade_pair_)(*in[0], *out[0], *in[1], *out[1]);
+  else
+    (this->*shade_group_)(in, out, n);
 }
 
 // A blend's sparse batches are packed into fewer (shade_compacted): up to eight at once, with at most four
@@ -480,18 +478,16 @@ void DisplacementProgram::shade_group(const Fragments* const* in, ShadeOutput* c
 // packed batches: docs/performance-history.md).
 static_assert(simd::LaneCompaction::kMaxBatches <= kMaxGroupBatches);
 
-int DisplacementProgram::group_batches() const {
-  return pairs_batches() && layers_.size() > 1 ? simd::LaneCompaction::kMaxBatches : ShadingProgram::group_batches();
-}
-
-int DisplacementProgram::group_lanes() const {
-  return pairs_batches() && layers_.size() > 1 ? 4 * simd::kLanes : ShadingProgram::group_lanes();
+BatchGrouping DisplacementProgram::grouping() const {
+  if (!pairs_technique(key_.trace.technique)) return {};
+  if (layers_.size() > 1) return {simd::LaneCompaction::kMaxBatches, 4 * simd::kLanes};
+  return {2, 2 * simd::kLanes};
 }
 
 // QDM, relief and POM over a blend: shade_group_variant() of the two. Single-layer QDM, relief and POM: both
 // batches set up and traced (QDM's walks interleaved), then the surface at each hit and its lighting, stage by
 // stage, each batch's chains of dependent operations beside the other's. Any other program shades one batch after
-// the other (pairs_batches() is false for them; this is the fallback).
+// the other (their grouping() is one batch; this is the fallback).
 template <class V>
 void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                              ShadeOutput& out_b) const {
@@ -523,7 +519,7 @@ void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& ou
 
 // QDM, relief and POM over a blend: n batches whose covered lanes fit fewer run as those (shade_compacted); else
 // each is traced over its own blended surface, two at a time (QDM's walks interleaved), and its hits shaded. Any
-// other program: ShadingProgram's pairs.
+// other program: in pairs.
 template <class V>
 void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const {
   if constexpr (pairs_technique(V::technique)) {
@@ -545,7 +541,9 @@ void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeO
       return;
     }
   }
-  ShadingProgram::shade_group(in, out, n);
+  int k = 0;
+  for (; k + 1 < n; k += 2) shade_pair_variant<V>(*in[k], *out[k], *in[k + 1], *out[k + 1]);
+  if (k < n) shade_variant<V>(*in[k], *out[k]);
 }
 
 // Two batches' QDM walks to their ends, a step of each per round: their hits on the box surface.
@@ -692,7 +690,6 @@ void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, c
   }
 }
 
-bool DisplacementProgram::pairs_batches() const { return pairs_technique(key_.trace.technique); }
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
   const Float& u = in.varyings[kU];

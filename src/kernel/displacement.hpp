@@ -39,12 +39,9 @@ class DisplacementProgram final : public ShadingProgram {
 public:
   DisplacementProgram(const DisplacementInputs& inputs, const ProgramKey& key, const ProgramParams& params,
                       const LightRig& lights);
-  void shade(const Fragments& in, ShadeOutput& out) const override;
-  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
-  bool pairs_batches() const override;
-  void shade_group(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
-  int group_batches() const override;
-  int group_lanes() const override;
+  // QDM, relief and POM take pairs (blends: up to LaneCompaction::kMaxBatches sparse batches); the others one.
+  BatchGrouping grouping() const override;
+  void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
 
   using Ray = trace::Ray;
   using Hit = trace::Hit;

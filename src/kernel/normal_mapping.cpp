@@ -93,7 +93,13 @@ void NormalMappingProgram::light(const Fragments& in, const Samples& s, const Ta
   out.hit_v = in.varyings[kV];
 }
 
-void NormalMappingProgram::shade(const Fragments& in, ShadeOutput& out) const {
+void NormalMappingProgram::shade(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  int k = 0;
+  for (; k + 1 < n; k += 2) shade_pair(*in[k], *out[k], *in[k + 1], *out[k + 1]);
+  if (k < n) shade_batch(*in[k], *out[k]);
+}
+
+void NormalMappingProgram::shade_batch(const Fragments& in, ShadeOutput& out) const {
   Samples s;
   const UvDerivatives d = derivatives(in);
   sample(in, d, albedo_lod(d), s);

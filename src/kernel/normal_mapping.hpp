@@ -20,11 +20,13 @@ public:
       : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling), twin_texels),
         lod_mode_(sampling.lod), lighting_model_(lighting_model), lighting_(lighting), specular_(specular),
         lights_(lights) {}
-  void shade(const Fragments& in, ShadeOutput& out) const override;
-  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const override;
-  bool pairs_batches() const override { return true; }
+  BatchGrouping grouping() const override { return {2, 2 * simd::kLanes}; }
+  void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
 
 private:
+  void shade_batch(const Fragments& in, ShadeOutput& out) const;
+  // Two batches, stage by stage side by side (the same results as shade_batch of each).
+  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   struct Samples;
   shading::UvDerivatives derivatives(const Fragments& in) const;
   bool magnified(const shading::UvDerivatives& d) const;

@@ -286,25 +286,25 @@ private:
     slots_[packing_].pass = 0;
   }
 
-  // A batch ready to shade: now, or held back for a group (a pair, or more: ShadingProgram::shade_group) when the
+  // A batch ready to shade: now, or held back for a group (a pair, or more: ShadingProgram::grouping) when the
   // program shades batches together.
   void ready(int slot) {
     PendingBatch& p = slots_[slot];
-    if (recorder_ == nullptr && p.program->pairs_batches()) {
+    if (recorder_ == nullptr && p.program != grouping_of_) {  // asked once per program, not per batch
+      grouping_of_ = p.program;
+      grouping_ = p.program->grouping();
+      grouping_.batches = std::min(grouping_.batches, kMaxGroupBatches);
+    }
+    if (recorder_ == nullptr && grouping_.batches > 1) {
       // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one
       // of its pixels is tested), so a later one's early depth test may run before an earlier one's write.
-      if (p.program != grouping_of_) {  // asked once per program, not per batch
-        grouping_of_ = p.program;
-        group_batches_ = std::min(p.program->group_batches(), kMaxGroupBatches);
-        group_lanes_ = p.program->group_lanes();
-      }
       const int lanes = std::popcount(p.pass);
-      if (held_count_ > 0 && (slots_[held_[0]].program != p.program || held_lanes_ + lanes > group_lanes_))
+      if (held_count_ > 0 && (slots_[held_[0]].program != p.program || held_lanes_ + lanes > grouping_.lanes))
         shade_held();
       held_[held_count_++] = slot;
       held_slots_ |= 1u << slot;
       held_lanes_ += lanes;
-      if (held_count_ >= group_batches_) shade_held();
+      if (held_count_ >= grouping_.batches) shade_held();
       return;
     }
     ShadeOutput out;
@@ -319,10 +319,10 @@ private:
         lane_y[l] = p.lane_pixel_y(l);
       }
       recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
-      p.program->shade(p.in, out);
+      p.program->shade_one(p.in, out);
       recorder_->end_batch();
     } else {
-      p.program->shade(p.in, out);
+      p.program->shade_one(p.in, out);
     }
     finish(p, out);
   }
@@ -335,9 +335,11 @@ private:
       ShadeOutput out[2];
       PendingBatch& first = slots_[held_[0]];
       if (held_count_ == 1) {
-        program.shade(first.in, out[0]);
+        program.shade_one(first.in, out[0]);
       } else {
-        program.shade_pair(first.in, out[0], slots_[held_[1]].in, out[1]);
+        const Fragments* const in[2] = {&first.in, &slots_[held_[1]].in};
+        ShadeOutput* const out_of[2] = {&out[0], &out[1]};
+        program.shade(in, out_of, 2);
       }
       finish(first, out[0]);
       if (held_count_ == 2) finish(slots_[held_[1]], out[1]);
@@ -358,7 +360,7 @@ private:
       in[k] = &slots_[held_[k]].in;
       out_of[k] = &out[k];
     }
-    program.shade_group(in, out_of, held_count_);
+    program.shade(in, out_of, held_count_);
     for (int k = 0; k < held_count_; ++k) finish(slots_[held_[k]], out[k]);
   }
 
@@ -564,8 +566,8 @@ private:
   PendingBatch slots_[kMaxGroupBatches + 2];
   int held_[kMaxGroupBatches] = {};
   int held_count_ = 0, held_lanes_ = 0;
-  const ShadingProgram* grouping_of_ = nullptr;  // the program group_batches_ and group_lanes_ are of
-  int group_batches_ = 2, group_lanes_ = 2 * kLanes;
+  const ShadingProgram* grouping_of_ = nullptr;  // the program grouping_ is of
+  BatchGrouping grouping_;
   std::uint32_t held_slots_ = 0;
   int packing_ = kMaxGroupBatches + 1;
   int packed_quads_ = 0;

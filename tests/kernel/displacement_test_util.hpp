@@ -141,7 +141,7 @@ inline std::vector<TechniqueResult> trace_rays(const DisplacementProgram& progra
     in.view_depth = simd::Float(10.0f);
     in.covered = simd::from_bits(covered);
     ShadeOutput out;
-    program.shade(in, out);
+    program.shade_one(in, out);
     alignas(64) float hu[simd::kLanes], hv[simd::kLanes], hd[simd::kLanes], it[simd::kLanes];
     out.hit_u.store_aligned(hu);
     out.hit_v.store_aligned(hv);

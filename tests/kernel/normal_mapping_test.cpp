@@ -1,4 +1,4 @@
-// NormalMappingProgram::shade_pair gives each batch what shade() gives it alone, bit for bit in every covered lane:
+// NormalMappingProgram::shade of a pair gives each batch what it gives the batch alone, bit for bit in every covered lane:
 // batches dense enough to run side by side, and sparse ones whose covered lanes run packed in one batch (small
 // triangles).
 #include <gtest/gtest.h>
@@ -88,7 +88,7 @@ void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbed
   lights.camera_position = glm::vec3(0.2f, -0.4f, 3.0f);
   const NormalMappingProgram program("test", albedo, normal, nullptr, SamplingDesc{}, lighting.model,
                                      lighting_params(lighting), specular, lights);
-  ASSERT_TRUE(program.pairs_batches());
+  ASSERT_EQ(program.grouping().batches, 2);
   const std::uint32_t all = (1u << kLanes) - 1u;
   int packed = 0, side_by_side = 0;
   for (int trial = 0; trial < 400; ++trial) {
@@ -100,9 +100,11 @@ void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbed
     const std::uint32_t covered_a = coverage(), covered_b = coverage();
     const Fragments a = random_fragments(rng, covered_a), b = random_fragments(rng, covered_b);
     ShadeOutput alone_a, alone_b, paired_a, paired_b;
-    program.shade(a, alone_a);
-    program.shade(b, alone_b);
-    program.shade_pair(a, paired_a, b, paired_b);
+    program.shade_one(a, alone_a);
+    program.shade_one(b, alone_b);
+    const Fragments* const pair_in[2] = {&a, &b};
+    ShadeOutput* const pair_out[2] = {&paired_a, &paired_b};
+    program.shade(pair_in, pair_out, 2);
     expect_same_covered_lanes(alone_a, paired_a, covered_a, trial);
     expect_same_covered_lanes(alone_b, paired_b, covered_b, trial);
     ++(simd::LanePacking::fits(covered_a, covered_b) ? packed : side_by_side);

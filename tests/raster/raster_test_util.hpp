@@ -18,7 +18,10 @@ class CountingProgram final : public ShadingProgram {
 public:
   explicit CountingProgram(int width, int height)
       : ShadingProgram("counting", kBaseVaryingCount), width_(width), counts(std::size_t(width) * height, 0) {}
-  void shade(const Fragments& in, ShadeOutput& out) const override {
+  void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override {
+    for (int k = 0; k < n; ++k) shade_batch(*in[k], *out[k]);
+  }
+  void shade_batch(const Fragments& in, ShadeOutput& out) const {
     alignas(64) float x[simd::kLanes], y[simd::kLanes];
     in.pixel_x.store_aligned(x);
     in.pixel_y.store_aligned(y);

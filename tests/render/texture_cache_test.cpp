@@ -91,7 +91,7 @@ TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
 // Also what the batch pairing and quad packing do: with the cache on, the rasterizer hands a program one batch at a
 // time, holding the quads of one triangle; off, it packs the quads of batches with an empty quad into shared
 // batches across triangles (where a batch holds several quads), and hands QDM, relief, POM and normal mapping two
-// batches at a time (ShadingProgram::pairs_batches). Every lane's result must be the same: image, displacement AOVs,
+// batches at a time (ShadingProgram::grouping). Every lane's result must be the same: image, displacement AOVs,
 // the loop statistics per pixel; only the batch count may fall. Programs also run their loops without the recorder's tests
 // when none listens. objects_displaced has single-layer QDM, POM and relief (paired) on meshes, and again with
 // CSM and RCSM (not paired) for its two QDM materials; terrain a 256x256 grid of small triangles under QDM over
