@@ -52,7 +52,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     : ShadingProgram(variant_name(with_trace(key, variant.options)),
                      inputs.layers.size() > 1 && key.weights == WeightMode::Vertex ? kWeight0 + int(inputs.layers.size())
                                                                                    : kBaseVaryingCount),
-      shade_(variant.shade), shade_pair_(variant.shade_pair), shade_group_(variant.shade_group), cones_(inputs.cones),
+      shade_(variant.shade), cones_(inputs.cones),
       reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo),
       reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(params.sampling)),
       lod_mode_(params.sampling.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
@@ -305,12 +305,6 @@ void blend_factors(BlendOperator op, float width, int count, const Float* h, con
 
 }  // namespace
 
-template <class V, class Surface>
-void DisplacementProgram::shade_surface(const Fragments& in, const Setup& setup, const Surface& surface,
-                                        ShadeOutput& out) const {
-  shade_hit<V>(in, setup, surface, trace<V>(surface, setup), out);
-}
-
 // The surface at the hit: where it is, its colour, normal, specular and baked AO.
 struct DisplacementProgram::SurfaceAtHit {
   Hit hit;
@@ -465,12 +459,7 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
 }
 
 void DisplacementProgram::shade(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  if (n == 1)
-    (this->*shade_)(*in[0], *out[0]);
-  else if (n == 2)
-    (this->*shade_pair_)(*in[0], *out[0], *in[1], *out[1]);
-  else
-    (this->*shade_group_)(in, out, n);
+  (this->*shade_)(in, out, n);
 }
 
 // A blend's sparse batches are packed into fewer (shade_compacted): up to eight at once, with at most four
@@ -484,66 +473,49 @@ BatchGrouping DisplacementProgram::grouping() const {
   return {2, 2 * simd::kLanes};
 }
 
-// QDM, relief and POM over a blend: shade_group_variant() of the two. Single-layer QDM, relief and POM: both
-// batches set up and traced (QDM's walks interleaved), then the surface at each hit and its lighting, stage by
-// stage, each batch's chains of dependent operations beside the other's. Any other program shades one batch after
-// the other (their grouping() is one batch; this is the fallback).
-template <class V>
-void DisplacementProgram::shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
-                                             ShadeOutput& out_b) const {
-  constexpr TechniqueKind kind = V::technique;
-  if constexpr (pairs_technique(kind)) {
-    if (layers_.size() > 1) {
-      const Fragments* const in[2] = {&a, &b};
-      ShadeOutput* const out[2] = {&out_a, &out_b};
-      shade_group_variant<V>(in, out, 2);
-      return;
-    }
-    const Setup setup_a = setup_for(a), setup_b = setup_for(b);
-    const SingleLayerSurface surface = layer_surface(0);
-    if constexpr (kind == TechniqueKind::Qdm) {
-      Hit hit_a, hit_b;
-      walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
-      refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
-      shade_hits<V>(a, setup_a, hit_a, out_a, b, setup_b, hit_b, out_b);
-    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
-      const Hit hit_a = trace<V>(surface, setup_a);
-      const Hit hit_b = trace<V>(surface, setup_b);
-      shade_hits<V>(a, setup_a, hit_a, out_a, b, setup_b, hit_b, out_b);
-    }
-    return;
-  }
-  shade_variant<V>(a, out_a);
-  shade_variant<V>(b, out_b);
-}
-
-// QDM, relief and POM over a blend: n batches whose covered lanes fit fewer run as those (shade_compacted); else
-// each is traced over its own blended surface, two at a time (QDM's walks interleaved), and its hits shaded. Any
-// other program: in pairs.
+// The one way batches are shaded, in stages: every batch of the group set up (derivatives, frame, the ray and its
+// depth range), then traced, then each one's surface at the hit, its lighting and its displaced depth. A group of
+// one batch is the usual case. Paired single-layer batches (QDM, relief, POM) run each stage side by side: QDM's
+// two walks step in one loop, and each batch's chains of dependent operations overlap the other's. A blend's
+// batches whose covered lanes fit fewer run packed (shade_compacted); otherwise each is traced over its own blended
+// surface, two at a time.
 template <class V>
 void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  if constexpr (pairs_technique(V::technique)) {
-    if (layers_.size() > 1) {
-      Setup setups[simd::LaneCompaction::kMaxBatches];
-      std::uint32_t covered[simd::LaneCompaction::kMaxBatches];
-      for (int k = 0; k < n; ++k) {
-        setups[k] = setup_for(*in[k]);
-        covered[k] = simd::to_bits(in[k]->covered);
-      }
+  Setup setups[kMaxGroupBatches];
+  for (int k = 0; k < n; ++k) setups[k] = setup_for(*in[k]);
+  if (layers_.size() > 1) {
+    if (n > 1) {
+      std::uint32_t covered[kMaxGroupBatches];
+      for (int k = 0; k < n; ++k) covered[k] = simd::to_bits(in[k]->covered);
       const simd::LaneCompaction lanes(covered, n);
       if (lanes.packed_batches() < n) {
         shade_compacted<V>(in, setups, out, lanes);
         return;
       }
-      trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit) {
-        shade_hit<V>(*in[k], setups[k], surface, hit, *out[k]);
-      });
+    }
+    trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit) {
+      shade_hit<V>(*in[k], setups[k], surface, hit, *out[k]);
+    });
+    return;
+  }
+  const SingleLayerSurface surface = layer_surface(0);
+  for (int k = 0; k < n; k += 2) {
+    if (k + 1 == n) {
+      shade_hit<V>(*in[k], setups[k], surface, trace<V>(surface, setups[k]), *out[k]);
       return;
     }
+    const Setup& setup_a = setups[k];
+    const Setup& setup_b = setups[k + 1];
+    Hit hit_a, hit_b;
+    if constexpr (V::technique == TechniqueKind::Qdm) {
+      walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
+      refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
+    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
+      hit_a = trace<V>(surface, setup_a);
+      hit_b = trace<V>(surface, setup_b);
+    }
+    shade_hits<V>(*in[k], setup_a, hit_a, *out[k], *in[k + 1], setup_b, hit_b, *out[k + 1]);
   }
-  int k = 0;
-  for (; k + 1 < n; k += 2) shade_pair_variant<V>(*in[k], *out[k], *in[k + 1], *out[k + 1]);
-  if (k < n) shade_variant<V>(*in[k], *out[k]);
 }
 
 // Two batches' QDM walks to their ends, a step of each per round: their hits on the box surface.
@@ -723,17 +695,6 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
   return setup;
 }
 
-template <class V>
-void DisplacementProgram::shade_variant(const Fragments& in, ShadeOutput& out) const {
-  const Setup setup = setup_for(in);
-  if (layers_.size() == 1) {
-    shade_surface<V>(in, setup, layer_surface(0), out);
-    return;
-  }
-  const LayerSurfaces layers = layer_surfaces();
-  shade_surface<V>(in, setup, blended_surface(layers, in, setup), out);
-}
-
 DisplacementProgram::LayerSurfaces DisplacementProgram::layer_surfaces() const {
   const int count = int(layers_.size());
   return {layer_surface(0), layer_surface(std::min(1, count - 1)), layer_surface(std::min(2, count - 1)),
@@ -760,8 +721,7 @@ BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers,
 
 template <class V>
 DisplacementProgram::Variant DisplacementProgram::variant() {
-  return {&DisplacementProgram::shade_variant<V>, &DisplacementProgram::shade_pair_variant<V>,
-          &DisplacementProgram::shade_group_variant<V>, V::options()};
+  return {&DisplacementProgram::shade_group_variant<V>, V::options()};
 }
 
 // Every combination of the trace options is instantiated (TraceOptions, qdmr/program/program_key.hpp): 5 techniques, and for qdm

@@ -55,15 +55,10 @@ private:
   };
   // What shade() computes before the surface is known: the frame, the ray and its depth range (the only one).
   struct Setup;
-  // The instantiation of shade_variant for a material's trace options, and the options of the type it runs.
-  using ShadeFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&) const;
-  using ShadePairFn = void (DisplacementProgram::*)(const Fragments&, ShadeOutput&, const Fragments&,
-                                                    ShadeOutput&) const;
-  using ShadeGroupFn = void (DisplacementProgram::*)(const Fragments* const*, ShadeOutput* const*, int) const;
+  // The instantiation of shade_group_variant for a material's trace options, and the options of the type it runs.
+  using ShadeFn = void (DisplacementProgram::*)(const Fragments* const*, ShadeOutput* const*, int) const;
   struct Variant {
     ShadeFn shade;
-    ShadePairFn shade_pair;
-    ShadeGroupFn shade_group;
     TraceOptions options;
   };
   // QDM's lowest level and iteration cap per lane.
@@ -83,16 +78,10 @@ private:
   LayerSurfaces layer_surfaces() const;
   BlendedSurface blended_surface(const LayerSurfaces& layers, const Fragments& in, const Setup& setup) const;
   Setup setup_for(const Fragments& in) const;
-  template <class V>
-  void shade_variant(const Fragments& in, ShadeOutput& out) const;
-  // The techniques whose batches are shaded in pairs (shade_pair_variant).
+  // The techniques whose batches are shaded in pairs (grouping()).
   static constexpr bool pairs_technique(TechniqueKind k) {
     return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
   }
-  template <class V>
-  void shade_pair_variant(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
-  template <class V, class Surface>
-  void shade_surface(const Fragments& in, const Setup& setup, const Surface& surface, ShadeOutput& out) const;
   // Everything after the trace: the surface's colour and normal at the hit, lighting and AOVs (light_hit), then the
   // displaced depth; in stages (a pair of batches runs each stage for both side by side).
   struct SurfaceAtHit;
@@ -104,6 +93,7 @@ private:
   template <class V, class Surface>
   void walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
                  const Setup& setup_b, Hit& hit_b) const;
+  // The batch scheduler: setup, trace, surface at the hit, lighting (displacement.cpp says how groups run).
   template <class V>
   void shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const;
   template <class V, class Shade>
@@ -140,8 +130,6 @@ private:
   Hit exact_hit(const Ray& ray, const simd::Float& depth_scale, const Hit& traced, const simd::Mask& covered) const;
 
   ShadeFn shade_;
-  ShadePairFn shade_pair_;
-  ShadeGroupFn shade_group_;
   std::vector<Layer> layers_;
   std::optional<TextureSampler> weights_;
   std::optional<TextureSampler> combined_;
