@@ -242,7 +242,7 @@ public:
   // accessor is held whole beside what it becomes.
   template <class Visit>
   void for_each_element(const Elements& e, Visit&& visit) const {
-    if (e.source->memory) {
+    if (!e.source->file) {
       for (std::size_t i = 0; i < e.count; ++i) visit(e.source->memory + e.first + i * e.stride, i);
       return;
     }
