@@ -190,8 +190,10 @@ void bind_studies(py::module_& m) {
            "Configuration `index`'s row as JSON text (kept files into out/images).")
       .def("reuse_order", &StudyMeasurer::reuse_order, py::arg("pending"),
            "`pending` grouped by the asset sets their plans build, the order that re-prepares least.")
-      .def("baseline_key", &StudyMeasurer::baseline_key, py::arg("index"),
-           "What configuration `index` is compared with: equal keys share a baseline ('' without one).")
+      .def("share_groups", &StudyMeasurer::share_groups, py::arg("pending"), py::call_guard<py::gil_scoped_release>(),
+           "`pending` in groups that share the exact reference and the heights it is traced on, each in reuse order.")
+      .def("estimated_cost", &StudyMeasurer::estimated_cost, py::arg("index"),
+           "A relative estimate of what configuration `index` costs to draw.")
       .def_property_readonly("spec_hash", &StudyMeasurer::spec_hash)
       .def_property_readonly("asset_builds", &StudyMeasurer::asset_builds);
   py::class_<StudyFolderHandle>(m, "StudyFolder", "A study's results folder, locked while a run writes it.")

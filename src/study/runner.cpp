@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "file/atomic_file.hpp"
@@ -341,6 +342,33 @@ std::vector<std::size_t> order_for_reuse(const StudySpec& spec, const std::vecto
   return order;
 }
 
+// What one measurer computes once for every configuration with the same key, beyond the timed frame's asset set:
+// the exact reference (the ReferenceMemo remembers hits by field content, ray and depth) is traced on the fields
+// of the error frame's plan (layer 0's stored heights, a blend's combined surface), from the camera, at the frame's
+// size; those fields' heights are built once per renderer. The depth is left out: configurations that differ only
+// in it still share the heights.
+std::string share_key(const StudySpec& spec, const StudyConfig& config, const SceneSource& source,
+                      const std::array<double, 9>& camera) {
+  PlanOptions options;
+  options.aovs = {Aov::ErrorTexels};
+  const FramePlan plan = plan_frame(source.load(study_overrides(spec, config, camera)), options);
+  std::set<std::string> fields;
+  for (const DerivedPlan& d : plan.derived) {
+    if (d.kind == DerivedKind::CombinedSurface) fields.insert(d.key);
+    if (d.kind != DerivedKind::HeightField) continue;
+    // Level 0 of the heights and the address mode: the field's content, whichever mip chain its texture has.
+    const std::string& heights = plan.textures[std::size_t(d.texture)].key;
+    fields.insert("field " + heights.substr(0, heights.rfind("|mip")) + d.key.substr(d.key.rfind("|address=")));
+  }
+  const CameraDesc& c = plan.scene.camera;
+  std::ostringstream key;
+  key << std::hexfloat << plan.width << "x" << plan.height << " camera " << c.position.x << "," << c.position.y << ","
+      << c.position.z << " " << c.target.x << "," << c.target.y << "," << c.target.z << " " << c.up.x << "," << c.up.y
+      << "," << c.up.z << " " << c.fov_y_deg;
+  for (const std::string& field : fields) key << "\n" << field;
+  return key.str();
+}
+
 }  // namespace
 
 std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::vector<StudyConfig>& configs,
@@ -395,10 +423,36 @@ StudyRow StudyMeasurer::measure(std::size_t index, const std::filesystem::path& 
   }
 }
 
-std::string StudyMeasurer::baseline_key(std::size_t index) const {
+std::vector<std::vector<std::size_t>> StudyMeasurer::share_groups(const std::vector<std::size_t>& pending) const {
   const State& s = *state_;
-  if (index >= s.configs.size() || !s.spec.wants(StudyMetric::ImageDiff) || s.spec.baseline.empty()) return {};
-  return nlohmann::json(baseline_config(s.spec, s.configs[index]).values).dump();
+  for (std::size_t index : pending)
+    if (index >= s.configs.size())
+      throw Error("study", "configuration " + std::to_string(index) + " does not exist (the spec has " +
+                               std::to_string(s.configs.size()) + ")");
+  const std::vector<std::size_t> order = reuse_order(pending);
+  std::map<std::string, std::size_t> group_of;
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t index : order) {
+    std::string key;
+    try {
+      key = share_key(s.spec, s.configs[index], s.source, s.camera);
+    } catch (const Error&) {
+      // A configuration that cannot be planned shares nothing: its own error is reported when it is drawn.
+      key = "unplanned " + std::to_string(index);
+    }
+    const auto found = group_of.emplace(key, groups.size()).first;
+    if (found->second == groups.size()) groups.emplace_back();
+    groups[found->second].push_back(index);
+  }
+  return groups;
+}
+
+double StudyMeasurer::estimated_cost(std::size_t index) const {
+  const State& s = *state_;
+  if (index >= s.configs.size())
+    throw Error("study", "configuration " + std::to_string(index) + " does not exist (the spec has " +
+                             std::to_string(s.configs.size()) + ")");
+  return qdmr::estimated_cost(s.spec, s.configs[index]);
 }
 
 std::vector<std::size_t> StudyMeasurer::reuse_order(const std::vector<std::size_t>& pending) const {

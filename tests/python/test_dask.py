@@ -59,6 +59,90 @@ def test_an_interrupted_dask_run_resumes(client, tmp_path):
     assert [r["index"] for r in qdmr.study.load(out)] == list(range(6))
 
 
+# Two height fields (stored plain and BC3-compressed) x two techniques: each field's exact reference and heights are
+# computed once per process that draws any configuration of it.
+FIELDS = {"scene": PLANE, "width": 64, "height": 36, "frames": 1, "warmup": 0, "metrics": ["time", "error"],
+          "axes": [{"name": "compression", "path": "/materials/bricks/layers/0/height/compression",
+                    "values": ["none", "bc3"]},
+                   {"name": "technique", "path": "/materials/bricks/technique/name", "values": ["qdm", "pom"]},
+                   {"name": "precision", "path": "/materials/bricks/sampling/precision", "values": ["exact", "hw8"]}],
+          "baseline": {"compression": "none", "precision": "exact"}}
+
+
+def test_configurations_are_grouped_by_the_reference_and_heights_they_share():
+    from qdmr import _dask, _qdmr
+    measurer = _qdmr.StudyMeasurer(FIELDS)
+    everything = list(range(8))  # compression is the outer axis: 0-3 plain, 4-7 BC3
+    groups = measurer.share_groups(everything)
+    assert sorted(sorted(g) for g in groups) == [[0, 1, 2, 3], [4, 5, 6, 7]]
+    for group in groups:  # each in the order that re-prepares least
+        assert group == measurer.reuse_order(sorted(group))
+    # Two workers: a field each (not a technique each, which would trace both references twice).
+    runs, group_of = _dask._assign(measurer, everything, 2)
+    assert sorted(sorted(run) for run in runs) == [[0, 1, 2, 3], [4, 5, 6, 7]]
+    assert len({group_of[i] for i in runs[0]}) == 1
+    # One worker: everything; three: a group is cut in two (each half computes its reference once).
+    assert [sorted(run) for run in _dask._assign(measurer, everything, 1)[0]] == [everything]
+    runs = sorted((sorted(run) for run in _dask._assign(measurer, everything, 3)[0]), key=len)
+    assert all(runs) and runs[2] in ([0, 1, 2, 3], [4, 5, 6, 7])
+    assert sorted(runs[0] + runs[1]) == sorted(set(everything) - set(runs[2]))
+    with pytest.raises(qdmr.SceneError, match="does not exist"):
+        measurer.share_groups([8])
+
+
+def test_a_worker_takes_from_another_run_only_when_it_pays():
+    from collections import deque
+    from qdmr import _dask
+    group_of = {i: 0 if i < 20 else 1 for i in range(40)}
+    # Its own run first, in order.
+    queues = [deque([0, 1]), deque([20, 21, 22])]
+    assert _dask._next(queues, 0, group_of, set(), set()) == 0
+    # Done, and the other run is short and of a group it has not drawn: nothing (it would compute that group's
+    # reference again for two configurations).
+    queues = [deque(), deque([20, 21, 22])]
+    assert _dask._next(queues, 0, group_of, {0}, set()) is None and list(queues[1]) == [20, 21, 22]
+    # Of a group it has drawn: the back half, in order.
+    queues = [deque(), deque([20, 21, 22, 23])]
+    assert _dask._next(queues, 0, group_of, {0, 1}, set()) == 22
+    assert list(queues[0]) == [23] and list(queues[1]) == [20, 21]
+    # A long run of another group: its back half.
+    queues = [deque(), deque(range(20, 20 + _dask.MIN_STEAL))]
+    assert _dask._next(queues, 0, group_of, {0}, set()) == 20 + _dask.MIN_STEAL // 2
+    assert len(queues[1]) == _dask.MIN_STEAL // 2
+    # A lost worker's run, however short.
+    queues = [deque(), deque([20])]
+    assert _dask._next(queues, 0, group_of, {0}, {1}) == 20
+
+
+def test_a_lost_worker_s_configurations_are_drawn_by_the_others(tmp_path):
+    # A worker killed in the middle of the run (its nanny starts another under a new address): the configurations
+    # given to it go to the worker left, and the rows are those of a one-process run.
+    import signal
+    import threading
+    import time
+    spec = dict(FIELDS, width=320, height=180, frames=2)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        pids = client.run(os.getpid)
+        killed = {}
+
+        def kill_one_after_the_first_row():
+            rows = tmp_path / "dask" / "rows.jsonl"
+            while not (rows.is_file() and rows.read_text().count("\n") >= 1):
+                time.sleep(0.005)
+            killed["rows"] = rows.read_text().count("\n")
+            os.kill(pids[sorted(pids)[1]], signal.SIGKILL)
+
+        killer = threading.Thread(target=kill_one_after_the_first_row)
+        killer.start()
+        spread = qdmr.study.run(spec, tmp_path / "dask", client=client)
+        killer.join()
+    assert killed["rows"] < 8  # killed while configurations were left
+    assert spread["rendered"] == 8
+    qdmr.study.run(spec, tmp_path / "one", threads=1)
+    assert deterministic(qdmr.study.load(tmp_path / "dask")) == deterministic(qdmr.study.load(tmp_path / "one"))
+
+
 def test_any_client_scheduler_and_workers_started_as_commands(tmp_path):
     # The shape of a cluster job (dask-jobqueue's Slurm script, a Kubernetes pod): a scheduler process writes its
     # address to a shared file, worker processes started apart (each under its nanny) connect through it, and the

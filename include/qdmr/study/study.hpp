@@ -67,9 +67,13 @@ public:
   // `pending` in the order that re-prepares least: grouped by the items their plans build (asset sets), groups in
   // the order of their first configuration, indices ascending within a group.
   std::vector<std::size_t> reuse_order(const std::vector<std::size_t>& pending) const;
-  // What configuration `index` is compared with (the image difference's baseline, drawn once per measurer):
-  // configurations with equal keys share it. Empty when the spec has no baseline.
-  std::string baseline_key(std::size_t index) const;
+  // `pending` in groups of configurations that share what one measurer computes once for all of them beyond an
+  // asset set: the exact reference (the fields it traces, from one camera at one frame size) and the heights
+  // those fields are made of. Each group in reuse_order, groups in the order of their first configuration.
+  // Processes that split a spec between them duplicate least when each draws whole groups.
+  std::vector<std::vector<std::size_t>> share_groups(const std::vector<std::size_t>& pending) const;
+  // A relative estimate of what configuration `index` costs to draw (the one shards are balanced by).
+  double estimated_cost(std::size_t index) const;
   std::size_t asset_builds() const;  // configurations measured so far whose timed scene built anything
   int threads() const;
   const char* isa() const;
