@@ -26,7 +26,8 @@ namespace qdmr {
 
 // The directions and taps a material's AO looks along (bake/ao_pattern.hpp).
 inline ao::Pattern pattern_of(const AoDesc& desc) {
-  return {desc.directions, desc.jitter, desc.seed, desc.radius, desc.coarse};
+  return {.directions = desc.directions, .jitter = desc.jitter, .seed = desc.seed, .radius = desc.radius,
+          .coarse = desc.coarse};
 }
 
 namespace ao {

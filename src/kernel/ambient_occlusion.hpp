@@ -33,12 +33,13 @@ inline simd::Int ao_rotation(const simd::Float& pixel_x, const simd::Float& pixe
   return xsimd::bitwise_cast<simd::Int>(h >> 28);
 }
 
-// ao' = 1 - strength * (1 - ao): strength 0 disables the darkening, 1 keeps it (for baked maps too).
 // The directions and taps of bake/ao_pattern.hpp the parameters ask for.
 inline ao::Pattern pattern_of(const AoParams& params) {
-  return {params.directions, params.jitter, params.seed, params.radius, params.coarse};
+  return {.directions = params.directions, .jitter = params.jitter, .seed = params.seed, .radius = params.radius,
+          .coarse = params.coarse};
 }
 
+// ao' = 1 - strength * (1 - ao): strength 0 disables the darkening, 1 keeps it (for baked maps too).
 inline simd::Float apply_ao_strength(const simd::Float& ao, float strength) {
   const simd::Float one(1.0f);
   return one - simd::Float(strength) * (one - ao);

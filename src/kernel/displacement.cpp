@@ -189,7 +189,9 @@ struct DisplacementProgram::Setup {
   Float ds;  // the depth range the ray is traced through: the depth scale after the distance fade and POM's LOD fade
   Ray ray;
   Mask active;  // the covered lanes (helper lanes are not traced)
-  Float height_lod = Float(0.0f);  // mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows
+  // Mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows; 0 without one. Set by
+  // setup_for (no default: a group's array of setups is made per batch, in the hot path).
+  Float height_lod;
 };
 
 template <class V, class Surface>
@@ -682,8 +684,9 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
   const Float vz = xsimd::max(setup.view_tangent.z, Float(1e-4f));  // grazing and back-facing views: nearly parallel rays
   setup.ray = Ray{u, v, (Float(0.0f) - setup.view_tangent.x) / vz, (Float(0.0f) - setup.view_tangent.y) / vz};
   setup.active = in.covered;
-  if (layers_[0].height)
-    setup.height_lod = layers_[0].height->height.lod(setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy);
+  setup.height_lod = layers_[0].height
+                         ? layers_[0].height->height.lod(setup.d.dudx, setup.d.dvdx, setup.d.dudy, setup.d.dvdy)
+                         : Float(0.0f);
   if (key_.trace.technique == TechniqueKind::Pom) {
     // Far away (high LOD) POM fades to normal mapping.
     const Float fade = xsimd::min(xsimd::max((setup.height_lod - Float(trace_.lod_threshold)) /

@@ -22,19 +22,49 @@ ProgramKey program_key(const MaterialDesc& material) {
   return key;
 }
 
+// Named, in declaration order: the compiler checks every field against its name.
 TraceParams trace_params(const TechniqueDesc& t) {
-  return {t.depth_scale,  t.write_depth,  t.exact_hits,    t.linear_steps,   t.binary_steps, t.min_steps,
-          t.max_steps,    t.lod_threshold, t.lod_fade,     t.max_iterations, t.refinement,   t.height_fetch,
-          t.lod_stop,     t.min_iterations, t.fade_start,  t.fade_end};
+  return {.depth_scale = t.depth_scale,
+          .write_depth = t.write_depth,
+          .exact_hits = t.exact_hits,
+          .linear_steps = t.linear_steps,
+          .binary_steps = t.binary_steps,
+          .min_steps = t.min_steps,
+          .max_steps = t.max_steps,
+          .lod_threshold = t.lod_threshold,
+          .lod_fade = t.lod_fade,
+          .max_iterations = t.max_iterations,
+          .refinement = t.refinement,
+          .height_fetch = t.height_fetch,
+          .lod_stop = t.lod_stop,
+          .min_iterations = t.min_iterations,
+          .fade_start = t.fade_start,
+          .fade_end = t.fade_end};
 }
 
-LightingParams lighting_params(const LightingDesc& l) { return {l.specular, l.shininess, l.roughness}; }
+LightingParams lighting_params(const LightingDesc& l) {
+  return {.specular = l.specular, .shininess = l.shininess, .roughness = l.roughness};
+}
 
 ShadowParams shadow_params(const ShadowDesc& s) {
-  return {s.strength, s.max_iterations, s.samples, s.length, s.profile, s.penumbra, s.tap_weights, s.bias};
+  return {.strength = s.strength,
+          .max_iterations = s.max_iterations,
+          .samples = s.samples,
+          .length = s.length,
+          .profile = s.profile,
+          .penumbra = s.penumbra,
+          .tap_weights = s.tap_weights,
+          .bias = s.bias};
 }
 
-AoParams ao_params(const AoDesc& a) { return {a.directions, a.jitter, a.seed, a.radius, a.coarse, a.strength}; }
+AoParams ao_params(const AoDesc& a) {
+  return {.directions = a.directions,
+          .jitter = a.jitter,
+          .seed = a.seed,
+          .radius = a.radius,
+          .coarse = a.coarse,
+          .strength = a.strength};
+}
 
 ProgramParams program_params(const MaterialDesc& material) {
   ProgramParams p;
@@ -44,7 +74,8 @@ ProgramParams program_params(const MaterialDesc& material) {
   for (const LayerDesc& layer : material.layers) p.specular.push_back(layer.specular);
   p.shadow = shadow_params(material.shadow);
   p.ao = ao_params(material.ao);
-  if (material.layers.size() > 1) p.blend = {material.blend.width, material.blend.weights.scale};
+  if (material.layers.size() > 1)
+    p.blend = {.width = material.blend.width, .weights_scale = material.blend.weights.scale};
   return p;
 }
 
