@@ -120,11 +120,18 @@ std::uint64_t texture_working_bytes(const TextureRequest& r, const SourceInfo& s
   return peak > r.bytes ? peak - r.bytes : 0;
 }
 
-// Textures are built kTexturesBuiltAtOnce at a time, in any order: the most their builds hold at once is the sum of
-// that many of the largest.
+// Texture build groups are built kTexturesBuiltAtOnce at a time, in any order: the most their builds hold at once is
+// the sum of that many of the largest. A group holds its shared heights while its textures are built one by one.
 std::uint64_t textures_working_bytes(const std::vector<TextureRequest>& textures) {
   std::vector<std::uint64_t> working;
-  for (const TextureRequest& t : textures) working.push_back(t.working_bytes);
+  for (const std::vector<std::size_t>& group : texture_build_groups(textures)) {
+    std::uint64_t shared = 0, most = 0;
+    for (std::size_t i : group) {
+      shared = std::max(shared, textures[i].shared_height_bytes);
+      most = std::max(most, textures[i].working_bytes);
+    }
+    working.push_back((group.size() > 1 ? shared : 0) + most);
+  }
   std::sort(working.begin(), working.end(), std::greater<>());
   std::uint64_t sum = 0;
   for (std::size_t i = 0; i < working.size() && i < kTexturesBuiltAtOnce; ++i) sum += working[i];
@@ -189,7 +196,11 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   const auto changes = [](const TextureDesc& t) { return time_dependent(t) || t.source == TextureSource::Pixels; };
   const bool from_height = purpose == TexturePurpose::Height || desc.source == TextureSource::FromHeight;
   r.dynamic = changes(desc) || (from_height && changes(layer.height));
-  if (from_height) r.height_key = height_key(layer);
+  if (from_height) {
+    r.height_key = height_key(layer);
+    r.shared_height_bytes = std::uint64_t(r.width) * std::uint64_t(r.height) * sizeof(float) +
+                            mip_chain_bytes(r.width, r.height, height_format(layer.height, source.bits));
+  }
   r.users.push_back(user);
   textures.push_back(std::move(r));
   return int(textures.size() - 1);
@@ -689,6 +700,22 @@ std::vector<std::string> FramePlan::items() const {
   for (const TextureRequest& t : textures) items.push_back("texture " + t.key);
   for (const DerivedPlan& d : derived) items.push_back(d.key);
   return items;
+}
+
+std::vector<std::vector<std::size_t>> texture_build_groups(const std::vector<TextureRequest>& textures) {
+  std::vector<std::vector<std::size_t>> groups;
+  std::map<std::string, std::size_t> group_of;  // height_key -> its group
+  for (std::size_t i = 0; i < textures.size(); ++i) {
+    const std::string& key = textures[i].height_key;
+    if (!key.empty()) {
+      if (const auto [it, added] = group_of.emplace(key, groups.size()); !added) {
+        groups[it->second].push_back(i);
+        continue;
+      }
+    }
+    groups.push_back({i});
+  }
+  return groups;
 }
 
 std::vector<std::string> FramePlan::dynamic_items() const {

@@ -22,8 +22,8 @@
 namespace qdmr {
 namespace {
 
-// The level 0 and stored box chain of a dynamic layer height, made once per prepare for every texture made from it
-// (its box chain, its max-quadtree, normals from it): each would otherwise make the pattern again.
+// The level 0 and stored box chain of a layer's heights, made once for the textures of its build group (its box
+// chain, its max-quadtree, normals from it): each would otherwise make the pattern again. Empty for a lone texture.
 struct SharedHeight {
   std::optional<Image> level0;
   std::optional<HeightTexture> stored_box;
@@ -230,27 +230,20 @@ private:
     });
   }
 
-  // The dynamic layer heights that more than one texture to build is made from: their level 0, and their box chain
-  // when a box-filtered height or from_height normals use it, made before the textures (one at a time, each with
-  // every thread). Still heights keep the one-build-per-texture path (and its memory plan).
-  std::map<std::string, SharedHeight> shared_heights(const std::vector<bool>& done) const {
-    std::map<std::string, std::vector<const TextureRequest*>> users;
-    for (std::size_t i = 0; i < plan_.textures.size(); ++i) {
+  // The level 0 of the layer heights the pending textures `requests` are made from, and their box chain when a
+  // box-filtered height or from_height normals use it: made once (each with every thread) where two or more of
+  // them would each make the pattern again.
+  SharedHeight shared_height(const std::vector<std::size_t>& requests) const {
+    SharedHeight s;
+    if (requests.size() < 2) return s;
+    const TextureRequest& first = plan_.textures[requests.front()];
+    s.level0 = make_layer_height(first.layer, first.where);
+    const bool box = std::any_of(requests.begin(), requests.end(), [&](std::size_t i) {
       const TextureRequest& r = plan_.textures[i];
-      if (!done[i] && r.dynamic && !r.height_key.empty() && !previous_.textures.count(r.key)) users[r.height_key].push_back(&r);
-    }
-    std::map<std::string, SharedHeight> shared;
-    for (const auto& [key, requests] : users) {
-      if (requests.size() < 2) continue;
-      SharedHeight& s = shared[key];
-      const TextureRequest& first = *requests.front();
-      s.level0 = make_layer_height(first.layer, first.where);
-      const bool box = std::any_of(requests.begin(), requests.end(), [](const TextureRequest* r) {
-        return r->purpose != TexturePurpose::Height || r->reduce == MipReduce::Box;
-      });
-      if (box) s.stored_box = make_height_texture(*s.level0, first.layer.height, MipReduce::Box, kernel_.mip_extremum());
-    }
-    return shared;
+      return r.purpose != TexturePurpose::Height || r.reduce == MipReduce::Box;
+    });
+    if (box) s.stored_box = make_height_texture(*s.level0, first.layer.height, MipReduce::Box, kernel_.mip_extremum());
+    return s;
   }
 
   // The dynamic heights whose every texture to build the family rebuild makes (heights stored as R8 or R16 with
@@ -314,34 +307,43 @@ private:
     assets_.textures.resize(n);
     assets_.texture_stats.resize(n);
     const std::vector<bool> done = height_families();
-    const std::map<std::string, SharedHeight> shared = shared_heights(done);
-    // At most kTexturesBuiltAtOnce in flight (the plan counts that many builds' working memory); each build's
-    // own loops use every thread.
+    for (std::size_t i = 0; i < n; ++i)
+      if (auto it = previous_.textures.find(plan_.textures[i].key); !done[i] && it != previous_.textures.end()) {
+        assets_.textures[i] = it->second.first;
+        assets_.texture_stats[i] = it->second.second;
+      }
+    std::vector<std::vector<std::size_t>> groups;  // the textures left to build, by texture_build_groups
+    for (const std::vector<std::size_t>& group : texture_build_groups(plan_.textures)) {
+      std::vector<std::size_t> pending;
+      for (std::size_t i : group)
+        if (!done[i] && !assets_.textures[i]) pending.push_back(i);
+      if (!pending.empty()) groups.push_back(std::move(pending));
+    }
+    // At most kTexturesBuiltAtOnce groups in flight (the plan counts that many groups' working memory); each
+    // build's own loops use every thread.
     std::size_t next = 0;
     tbb::parallel_pipeline(
         kTexturesBuiltAtOnce,
         tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
                                             [&](tbb::flow_control& fc) -> std::size_t {
-                                              if (next < n) return next++;
+                                              if (next < groups.size()) return next++;
                                               fc.stop();
                                               return 0;
                                             }) &
-            tbb::make_filter<std::size_t, void>(tbb::filter_mode::parallel, [&](std::size_t i) {
-              const TextureRequest& request = plan_.textures[i];
-              if (done[i]) return;
-              if (auto it = previous_.textures.find(request.key); it != previous_.textures.end()) {
-                assets_.textures[i] = it->second.first;
-                assets_.texture_stats[i] = it->second.second;
-                return;
+            tbb::make_filter<std::size_t, void>(tbb::filter_mode::parallel, [&](std::size_t g) {
+              auto start = Clock::now();  // the shared heights count in the group's first texture
+              const SharedHeight shared = shared_height(groups[g]);
+              for (std::size_t i : groups[g]) {
+                const TextureRequest& request = plan_.textures[i];
+                const ProgressStep step("texture " + std::to_string(request.width) + "x" +
+                                        std::to_string(request.height) + " (" + request.where +
+                                        ")");  // a line on a terminal when it takes seconds
+                assets_.textures[i] = std::make_shared<Texture>(
+                    build_texture(request, kernel_.mip_extremum(), assets_.texture_stats[i], &shared));
+                record("texture " + request.key, plan_.meshes.size() + i,
+                       {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
+                start = Clock::now();
               }
-              const ProgressStep step("texture " + std::to_string(request.width) + "x" + std::to_string(request.height) +
-                                      " (" + request.where + ")");  // a line on a terminal when it takes seconds
-              const auto start = Clock::now();
-              const auto s = shared.find(request.height_key);
-              assets_.textures[i] = std::make_shared<Texture>(build_texture(
-                  request, kernel_.mip_extremum(), assets_.texture_stats[i], s == shared.end() ? nullptr : &s->second));
-              record("texture " + request.key, plan_.meshes.size() + i,
-                     {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
             }));
   }
 

@@ -46,12 +46,18 @@ struct TextureRequest {
   // normals from such heights): rebuilt every frame of a sequence.
   bool dynamic = false;
   // Heights and from_height normals: the content key of the layer's heights they are made from, else empty.
-  // prepare makes a dynamic one's level 0 (and box chain) once for every texture made from it.
+  // prepare makes the level 0 (and box chain) once for every texture of a build group made from it.
   std::string height_key;
+  // What that shared level 0 and box chain hold while their group is built (0 without a height_key).
+  std::uint64_t shared_height_bytes = 0;
 };
 
-// prepare() builds at most this many textures at once (each of them with every thread), so that their working
-// memory is bounded whatever the number of threads.
+// The textures built together: those made from one layer's heights (one height_key) share its level 0 and box chain,
+// made once for the group; any other texture is a group of its own. In the order of each group's first texture.
+std::vector<std::vector<std::size_t>> texture_build_groups(const std::vector<TextureRequest>& textures);
+
+// prepare() builds at most this many texture build groups at once (each texture with every thread), so that their
+// working memory is bounded whatever the number of threads.
 inline constexpr std::size_t kTexturesBuiltAtOnce = 2;
 
 // Data derived from textures, meshes and material settings, built after them.
@@ -144,7 +150,7 @@ struct FramePlan {
   std::vector<MeshPlan> meshes;          // one per scene object
   std::vector<Aov> aovs;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, derived_bytes = 0;
-  // The working memory of the kTexturesBuiltAtOnce textures whose builds need the most.
+  // The working memory of the kTexturesBuiltAtOnce texture build groups whose builds need the most.
   std::uint64_t texture_working_bytes = 0;
   // The most working memory held at once: texture_working_bytes, or the largest DerivedPlan::working_bytes
   // (derived data is built one item at a time, after the textures). Counted on top of everything kept.
