@@ -512,7 +512,17 @@ void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeO
     if constexpr (V::technique == TechniqueKind::Qdm) {
       walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
       refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
-    } else {  // relief and POM: their loops run at the core's throughput already; one after the other
+    } else if constexpr (V::technique == TechniqueKind::Relief) {  // the binary searches side by side
+      if (fetch_recorder_listens()) {
+        hit_a = trace<V>(surface, setup_a);
+        hit_b = trace<V>(surface, setup_b);
+      } else {
+        trace::relief_pair(surface, trace_, setup_a.ray, setup_a.ds, setup_a.height_lod, setup_a.active, hit_a,
+                           setup_b.ray, setup_b.ds, setup_b.height_lod, setup_b.active, hit_b);
+        hit_a.box_s = hit_a.s;
+        hit_b.box_s = hit_b.s;
+      }
+    } else {  // POM: its loop runs at the core's throughput already; one after the other
       hit_a = trace<V>(surface, setup_a);
       hit_b = trace<V>(surface, setup_b);
     }
