@@ -19,29 +19,31 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
   Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
   LoopLanes<Recorded> lanes(FetchPhase::Trace);
   lanes.narrow(active);
-  // gap = surface depth - ray depth: > 0 while the ray is above the surface.
-  {
-    const Float gap0 = ds * (Float(1.0f) - surface_height<Recorded>(surface, ray.u0, ray.v0, lod));
-    iterations += count(active);
-    const Mask at_top = active & (gap0 <= Float(0.0f));
-    s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
-    active = active & ~at_top;
-    prev_gap = gap0;
-  }
-  for (int i = 1; i <= technique.max_steps && xsimd::any(active); ++i) {
-    const Float fi = Float(static_cast<float>(i));
-    const Mask in_range = active & (fi <= n);
-    lanes.narrow(in_range);
-    const Float s = step * fi;
-    const Float gap = ds * (Float(1.0f) - surface_height<Recorded>(surface, ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
-    iterations += count(in_range);
-    const Mask found = in_range & (gap <= Float(0.0f));
-    const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
-    s_hit = xsimd::select(found, prev_s + (s - prev_s) * t, s_hit);
-    active = in_range & ~found;
-    prev_s = s;
-    prev_gap = gap;
-  }
+  with_surface_height<Recorded>(surface, [&](const auto& height) __attribute__((always_inline)) {
+    // gap = surface depth - ray depth: > 0 while the ray is above the surface.
+    {
+      const Float gap0 = ds * (Float(1.0f) - height(ray.u0, ray.v0, lod));
+      iterations += count(active);
+      const Mask at_top = active & (gap0 <= Float(0.0f));
+      s_hit = xsimd::select(at_top, Float(0.0f), s_hit);
+      active = active & ~at_top;
+      prev_gap = gap0;
+    }
+    for (int i = 1; i <= technique.max_steps && xsimd::any(active); ++i) {
+      const Float fi = Float(static_cast<float>(i));
+      const Mask in_range = active & (fi <= n);
+      lanes.narrow(in_range);
+      const Float s = step * fi;
+      const Float gap = ds * (Float(1.0f) - height(ray.u0 + ray.du * s, ray.v0 + ray.dv * s, lod)) - s;
+      iterations += count(in_range);
+      const Mask found = in_range & (gap <= Float(0.0f));
+      const Float t = prev_gap / (prev_gap - gap);  // prev_gap > 0 >= gap: denominator > 0
+      s_hit = xsimd::select(found, prev_s + (s - prev_s) * t, s_hit);
+      active = in_range & ~found;
+      prev_s = s;
+      prev_gap = gap;
+    }
+  });
   return {s_hit, iterations, Float(0.0f)};
 }
 

@@ -45,6 +45,17 @@ template <bool Recorded, class Surface>
     return surface.height(u, v, lod);
 }
 
+// Calls f(fetch) with fetch(u, v, lod) = surface_height<Recorded>(surface, u, v, lod): the surface's fetch made once
+// for the loop in f where it offers one (SingleLayerSurface::with_height).
+template <bool Recorded, class Surface, class F>
+[[gnu::always_inline]] inline void with_surface_height(const Surface& surface, const F& f) {
+  if constexpr (requires { surface.template with_height<Recorded>(f); })
+    surface.template with_height<Recorded>(f);
+  else
+    f([&](const Float& u, const Float& v, const Float& lod)
+          __attribute__((always_inline)) { return surface_height<Recorded>(surface, u, v, lod); });
+}
+
 // Smallest depth step that moves the ray by one level-0 texel (the scale of refinement brackets).
 inline Float texel_step(const Ray& ray, float width, float height) {
   const Float reach = xsimd::max(xsimd::abs(ray.du) * Float(width), xsimd::abs(ray.dv) * Float(height));

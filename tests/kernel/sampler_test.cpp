@@ -671,39 +671,59 @@ TEST(TextureSampler, CellMaxIsLoadWrapped) {
 // The heights the tracing loops read (SingleLayerSurface::height): inlined for bilinear R8 and R16 maps with exact or
 // 8-bit weights (the math modes whose key floors the exact texel coordinate for hw8), through the sampler
 // otherwise; the bits of the height sampler's first channel either way, including coordinates far out and non-finite.
+// The same for the fetch a loop takes before it starts (with_height), which reads the wrap footprints with the
+// texture's values bound once (FootprintHeight) exactly where the heights are inlined and have footprints.
 TEST(TextureSampler, SurfaceHeightIsTheHeightSamplers) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> coordinate(-3.0f, 3.0f);
-  for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16, TexelFormat::R32F})
-    for (const SamplePrecision precision : kPrecisions)
-      for (const MathMode math : kMathModes) {
-        Image img(32, 16, 1);
-        for (int y = 0; y < 16; ++y)
-          for (int x = 0; x < 32; ++x) img.at(x, y, 0) = float((x * 7 + y * 13) % 31) / 30.0f;
-        const Texture heights = make_mip_texture(img, format, false, MipReduce::Box);
-        SamplerState state;
-        state.precision = precision;
-        state.math = math;
-        const HeightLayerTextures textures(heights, nullptr, state, HeightFetch::Bilinear);
-        const bool inlined = format != TexelFormat::R32F && precision != SamplePrecision::Hw6 &&
-                             (precision == SamplePrecision::Exact || math != MathMode::Sm3);
-        EXPECT_EQ(textures.inline_height != InlineHeight::None, inlined)
-            << int(format) << " " << int(precision) << " " << int(math);
-        const SingleLayerSurface surface(textures);
-        for (int round = 0; round < 32; ++round) {
-          Lanes u, v;
-          for (int l = 0; l < kLanes; ++l) {
-            u[std::size_t(l)] = coordinate(rng);
-            v[std::size_t(l)] = coordinate(rng);
+  for (const bool footprints : {false, true})
+    for (const TexelFormat format : {TexelFormat::R8, TexelFormat::R16, TexelFormat::R32F})
+      for (const SamplePrecision precision : kPrecisions)
+        for (const MathMode math : kMathModes) {
+          Image img(32, 16, 1);
+          for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 32; ++x) img.at(x, y, 0) = float((x * 7 + y * 13) % 31) / 30.0f;
+          Texture heights = make_mip_texture(img, format, false, MipReduce::Box);
+          if (footprints) {
+            if (heights.linear.empty()) add_linear_copy(heights);
+            add_wrap_footprints(heights);
           }
-          if (round == 0) u[0] = kNaN;
-          Float expected[4];
-          textures.height.sample(load(u), load(v), Float(0.0f), expected);
-          const Lanes want = lanes(expected[0]), got = lanes(surface.height(load(u), load(v), Float(0.0f)));
-          for (int l = 0; l < kLanes; ++l)
-            ASSERT_EQ(bits(got[std::size_t(l)]), bits(want[std::size_t(l)])) << int(format) << " lane " << l;
+          SamplerState state;
+          state.precision = precision;
+          state.math = math;
+          const HeightLayerTextures textures(heights, nullptr, state, HeightFetch::Bilinear);
+          const bool inlined = format != TexelFormat::R32F && precision != SamplePrecision::Hw6 &&
+                               (precision == SamplePrecision::Exact || math != MathMode::Sm3);
+          EXPECT_EQ(textures.inline_height != InlineHeight::None, inlined)
+              << int(format) << " " << int(precision) << " " << int(math);
+          const SingleLayerSurface surface(textures);
+          for (int round = 0; round < 32; ++round) {
+            Lanes u, v;
+            for (int l = 0; l < kLanes; ++l) {
+              u[std::size_t(l)] = coordinate(rng);
+              v[std::size_t(l)] = coordinate(rng);
+            }
+            if (round == 0) u[0] = kNaN, v[1 % kLanes] = -kInf, u[2 % kLanes] = 3e7f, v[3 % kLanes] = -1e30f;
+            if (round == 1)  // the last column and row: the footprints' wrapped neighbours
+              for (std::size_t l = 0; l < std::size_t(kLanes); ++l)
+                u[l] = 1.0f - 0.1f / 32.0f, v[l] = float(l % 3) - 0.2f / 16.0f;
+            Float expected[4];
+            textures.height.sample(load(u), load(v), Float(0.0f), expected);
+            const Lanes want = lanes(expected[0]), got = lanes(surface.height(load(u), load(v), Float(0.0f)));
+            Lanes bound_got{};
+            bool bound = false;
+            surface.with_height<false>([&](const auto& fetch) {
+              bound = requires { fetch.footprints; };
+              bound_got = lanes(fetch(load(u), load(v), Float(0.0f)));
+            });
+            EXPECT_EQ(bound, footprints && inlined) << int(format) << " " << int(precision) << " " << int(math);
+            for (int l = 0; l < kLanes; ++l) {
+              ASSERT_EQ(bits(got[std::size_t(l)]), bits(want[std::size_t(l)])) << int(format) << " lane " << l;
+              ASSERT_EQ(bits(bound_got[std::size_t(l)]), bits(want[std::size_t(l)]))
+                  << int(format) << " footprints " << footprints << " lane " << l;
+            }
+          }
         }
-      }
 }
 
 // A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler (their
