@@ -50,6 +50,37 @@ inline IntMask int_mask(const Mask& m) { return reinterpret_mask<IntMask>(m); }
 inline Mask float_mask(const IntMask& m) { return reinterpret_mask<Mask>(m); }
 inline Float count(const Mask& m) { return xsimd::select(m, Float(1.0f), Float(0.0f)); }
 
+// a & ~b. SSE and AVX2 do it in one andnot instruction, but GCC builds their ~ as an xor with all-ones and does not
+// fold it into the and; AVX-512's masks are k registers (kandn). xsimd 8's bitwise_andnot is not used: it takes its
+// operands in a different order on AVX2 (~a & b) and AVX-512 (a & ~b).
+inline Mask and_not(const Mask& a, const Mask& b) {
+#if defined(__AVX512F__)
+  return a & ~b;
+#elif defined(__AVX__)
+  return Mask(_mm256_andnot_ps(static_cast<__m256>(b), static_cast<__m256>(a)));
+#else
+  return Mask(_mm_andnot_ps(static_cast<__m128>(b), static_cast<__m128>(a)));
+#endif
+}
+inline IntMask and_not(const IntMask& a, const IntMask& b) { return int_mask(and_not(float_mask(a), float_mask(b))); }
+
+// n + 1 (plus_one_where) or n - 1 (minus_one_where) in the lanes of m, n elsewhere: with SSE and AVX2 a true lane of
+// the mask is the integer -1, so one subtraction or addition; with AVX-512 one masked addition.
+inline Int plus_one_where(const Int& n, const IntMask& m) {
+#if defined(__AVX512F__)
+  return xsimd::select(m, n + Int(1), n);
+#else
+  return n - Int(typename IntMask::register_type(m));
+#endif
+}
+inline Int minus_one_where(const Int& n, const IntMask& m) {
+#if defined(__AVX512F__)
+  return xsimd::select(m, n - Int(1), n);
+#else
+  return n + Int(typename IntMask::register_type(m));
+#endif
+}
+
 // Bit i set = lane i active: the sign bits by movemask (SSE4.2, AVX2), the mask register itself (AVX-512).
 inline std::uint32_t to_bits(const Mask& m) {
 #if defined(__AVX512F__)

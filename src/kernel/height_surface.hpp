@@ -8,6 +8,7 @@
 //                                `needed` (every lane by default; the others get any value).
 // SingleLayerSurface is one height texture with its max-quadtree; BlendedSurface (kernel/blended_surface.hpp) combines
 // up to four. Both are small per-batch values; the algorithms are templates over the surface type.
+#include <array>
 #include <cstdint>
 
 #include "core/simd.hpp"
@@ -64,6 +65,34 @@ template <bool Recorded>
   return true;
 }
 
+// The decoded copy of a one-channel max chain whose level sizes are level 0's shifted right (at least 1), as QDM's
+// paired walks read it at every step: a texel's index from its level's start and level 0's wrap masks shifted by
+// the level. No table of sizes, no level clamp (a walk stays within the chain), no test of the texture's format or
+// of its decoded copy per fetch: the same texels as cell_max, in fewer instructions.
+struct MaxChainCells {
+  const Texture* texture = nullptr;  // null: not such a chain (the walks call cell_max)
+  std::int32_t width_mask = 0, height_mask = 0;  // level 0's width - 1, height - 1
+  simd::FetchPath fetch = simd::FetchPath::Portable;
+  alignas(64) std::array<std::int32_t, TextureView::kMaxLevels> start{};  // each level's first texel, decoded
+
+  // The cells of `tree` (a sampler's view of a max chain read inline, `chain`), or none.
+  MaxChainCells(const TextureSampler& tree, InlineMaxChain chain);
+
+  // The decoded texels as they are now, or null (no decoded copy: read through cell_max).
+  const float* texels() const {
+    return texture != nullptr && !texture->linear.empty() ? texture->linear.data() : nullptr;
+  }
+
+  // Cell (cx, cy) of `level` from texels(), 0 <= level < the chain's levels; indices wrap.
+  [[gnu::always_inline]] simd::Float at(const float* texels, const simd::Int& level, const simd::Int& cx,
+                                        const simd::Int& cy) const {
+    using simd::Int;
+    const Int wrap_x = Int(width_mask) >> level, wrap_y = Int(height_mask) >> level;
+    const Int index = simd::lookup16(start.data(), level) + (cy & wrap_y) * (wrap_x + Int(1)) + (cx & wrap_x);
+    return simd::load_f32(texels, index, fetch);
+  }
+};
+
 // The textures of one height layer, bound once per program to the samplers its material fixes.
 struct HeightLayerTextures {
   // height: box-filtered heights; quadtree: its max chain (power-of-two sizes), or null when the material needs
@@ -77,6 +106,7 @@ struct HeightLayerTextures {
   HeightFetch fetch;
   InlineHeight inline_height;
   InlineMaxChain inline_max_chain;
+  MaxChainCells max_chain_cells;
 };
 
 // An inline height fetch (key K) over a power-of-two texture's wrap footprints with what it reads of the texture
@@ -164,6 +194,9 @@ public:
       t.load_wrapped(level, cx, cy, texel);
     return texel[0];
   }
+
+  // The max chain's cells for QDM's paired walks (see MaxChainCells::texels()).
+  const MaxChainCells& max_chain_cells() const { return textures_->max_chain_cells; }
 
   // The highest height anywhere (a bound for early exits).
   simd::Float max_height() const { return cell_max(simd::Int(top_level()), simd::Int(0), simd::Int(0)); }

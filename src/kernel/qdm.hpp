@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "qdmr/scene/material_modes.hpp"
+#include "kernel/height_surface.hpp"
 #include "kernel/trace_ray.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::trace {
@@ -27,7 +28,12 @@ public:
               ray.du * Float(float(surface.width())), ray.dv * Float(float(surface.height()))),
         level_(top_), cx_(xsimd::to_int(xsimd::floor(grid_.x0)) >> top_),
         cy_(xsimd::to_int(xsimd::floor(grid_.y0)) >> top_),
-        stop_(xsimd::to_int(stop_level)), active_(active), loop_(cap, FetchPhase::Trace) {}
+        stop_end_(xsimd::to_int(stop_level) + Int(1)), active_(active), loop_(cap, FetchPhase::Trace) {
+    if constexpr (requires { surface.max_chain_cells(); }) {
+      texels_ = surface.max_chain_cells().texels();
+      if (texels_ != nullptr) cells_ = &surface.max_chain_cells();
+    }
+  }
   QdmWalk(const QdmWalk&) = delete;
   QdmWalk& operator=(const QdmWalk&) = delete;
 
@@ -42,33 +48,36 @@ public:
       hmax = surface_.cell_max_filtered(ray_.u0 + ray_.du * s_, ray_.v0 + ray_.dv * s_, xsimd::to_float(level_));
     else if constexpr (Recorded)
       hmax = surface_.cell_max(level_, cx_, cy_, active_);
+    else if (cells_ != nullptr)
+      hmax = cells_->at(texels_, level_, cx_, cy_);
     else
       hmax = surface_.template cell_max<false>(level_, cx_, cy_, active_);
     const Float top_depth = ds_ * (Float(1.0f) - hmax);
     const Mask below = active_ & (s_ >= top_depth);
-    const IntMask at_stop = level_ <= stop_;
-    const Mask hit = below & float_mask(at_stop);
-    active_ = active_ & ~hit;
+    const Mask at_stop = float_mask(level_ < stop_end_);
+    const Mask hit = below & at_stop;
+    active_ = simd::and_not(active_, hit);
     // Above the cell's top: advance to its top plane or its wall, whichever comes first.
-    const Mask above = active_ & ~below;
+    const Mask above = simd::and_not(active_, below);
+    const CellPlace place = cell_place(level_, cx_, cy_);
     Float tx, ty;
-    exit_walls<fp64>(level_, cx_, cy_, grid_, tx, ty);
+    exit_walls<fp64>(place, grid_, tx, ty);
     const Float t_wall = xsimd::max(xsimd::min(tx, ty), s_);
     const Mask to_plane = above & (top_depth <= t_wall);
     s_ = xsimd::select(to_plane, top_depth, s_);
     // Below the cell's top but not at the last level: descend into the child that holds the ray. On the cell's
     // top plane the ray is at its highest point: the hit at the last level, else descend now, as the next
     // iteration would after reading the same cell again (a filtered max moves with the ray: it reads again).
-    Mask descend = below & ~hit;
+    Mask descend = simd::and_not(below, hit);
     if constexpr (!V::filtered_max) {
-      const Mask plane_hit = to_plane & float_mask(at_stop);
-      active_ = active_ & ~plane_hit;
-      descend = descend | (to_plane & ~plane_hit);
+      const Mask plane_hit = to_plane & at_stop;
+      active_ = simd::and_not(active_, plane_hit);
+      descend = descend | simd::and_not(to_plane, plane_hit);
     }
     // No branch on whether any lane descends or crosses: a mispredicted one would also throw away the other
     // walk's steps in flight (qdm_pair).
-    descend_to_child<fp64>(int_mask(descend), s_, grid_, level_, cx_, cy_);
-    const Mask cross = above & ~to_plane;
+    descend_to_child<fp64>(int_mask(descend), s_, place, grid_, level_, cx_, cy_);
+    const Mask cross = simd::and_not(above, to_plane);
     s_ = xsimd::select(cross, t_wall, s_);
     const IntMask cross_i = int_mask(cross);
     const IntMask cross_x = cross_i & int_mask(tx <= ty);
@@ -89,7 +98,7 @@ public:
     // while the wall just crossed is also a wall of the parent.
     if constexpr (V::level_up == QdmLevelUp::One) {
       const IntMask up = cross_i & (level_ < Int(top_));
-      level_ = xsimd::select(up, level_ + Int(1), level_);
+      level_ = simd::plus_one_where(level_, up);
       cx_ = xsimd::select(up, cx_ >> 1, cx_);
       cy_ = xsimd::select(up, cy_ >> 1, cy_);
     } else if constexpr (V::level_up == QdmLevelUp::Aligned) {
@@ -108,10 +117,13 @@ private:
   const int top_;
   const GridRay grid_;  // the ray in texels per unit of depth
   Int level_, cx_, cy_;
-  const Int stop_;
+  const Int stop_end_;  // one past the last level (stop_level): a lane below it is at its last level
   Float s_ = Float(0.0f);
   Mask active_;
   CappedLoop<Recorded> loop_;
+  // The max chain read inline by unrecorded walks (MaxChainCells), or null: through the surface's cell_max.
+  const MaxChainCells* cells_ = nullptr;
+  const float* texels_ = nullptr;
 };
 
 template <class V, class Surface>

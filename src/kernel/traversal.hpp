@@ -33,7 +33,7 @@ public:
     const simd::IntMask running = simd::int_mask(active) & (done_ < cap_);
     active = simd::float_mask(running);
     if (!xsimd::any(active)) return false;
-    done_ += xsimd::select(running, simd::Int(1), simd::Int(0));
+    done_ = simd::plus_one_where(done_, running);
     lanes_.narrow(active);
     return true;
   }
@@ -80,7 +80,7 @@ struct GridRay {
         neg_x(dx < simd::Float(0.0f)), neg_y(dy < simd::Float(0.0f)), flat_x(dx == simd::Float(0.0f)),
         flat_y(dy == simd::Float(0.0f)), exit_x(xsimd::select(pos_x, simd::Int(1), simd::Int(0))),
         exit_y(xsimd::select(pos_y, simd::Int(1), simd::Int(0))), step_x(exit_x + exit_x - simd::Int(1)),
-        step_y(exit_y + exit_y - simd::Int(1)),
+        step_y(exit_y + exit_y - simd::Int(1)), exit_fx(xsimd::to_float(exit_x)), exit_fy(xsimd::to_float(exit_y)),
         regular(xsimd::all(~(flat_x | flat_y) & finite(inv_dx) & finite(inv_dy) & finite(x0) & finite(y0))) {}
 
   simd::Float x0, y0, dx, dy;
@@ -90,6 +90,7 @@ struct GridRay {
   simd::Mask flat_x, flat_y;   // dx == 0, dy == 0: parallel to that axis's walls
   simd::Int exit_x, exit_y;    // 1 where the index steps up, else 0: the exit wall of cell c is c + exit
   simd::Int step_x, step_y;    // +1 where the index steps up, else -1: the cell after an exit wall is c + step
+  simd::Float exit_fx, exit_fy;  // exit_x, exit_y as floats
   // Every lane has a finite origin and a nonzero direction with finite reciprocals in both axes, so no crossing
   // is NaN or parallel: the cell stepping can skip the parallel lanes' rules (the same results for such rays).
   bool regular;
@@ -98,18 +99,26 @@ private:
   static simd::Mask finite(const simd::Float& f) { return xsimd::abs(f) <= simd::Float(3.4028235e38f); }
 };
 
-// Moves the `descend` lanes from cell (cx, cy) of `level` to the child holding the ray at t: t is compared with
-// where the ray crosses the parent's mid lines, computed exactly as wall crossings are, so a ray standing on a wall
-// is never put back into the cell it just left. t is never NaN.
+// Cell (cx, cy) of `level` in texel units: its indices as floats and its side 2^level, which its walls and mid
+// lines are computed from: (c + 1/2) 2^level and (c + exit) 2^level are exact while |c| < 2^23 (8 M texels; fp32
+// positions that far out have no fraction left anyway).
+struct CellPlace {
+  simd::Float x, y, size;
+};
+inline CellPlace cell_place(const simd::Int& level, const simd::Int& cx, const simd::Int& cy) {
+  return {xsimd::to_float(cx), xsimd::to_float(cy), xsimd::to_float(simd::Int(1) << level)};
+}
+
+// Moves the `descend` lanes from their cell (`place`, at `level` >= 1) to the child holding the ray at t: t is
+// compared with where the ray crosses the cell's mid lines, computed exactly as wall crossings are, so a ray standing
+// on a wall is never put back into the cell it just left. t is never NaN.
 template <bool Fp64 = false>
-inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const GridRay& ray, simd::Int& level,
-                             simd::Int& cx, simd::Int& cy) {
+inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const CellPlace& place,
+                             const GridRay& ray, simd::Int& level, simd::Int& cx, simd::Int& cy) {
   using simd::Float;
   using simd::Int;
-  const Int child_level = xsimd::max(level - Int(1), Int(0));
-  const Float child_cell = xsimd::to_float(Int(1) << child_level);
-  const Float mid_x = xsimd::to_float(cx * Int(2) + Int(1)) * child_cell;
-  const Float mid_y = xsimd::to_float(cy * Int(2) + Int(1)) * child_cell;
+  const Float mid_x = (place.x + Float(0.5f)) * place.size;  // (2 cx + 1) 2^(level - 1), exactly
+  const Float mid_y = (place.y + Float(0.5f)) * place.size;
   const Float tx = crossing<Fp64>(mid_x, ray.x0, ray.dx, ray.inv_dx);
   const Float ty = crossing<Fp64>(mid_y, ray.y0, ray.dy, ray.inv_dy);
   Int high_x, high_y;  // 1 for the child on the high side of the mid line
@@ -125,28 +134,35 @@ inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t,
     high_x = xsimd::select(simd::int_mask(hx), Int(1), Int(0));
     high_y = xsimd::select(simd::int_mask(hy), Int(1), Int(0));
   }
-  cx = xsimd::select(descend, cx * Int(2) + high_x, cx);
-  cy = xsimd::select(descend, cy * Int(2) + high_y, cy);
-  level = xsimd::select(descend, child_level, level);
+  cx = xsimd::select(descend, cx + cx + high_x, cx);
+  cy = xsimd::select(descend, cy + cy + high_y, cy);
+  level = simd::minus_one_where(level, descend);
+}
+template <bool Fp64 = false>
+inline void descend_to_child(const simd::IntMask& descend, const simd::Float& t, const GridRay& ray, simd::Int& level,
+                             simd::Int& cx, simd::Int& cy) {
+  descend_to_child<Fp64>(descend, t, cell_place(level, cx, cy), ray, level, cx, cy);
 }
 
-// Where the ray crosses the exit walls of cell (cx, cy) of `level` (the walls ahead in each axis), as t; infinity
-// in an axis the ray is parallel to.
+// Where the ray crosses the exit walls of cell `place` (the walls ahead in each axis), as t; infinity in an axis
+// the ray is parallel to.
 template <bool Fp64 = false>
-inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const GridRay& ray,
-                       simd::Float& tx, simd::Float& ty) {
+inline void exit_walls(const CellPlace& place, const GridRay& ray, simd::Float& tx, simd::Float& ty) {
   using simd::Float;
-  using simd::Int;
   const Float inf(std::numeric_limits<float>::infinity());
-  const Float cell = xsimd::to_float(Int(1) << level);
-  const Float wall_x = xsimd::to_float(cx + ray.exit_x) * cell;
-  const Float wall_y = xsimd::to_float(cy + ray.exit_y) * cell;
+  const Float wall_x = (place.x + ray.exit_fx) * place.size;
+  const Float wall_y = (place.y + ray.exit_fy) * place.size;
   tx = crossing<Fp64>(wall_x, ray.x0, ray.dx, ray.inv_dx);
   ty = crossing<Fp64>(wall_y, ray.y0, ray.dy, ray.inv_dy);
   if (!ray.regular) {
     tx = xsimd::select(ray.flat_x, inf, tx);
     ty = xsimd::select(ray.flat_y, inf, ty);
   }
+}
+template <bool Fp64 = false>
+inline void exit_walls(const simd::Int& level, const simd::Int& cx, const simd::Int& cy, const GridRay& ray,
+                       simd::Float& tx, simd::Float& ty) {
+  exit_walls<Fp64>(cell_place(level, cx, cy), ray, tx, ty);
 }
 
 // After a wall crossing, the `climbing` lanes go up while the wall just crossed (cross_x / cross_y) is also a
