@@ -109,21 +109,20 @@ struct HeightLayerTextures {
   MaxChainCells max_chain_cells;
 };
 
-// An inline height fetch (key K) over a power-of-two texture's wrap footprints with what it reads of the texture
-// read once, when it is made: a loop that takes one before it keeps them in registers (through the surface's
-// pointer, the loop reads them again at every step). Never recorded.
+// An inline height fetch (key K) over a power-of-two texture's wrap footprints at finite coordinates, with what it
+// reads of the texture read once, when it is made: a loop that takes one before it keeps them in registers
+// (through the surface's pointer, the loop reads them again at every step). Never recorded.
 template <SamplerKey K>
 struct FootprintHeight {
   explicit FootprintHeight(const TextureView& view)
       : footprints(view.texture().wrap_footprints.data()), level0(sampling_code::level_zero(view)),
-        w(xsimd::to_float(level0.width)), h(xsimd::to_float(level0.height)), first(view.first_texel()[0]) {}
+        w(xsimd::to_float(level0.width)), h(xsimd::to_float(level0.height)) {}
   [[gnu::always_inline]] simd::Float operator()(const simd::Float& u, const simd::Float& v, const simd::Float&) const {
-    return sampling_code::sample_wrap_footprints<K>(footprints, level0, w, h, first, u, v);
+    return sampling_code::sample_wrap_footprints<K>(footprints, level0, w, h, u, v);
   }
   const float* footprints;
   sampling_code::LevelInfo level0;
   simd::Float w, h;
-  float first;
 };
 
 class SingleLayerSurface {
@@ -165,11 +164,12 @@ public:
   }
 
   // Calls f(fetch) with fetch(u, v, lod) = height<Recorded>(u, v, lod), the same bits: a FootprintHeight where the
-  // heights are inline and have wrap footprints (and no recorder listens), for a loop in f to take before it starts.
+  // heights are inline and have wrap footprints, no recorder listens and the caller knows that every coordinate
+  // it will fetch at (in the lanes it reads) is finite (`finite`), for a loop in f to take before it starts.
   template <bool Recorded, class F>
-  [[gnu::always_inline]] void with_height(const F& f) const {
+  [[gnu::always_inline]] void with_height(bool finite, const F& f) const {
     const TextureSampler& t = textures_->height;
-    if (!Recorded && t.view().power_of_two() && !t.texture().wrap_footprints.empty()) {
+    if (!Recorded && finite && t.view().power_of_two() && !t.texture().wrap_footprints.empty()) {
       switch (textures_->inline_height) {
         case InlineHeight::BilinearR16: return f(FootprintHeight<inline_height_key(TexelFormat::R16)>(t.view()));
         case InlineHeight::BilinearR8: return f(FootprintHeight<inline_height_key(TexelFormat::R8)>(t.view()));

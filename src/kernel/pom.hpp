@@ -19,7 +19,9 @@ Hit pom(const Surface& surface, const Ray& ray, const Float& ds,
   Float prev_s(0.0f), prev_gap(0.0f), s_hit = ds, iterations(0.0f);
   LoopLanes<Recorded> lanes(FetchPhase::Trace);
   lanes.narrow(active);
-  with_surface_height<Recorded>(surface, [&](const auto& height) __attribute__((always_inline)) {
+  // Only the running lanes' fetches matter, at s in [0, ds] (i <= n).
+  const bool finite = finite_along(ray, ds, active);
+  with_surface_height<Recorded>(surface, finite, [&](const auto& height) __attribute__((always_inline)) {
     // gap = surface depth - ray depth: > 0 while the ray is above the surface.
     {
       const Float gap0 = ds * (Float(1.0f) - height(ray.u0, ray.v0, lod));

@@ -54,7 +54,9 @@ template <bool Recorded, class Surface>
 Hit relief(const Surface& surface, const Ray& ray, const Float& ds, const Float& lod, Mask active,
            const TraceParams& technique) {
   Hit hit;
-  with_surface_height<Recorded>(surface, [&](const auto& height) __attribute__((always_inline)) {
+  // s, lo, hi and the midpoints stay in [0, ds]; in every lane (the binary search runs in lanes never active)
+  const bool finite = finite_along(ray, ds, Mask(true));
+  with_surface_height<Recorded>(surface, finite, [&](const auto& height) __attribute__((always_inline)) {
     ReliefBracket b = relief_linear<Recorded>(height, ray, ds, lod, active, technique);
     LoopLanes<Recorded> search_lanes(FetchPhase::Refine);
     for (int i = 0; i < technique.binary_steps && xsimd::any(b.searching); ++i) {
@@ -73,7 +75,8 @@ template <class Surface>
 void relief_pair(const Surface& surface, const TraceParams& technique, const Ray& ray_a, const Float& ds_a,
                  const Float& lod_a, Mask active_a, Hit& hit_a, const Ray& ray_b, const Float& ds_b,
                  const Float& lod_b, Mask active_b, Hit& hit_b) {
-  with_surface_height<false>(surface, [&](const auto& height) __attribute__((always_inline)) {
+  const bool finite = finite_along(ray_a, ds_a, Mask(true)) && finite_along(ray_b, ds_b, Mask(true));  // as relief()'s
+  with_surface_height<false>(surface, finite, [&](const auto& height) __attribute__((always_inline)) {
     ReliefBracket a = relief_linear<false>(height, ray_a, ds_a, lod_a, active_a, technique);
     ReliefBracket b = relief_linear<false>(height, ray_b, ds_b, lod_b, active_b, technique);
     const bool search_a = xsimd::any(a.searching), search_b = xsimd::any(b.searching);  // fixed through the search

@@ -292,26 +292,24 @@ QDMR_SAMPLER_INLINE void fetch_wrap_footprints(const TextureView& view, const Sa
 }
 
 // Channel 0 of sample_with() for a bilinear key with wrap addressing on a power-of-two texture with wrap footprints
-// (never recorded), from values of the texture that the caller reads once: footprints (Texture::wrap_footprints),
-// level 0's size as integers and floats, and the first texel's channel 0. sample_levels(), bilinear_taps(),
-// fetch_wrap_footprints() and filter_taps() in one line, so the same bits.
+// (never recorded) at finite coordinates, from values of the texture that the caller reads once: footprints
+// (Texture::wrap_footprints) and level 0's size as integers and floats. sample_levels(), bilinear_taps(),
+// fetch_wrap_footprints() and filter_taps() in one line without the test for non-finite coordinates, so the same
+// bits where u and v are finite; elsewhere any value (the addresses stay in the level: indices wrap by masking).
 template <SamplerKey K>
 QDMR_SAMPLER_INLINE Float sample_wrap_footprints(const float* footprints, const LevelInfo& level0, const Float& w,
-                                                 const Float& h, float first, const Float& u, const Float& v) {
+                                                 const Float& h, const Float& u, const Float& v) {
   static_assert(K.filter == Filter::Bilinear && K.address == AddressMode::Wrap && channel_count(K.format) == 1);
-  const Mask finite = is_finite(u) & is_finite(v);
-  const Float ru = reduce(xsimd::select(finite, u, Float(0.0f)), K.address);
-  const Float rv = reduce(xsimd::select(finite, v, Float(0.0f)), K.address);
   Int x0, y0;
   Float wx, wy;
-  split(ru, w, true, 0.5f, K.fraction_bits, K.exact_texel, x0, wx);
-  split(rv, h, true, 0.5f, K.fraction_bits, K.exact_texel, y0, wy);
+  split(reduce(u, K.address), w, true, 0.5f, K.fraction_bits, K.exact_texel, x0, wx);
+  split(reduce(v, K.address), h, true, 0.5f, K.fraction_bits, K.exact_texel, y0, wy);
   const Int xa = address(x0, level0.width, K.address, true), ya = address(y0, level0.height, K.address, true);
   Float t[4];  // (xa, ya), (xb, ya), (xa, yb), (xb, yb)
   simd::load_f32x4(footprints, (ya * level0.width + xa) * Int(4), K.fetch, t);
   const Float top = t[0] + (t[1] - t[0]) * wx;
   const Float bottom = t[2] + (t[3] - t[2]) * wx;
-  return xsimd::select(finite, top + (bottom - top) * wy, Float(first));
+  return top + (bottom - top) * wy;
 }
 
 QDMR_SAMPLER_INLINE void sample_level(const TextureView& view, const SamplerKey& k, const Float& u, const Float& v,

@@ -45,12 +45,22 @@ template <bool Recorded, class Surface>
     return surface.height(u, v, lod);
 }
 
-// Calls f(fetch) with fetch(u, v, lod) = surface_height<Recorded>(surface, u, v, lod): the surface's fetch made once
-// for the loop in f where it offers one (SingleLayerSurface::with_height).
+// Whether u0 + du s and v0 + dv s are finite in the active lanes for every s with |s| <= 2 |ds|: all are far below
+// the float range (a NaN fails the comparisons). The loops that step s through [0, ds] fetch only finite coordinates.
+inline bool finite_along(const Ray& ray, const Float& ds, const Mask& active) {
+  const Float far(0x1p100f);
+  const Mask finite = (xsimd::abs(ray.u0) < far) & (xsimd::abs(ray.v0) < far) & (xsimd::abs(ray.du) < far) &
+                      (xsimd::abs(ray.dv) < far) & (xsimd::abs(ds) < Float(0x1p20f));
+  return xsimd::all(finite | ~active);
+}
+
+// Calls f(fetch) with fetch(u, v, lod) = surface_height<Recorded>(surface, u, v, lod) in the lanes the loop in f
+// reads: the surface's fetch made once for that loop where it offers one (SingleLayerSurface::with_height).
+// finite: every coordinate the loop fetches at in those lanes is finite (finite_along).
 template <bool Recorded, class Surface, class F>
-[[gnu::always_inline]] inline void with_surface_height(const Surface& surface, const F& f) {
-  if constexpr (requires { surface.template with_height<Recorded>(f); })
-    surface.template with_height<Recorded>(f);
+[[gnu::always_inline]] inline void with_surface_height(const Surface& surface, bool finite, const F& f) {
+  if constexpr (requires { surface.template with_height<Recorded>(finite, f); })
+    surface.template with_height<Recorded>(finite, f);
   else
     f([&](const Float& u, const Float& v, const Float& lod)
           __attribute__((always_inline)) { return surface_height<Recorded>(surface, u, v, lod); });
