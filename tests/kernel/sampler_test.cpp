@@ -13,6 +13,7 @@
 #include "texture/twin_texels.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/sampler.hpp"
+#include "kernel/trace_ray.hpp"
 #include "texture/sampler_test_util.hpp"
 
 namespace qdmr {
@@ -730,6 +731,29 @@ TEST(TextureSampler, SurfaceHeightIsTheHeightSamplers) {
             }
           }
         }
+}
+
+// trace::finite_along, which lets relief's and POM's loops take the fetch without the non-finite test: true only
+// where every lane it checks has a ray far inside the float range (NaN, infinite and huge values fail; unchecked
+// lanes may hold anything).
+TEST(TextureSampler, FiniteAlongOnlyForRaysFarInsideTheFloatRange) {
+  const auto ray_with = [](int field, float value) {
+    std::array<Lanes, 4> f;  // u0, v0, du, dv
+    for (Lanes& l : f) l.fill(0.5f);
+    if (field < 4) f[std::size_t(field)][0] = value;
+    return trace::Ray{load(f[0]), load(f[1]), load(f[2]), load(f[3])};
+  };
+  const simd::Mask all(true), not_lane0 = ~simd::from_bits(1u);
+  EXPECT_TRUE(trace::finite_along(ray_with(4, 0.0f), Float(0.3f), all));
+  for (const float bad : {kNaN, kInf, -kInf, 1e35f})
+    for (int field = 0; field <= 4; ++field) {
+      Lanes ds;
+      ds.fill(0.3f);
+      if (field == 4) ds[0] = bad;
+      const trace::Ray ray = ray_with(field, bad);
+      EXPECT_FALSE(trace::finite_along(ray, load(ds), all)) << field << " " << bad;
+      EXPECT_TRUE(trace::finite_along(ray, load(ds), not_lane0)) << field << " " << bad;
+    }
 }
 
 // A TwinSampler (albedo and normal map sampled at one UV) gives each texture the bits of its own TextureSampler (their
