@@ -98,6 +98,7 @@ TextureAddressMap cache_address_map(const FramePlan& plan, const Assets& assets)
     for (const LayerPlan& l : m.layers) {
       texture(l.albedo, false);
       texture(l.normal, false);
+      texture(l.orm, false);
       texture(l.height, false);
       texture(l.height_max, true);
       derived(l.ao, false);
@@ -148,7 +149,8 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       const DerivedAsset* twin = derived(l.twin);
       inputs.layers.push_back({texture(l.albedo), texture(l.normal), texture(l.height), texture(l.height_max),
                                ao ? ao->texture.get() : nullptr,
-                               twin && !twin->twin_texels->empty() ? twin->twin_texels->data() : nullptr});
+                               twin && !twin->twin_texels->empty() ? twin->twin_texels->data() : nullptr,
+                               texture(l.orm)});
     }
     if (const DerivedAsset* w = derived(m.weights); w && m.weight_mode == WeightMode::Pixel) inputs.weights = w->texture.get();
     if (const DerivedAsset* c = derived(m.combined_quadtree)) {

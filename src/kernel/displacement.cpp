@@ -56,17 +56,20 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
       reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo),
       reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(params.sampling)),
       lod_mode_(params.sampling.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
-      blend_(params.blend), shadow_(params.shadow), ao_(params.ao), lights_(lights) {
+      orm_params_(params.orm), blend_(params.blend), shadow_(params.shadow), ao_(params.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
+  if (key.orm != (inputs.layers.size() == 1 && inputs.layers[0].orm != nullptr))
+    throw Error("displacement program", "an orm texture needs the key's orm and one layer");
   SamplerState ao_sampler = sampler_;
   ao_sampler.filter = Filter::Bilinear;
   for (std::size_t i = 0; i < inputs.layers.size(); ++i) {
     const LayerInputs& l = inputs.layers[i];
     Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_, l.twin_texels), std::nullopt, std::nullopt,
-                i < params.specular.size() ? params.specular[i] : SpecularFromAlbedo{}};
+                i < params.specular.size() ? params.specular[i] : SpecularFromAlbedo{}, std::nullopt};
     if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, trace_.height_fetch);
     if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);
+    if (l.orm) layer.orm.emplace(*l.orm, sampler_);
     layers_.push_back(std::move(layer));
   }
   if (inputs.blend_ao) {
@@ -307,11 +310,13 @@ void blend_factors(BlendOperator op, float width, int count, const Float* h, con
 
 }  // namespace
 
-// The surface at the hit: where it is, its colour, normal, specular and baked AO.
+// The surface at the hit: where it is, its colour, normal, specular and baked AO; with an ORM texture, its
+// roughness and occlusion (apply_orm), else those are not read.
 struct DisplacementProgram::SurfaceAtHit {
   Hit hit;
   Float hu, hv;
   Float albedo[4], tangent_normal[3], specular = Float(0.0f), ao = Float(1.0f);
+  Float roughness, occlusion;
 };
 
 template <class V, class Surface>
@@ -349,6 +354,18 @@ void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surf
     const Layer& l = layers_[0];
     layer_colour(l.textures, d, height_map, setup.height_lod, hu, hv, albedo, tangent_normal);
     specular = specular_from_albedo(albedo, l.specular, lighting_.specular);
+    if (l.orm) {
+      // Beside the albedo: the same UV, derivatives and filter (its own LOD when it is not alike).
+      const Float lod = height_map != nullptr && l.orm->same_lod_as(*height_map) ? setup.height_lod
+                                                                                 : l.orm->lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+      Float orm[4];
+      l.orm->sample(hu, hv, lod, orm);
+      const OrmSurface s = apply_orm(orm, orm_params_, lighting_.roughness, albedo, specular);
+      for (int c = 0; c < 3; ++c) albedo[c] = s.albedo[c];
+      specular = s.specular;
+      at.roughness = s.roughness;
+      at.occlusion = s.occlusion;
+    }
     if (l.ao) ao = baked_ao(l);
   } else {
     const int count = surface.layer_count();
@@ -400,7 +417,9 @@ void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, con
   const TangentFrame& frame = setup.frame;
   const Vec3 shading_normal =
       normalize(frame.to_world({at.tangent_normal[0], at.tangent_normal[1], at.tangent_normal[2]}));
-  light(in, setup, surface, hit, at.albedo, at.specular, at.ao, shading_normal, out);
+  const bool orm = layers_[0].orm.has_value();
+  light(in, setup, surface, hit, at.albedo, at.specular, at.ao, orm ? &at.roughness : nullptr,
+        orm ? &at.occlusion : nullptr, shading_normal, out);
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
@@ -417,7 +436,8 @@ void DisplacementProgram::light_hit(const Fragments& in, const Setup& setup, con
 template <class Surface>
 void DisplacementProgram::light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
                                 const Float* albedo, const Float& specular, const Float& baked_ao,
-                                const Vec3& shading_normal, ShadeOutput& out) const {
+                                const Float* roughness, const Float* occlusion, const Vec3& shading_normal,
+                                ShadeOutput& out) const {
   const Ray& ray = setup.ray;
   const Float& ds = setup.ds;
   // Hard shadows trace the box surface, so they start from the hit on it: a refined hit between texel centres
@@ -453,10 +473,11 @@ void DisplacementProgram::light(const Fragments& in, const Setup& setup, const S
                            in.pixel_x, in.pixel_y, setup.active);
   }
   if (key_.ao != AoMode::Off) ao = apply_ao_strength(ao, ao_.strength);
+  if (occlusion) ao = ao * *occlusion;  // the ORM texture's, on top of the material's
   // The lighting AOVs: what the lighting model multiplies by, for the first directional light.
   out.shadow = shadows && !lights_.directional.empty() ? visibility[0] : Float(1.0f);
   out.ao = ao;
-  shade_lights(shading_normal, setup.frame.n, setup.view, SurfaceSample{albedo, specular, ao},
+  shade_lights(shading_normal, setup.frame.n, setup.view, SurfaceSample{albedo, specular, ao, roughness},
                shadows ? visibility : nullptr, key_.lighting, lighting_, lights_, out.color);
 }
 

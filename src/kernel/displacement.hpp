@@ -52,6 +52,7 @@ private:
     std::optional<HeightLayerTextures> height;  // and its max chain
     std::optional<TextureSampler> ao;          // bilinear
     SpecularFromAlbedo specular;
+    std::optional<TextureSampler> orm;         // occlusion, roughness, metalness (ProgramKey::orm)
   };
   // What shade() computes before the surface is known: the frame, the ray and its depth range (the only one).
   struct Setup;
@@ -120,7 +121,8 @@ private:
   template <class Surface>
   void light(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
              const simd::Float* albedo, const simd::Float& specular, const simd::Float& baked_ao,
-             const shading::Vec3& shading_normal, ShadeOutput& out) const;
+             const simd::Float* roughness, const simd::Float* occlusion, const shading::Vec3& shading_normal,
+             ShadeOutput& out) const;
   // Calls per_lane(lane, ray in the reference's UV, its hit) for each covered lane.
   template <class PerLane>
   void trace_reference(const Ray& ray, const simd::Float& depth_scale, const simd::Mask& covered,
@@ -149,6 +151,7 @@ private:
   ProgramKey key_;
   TraceParams trace_;
   LightingParams lighting_;
+  OrmParams orm_params_;
   BlendParams blend_;
   ShadowParams shadow_;
   AoParams ao_;

@@ -25,8 +25,9 @@ public:
       if (inputs.layers.size() != 1 || params.specular.size() != 1)
         throw Error("normal mapping program", "needs one layer");
       const LayerInputs& l = inputs.layers[0];
-      return std::make_unique<NormalMappingProgram>(variant_name(key), *l.albedo, *l.normal, l.twin_texels,
-                                                    params.sampling, key.lighting, params.lighting,
+      if (key.orm != (l.orm != nullptr)) throw Error("normal mapping program", "the key's orm and the inputs' differ");
+      return std::make_unique<NormalMappingProgram>(variant_name(key), *l.albedo, *l.normal, l.twin_texels, l.orm,
+                                                    params.orm, params.sampling, key.lighting, params.lighting,
                                                     params.specular[0], lights);
     }
     return std::make_unique<DisplacementProgram>(inputs, key, params, lights);

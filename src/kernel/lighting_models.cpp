@@ -3,12 +3,14 @@
 namespace qdmr::QDMR_ISA_NAMESPACE::shading {
 namespace {
 
-// pi * D * Vis * F * n.l of the header, for one light.
+// pi * D * Vis * F * n.l of the header, for one light. Roughness: one float for the batch, or a Float per lane (the
+// same operations, lane by lane).
+template <class Roughness>
 Float cook_torrance(const Float& n_dot_l, const Float& n_dot_v, const Float& n_dot_h, const Float& v_dot_h,
-                    const Float& f0, float roughness) {
+                    const Float& f0, const Roughness& roughness) {
   const Float one(1.0f);
-  const float alpha = roughness * roughness;
-  const Float a2(alpha * alpha), one_minus_a2(1.0f - alpha * alpha);
+  const Roughness alpha = roughness * roughness;
+  const Float a2(alpha * alpha), one_minus_a2(Roughness(1.0f) - alpha * alpha);
   const Float d_root = n_dot_h * n_dot_h * (a2 - one) + one;  // >= alpha^2 > 0
   const Float d = a2 / (d_root * d_root);                     // pi * D
   const Float lambda_v = n_dot_l * xsimd::sqrt(n_dot_v * n_dot_v * one_minus_a2 + a2);
@@ -21,11 +23,10 @@ Float cook_torrance(const Float& n_dot_l, const Float& n_dot_v, const Float& n_d
   return d * vis * fresnel * n_dot_l;
 }
 
-}  // namespace
-
-void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
-                  const Float* light_visibility, LightingModel model, const LightingParams& lighting, const LightRig& lights,
-                  Float* color) {
+template <class Roughness>
+void shade_lights_with(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view,
+                       const SurfaceSample& surface, const Float* light_visibility, LightingModel model,
+                       const LightingParams& lighting, const Roughness& roughness, const LightRig& lights, Float* color) {
   const Float zero(0.0f);
   Float diffuse[3] = {Float(lights.ambient.x) * surface.ambient_occlusion, Float(lights.ambient.y) * surface.ambient_occlusion,
                       Float(lights.ambient.z) * surface.ambient_occlusion};
@@ -40,7 +41,7 @@ void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, cons
     const Float facing = xsimd::select(dot(geometric_normal, l) > zero, Float(1.0f), zero);
     Float spec = cook_torrance_model
                      ? cook_torrance(n_dot_l, n_dot_v, xsimd::max(dot(shading_normal, h), zero),
-                                     xsimd::max(dot(view, h), zero), surface.specular, lighting.roughness) *
+                                     xsimd::max(dot(view, h), zero), surface.specular, roughness) *
                            facing
                      : detmath::pow_uniform(xsimd::max(dot(shading_normal, h), zero), lighting.shininess) *
                            surface.specular * facing * xsimd::min(n_dot_l * Float(8.0f), Float(1.0f));
@@ -55,6 +56,32 @@ void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, cons
     }
   }
   for (int c = 0; c < 3; ++c) color[c] = surface.albedo[c] * diffuse[c] + specular[c];
+}
+
+}  // namespace
+
+void shade_lights(const Vec3& shading_normal, const Vec3& geometric_normal, const Vec3& view, const SurfaceSample& surface,
+                  const Float* light_visibility, LightingModel model, const LightingParams& lighting, const LightRig& lights,
+                  Float* color) {
+  if (surface.roughness && model == LightingModel::CookTorrance)
+    shade_lights_with(shading_normal, geometric_normal, view, surface, light_visibility, model, lighting,
+                      *surface.roughness, lights, color);
+  else
+    shade_lights_with(shading_normal, geometric_normal, view, surface, light_visibility, model, lighting,
+                      lighting.roughness, lights, color);
+}
+
+OrmSurface apply_orm(const Float* orm, const OrmParams& params, float lighting_roughness, const Float* albedo,
+                     const Float& specular) {
+  const Float one(1.0f);
+  OrmSurface s;
+  const Float metal = orm[2] * Float(params.metallic);
+  const Float luminance = Float(0.2126f) * albedo[0] + Float(0.7152f) * albedo[1] + Float(0.0722f) * albedo[2];
+  for (int c = 0; c < 3; ++c) s.albedo[c] = albedo[c] * (one - metal);
+  s.specular = specular + (luminance - specular) * metal;
+  s.roughness = xsimd::max(orm[1] * Float(lighting_roughness), Float(0.02f));
+  s.occlusion = one + Float(params.occlusion_strength) * (orm[0] - one);
+  return s;
 }
 
 Float specular_from_albedo(const Float* albedo, const SpecularFromAlbedo& coeffs, float fallback) {

@@ -22,7 +22,19 @@ struct SurfaceSample {
   const Float* albedo;      // 3 channels, linear RGB
   Float specular;           // Blinn-Phong: highlight scale; Cook-Torrance: F0 (reflectance at normal incidence)
   Float ambient_occlusion;  // multiplies the ambient light; 1 = open
+  const Float* roughness = nullptr;  // Cook-Torrance: per lane (apply_orm), or null for LightingParams::roughness
 };
+
+// What an ORM sample (R occlusion, G roughness, B metalness; ProgramKey::orm) makes of a surface, per lane: metalness
+// m = B * metallic scales the albedo by 1 - m and moves the specular (F0) from `specular`, the dielectric's, towards
+// the albedo's Rec. 709 luminance: F0 = specular + (luminance - specular) m (a scalar F0: qdmr's specular light is
+// untinted); roughness = max(G * lighting_roughness, 0.02) (GGX's alpha^2 must stay > 0); the ambient occlusion
+// `occlusion` = 1 + occlusion_strength (R - 1). With (1, 1, 1) and metallic 0 every value is the one it replaces, bit for bit.
+struct OrmSurface {
+  Float albedo[3], specular, roughness, occlusion;
+};
+OrmSurface apply_orm(const Float* orm, const OrmParams& params, float lighting_roughness, const Float* albedo,
+                     const Float& specular);
 
 // light_visibility: one factor per directional light of the rig (1 = lit, 0 = shadowed), or nullptr for all lit.
 // LightingParams::specular is not read: the caller puts it (or specular_from_albedo) into surface.specular.

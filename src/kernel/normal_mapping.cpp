@@ -7,9 +7,9 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 
 using namespace shading;
 
-// One batch's texture samples: albedo and the tangent-space normal at the batch's UVs.
+// One batch's texture samples: albedo and the tangent-space normal at the batch's UVs (and the ORM texture's).
 struct NormalMappingProgram::Samples {
-  Float albedo[4], tangent_normal[4];
+  Float albedo[4], tangent_normal[4], orm[4];
 };
 
 UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
@@ -62,11 +62,18 @@ Float NormalMappingProgram::normal_lod(const UvDerivatives& d, const Float& albe
   return textures_.second().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
+Float NormalMappingProgram::orm_lod(const UvDerivatives& d, const Float& albedo_lod) const {
+  if (orm_->same_lod_as(textures_.first())) return albedo_lod;
+  return orm_->lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
+}
+
+template <bool Orm>
 void NormalMappingProgram::sample(const Fragments& in, const UvDerivatives& d, const Float& albedo_lod,
                                   Samples& out) const {
   const UvAhead ahead = d.quad_below();
   textures_.sample(in.varyings[kU], in.varyings[kV], albedo_lod, normal_lod(d, albedo_lod), out.albedo,
                    out.tangent_normal, &ahead);
+  if constexpr (Orm) orm_->sample(in.varyings[kU], in.varyings[kV], orm_lod(d, albedo_lod), out.orm);
 }
 
 namespace {
@@ -79,38 +86,57 @@ Vec3 shading_normal_of(const TangentFrame& frame, const Float* tangent_normal) {
 
 }  // namespace
 
+template <bool Orm>
 void NormalMappingProgram::light(const Fragments& in, const Samples& s, const TangentFrame& frame,
                                  const Vec3& shading_normal, const Vec3& view, ShadeOutput& out) const {
-  shade_lights(shading_normal, frame.n, view,
-               SurfaceSample{s.albedo, specular_from_albedo(s.albedo, specular_, lighting_.specular), Float(1.0f)},
-               nullptr, lighting_model_, lighting_, lights_, out.color);
+  const Float specular = specular_from_albedo(s.albedo, specular_, lighting_.specular);
+  if constexpr (Orm) {
+    const OrmSurface orm = apply_orm(s.orm, orm_params_, lighting_.roughness, s.albedo, specular);
+    shade_lights(shading_normal, frame.n, view, SurfaceSample{orm.albedo, orm.specular, orm.occlusion, &orm.roughness},
+                 nullptr, lighting_model_, lighting_, lights_, out.color);
+    out.ao = orm.occlusion;
+  } else {
+    shade_lights(shading_normal, frame.n, view, SurfaceSample{s.albedo, specular, Float(1.0f)}, nullptr,
+                 lighting_model_, lighting_, lights_, out.color);
+    out.ao = Float(1.0f);  // no AO
+  }
   out.normal[0] = shading_normal.x;
   out.normal[1] = shading_normal.y;
   out.normal[2] = shading_normal.z;
   out.iterations = out.hit_depth = out.error_texels = out.missed = Float(0.0f);
-  out.shadow = out.ao = Float(1.0f);  // no self-shadowing, no AO
+  out.shadow = Float(1.0f);  // no self-shadowing
   out.hit_u = in.varyings[kU];
   out.hit_v = in.varyings[kV];
 }
 
 void NormalMappingProgram::shade(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  int k = 0;
-  for (; k + 1 < n; k += 2) shade_pair(*in[k], *out[k], *in[k + 1], *out[k + 1]);
-  if (k < n) shade_batch(*in[k], *out[k]);
+  if (orm_)
+    shade_batches<true>(in, out, n);
+  else
+    shade_batches<false>(in, out, n);
 }
 
+template <bool Orm>
+void NormalMappingProgram::shade_batches(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  int k = 0;
+  for (; k + 1 < n; k += 2) shade_pair<Orm>(*in[k], *out[k], *in[k + 1], *out[k + 1]);
+  if (k < n) shade_batch<Orm>(*in[k], *out[k]);
+}
+
+template <bool Orm>
 void NormalMappingProgram::shade_batch(const Fragments& in, ShadeOutput& out) const {
   Samples s;
   const UvDerivatives d = derivatives(in);
-  sample(in, d, albedo_lod(d), s);
+  sample<Orm>(in, d, albedo_lod(d), s);
   const TangentFrame frame = TangentFrame::from(in);
-  light(in, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(in, lights_), out);
+  light<Orm>(in, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(in, lights_), out);
 }
 
 // Stage by stage, a's and b's work side by side: each stage of one batch is a chain of dependent operations
 // (derivatives, LOD, the sample's addresses, its loads, the filter), and the other batch's same stage next to it
 // gives the core independent work to overlap with it. Sparse batches whose covered lanes fit in one run packed
 // (shade_packed).
+template <bool Orm>
 void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
                                       ShadeOutput& out_b) const {
   const UvDerivatives da = derivatives(a), db = derivatives(b);
@@ -118,7 +144,7 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
   albedo_lods(da, db, lod_a, lod_b);
   const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
   if (simd::LanePacking::fits(covered_a, covered_b)) {
-    shade_packed(a, da, lod_a, out_a, b, db, lod_b, out_b, simd::LanePacking(covered_a, covered_b));
+    shade_packed<Orm>(a, da, lod_a, out_a, b, db, lod_b, out_b, simd::LanePacking(covered_a, covered_b));
     return;
   }
   Samples sa, sb;
@@ -127,15 +153,16 @@ void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, co
   // vectors need no sample: made while the LOD's chain (a logarithm after a division) is under way.
   const TangentFrame frame_a = TangentFrame::from(a), frame_b = TangentFrame::from(b);
   const Vec3 view_a = view_vector(a, lights_), view_b = view_vector(b, lights_);
-  sample(a, da, lod_a, sa);
-  sample(b, db, lod_b, sb);
+  sample<Orm>(a, da, lod_a, sa);
+  sample<Orm>(b, db, lod_b, sb);
   const Vec3 normal_a = shading_normal_of(frame_a, sa.tangent_normal), normal_b = shading_normal_of(frame_b, sb.tangent_normal);
-  light(a, sa, frame_a, normal_a, view_a, out_a);
-  light(b, sb, frame_b, normal_b, view_b, out_b);
+  light<Orm>(a, sa, frame_a, normal_a, view_a, out_a);
+  light<Orm>(b, sb, frame_b, normal_b, view_b, out_b);
 }
 
 // Past the LODs (which read whole quads) everything is lane by lane: the covered lanes of both batches run as one
 // batch, and each batch's outputs are its own lanes back (the others are never written).
+template <bool Orm>
 void NormalMappingProgram::shade_packed(const Fragments& a, const UvDerivatives& da, const Float& lod_a,
                                         ShadeOutput& out_a, const Fragments& b, const UvDerivatives& db,
                                         const Float& lod_b, ShadeOutput& out_b, const simd::LanePacking& packing) const {
@@ -146,15 +173,18 @@ void NormalMappingProgram::shade_packed(const Fragments& a, const UvDerivatives&
   Samples s;
   textures_.sample(packed.varyings[kU], packed.varyings[kV], packing.pack(lod_a, lod_b),
                    packing.pack(normal_lod(da, lod_a), normal_lod(db, lod_b)), s.albedo, s.tangent_normal, &ahead);
+  if constexpr (Orm)
+    orm_->sample(packed.varyings[kU], packed.varyings[kV], packing.pack(orm_lod(da, lod_a), orm_lod(db, lod_b)), s.orm);
   const TangentFrame frame = TangentFrame::from(packed);
   ShadeOutput lit;
-  light(packed, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(packed, lights_), lit);
+  light<Orm>(packed, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(packed, lights_), lit);
   const auto unpack = [&](const Fragments& in, ShadeOutput& out, auto lanes) {
     out = lit;
     for (int c = 0; c < 3; ++c) {
       out.color[c] = lanes(lit.color[c]);
       out.normal[c] = lanes(lit.normal[c]);
     }
+    if constexpr (Orm) out.ao = lanes(lit.ao);
     out.hit_u = in.varyings[kU];
     out.hit_v = in.varyings[kV];
   };

@@ -1,6 +1,8 @@
 #pragma once
 // The first shading program: albedo with tangent-space normal mapping, lit by the material's lighting model
 // (lighting_models.hpp) from directional lights plus ambient.
+#include <optional>
+
 #include "kernel/lane_packing.hpp"
 #include "program/light_rig.hpp"
 #include "kernel/batch.hpp"
@@ -13,19 +15,28 @@ namespace qdmr::QDMR_ISA_NAMESPACE {
 class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
-  // twin_texels: the two maps interleaved (texture/twin_texels.hpp), or null.
+  // twin_texels: the two maps interleaved (texture/twin_texels.hpp), or null. orm: RGBA8 linear occlusion,
+  // roughness and metalness sampled beside the albedo (ProgramKey::orm), or null.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const float* twin_texels,
-                       const SamplingDesc& sampling, LightingModel lighting_model, const LightingParams& lighting,
-                       const SpecularFromAlbedo& specular, const LightRig& lights)
+                       const Texture* orm, const OrmParams& orm_params, const SamplingDesc& sampling,
+                       LightingModel lighting_model, const LightingParams& lighting, const SpecularFromAlbedo& specular,
+                       const LightRig& lights)
       : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling), twin_texels),
         lod_mode_(sampling.lod), lighting_model_(lighting_model), lighting_(lighting), specular_(specular),
-        lights_(lights) {}
+        orm_params_(orm_params), lights_(lights) {
+    if (orm) orm_.emplace(*orm, SamplerState::from(sampling));
+  }
   BatchGrouping grouping() const override { return {2, 2 * simd::kLanes}; }
   void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
 
 private:
+  // Orm: the ORM texture is sampled and applied (orm_ is set); both instantiations are made, shade() picks one.
+  template <bool Orm>
+  void shade_batches(const Fragments* const* in, ShadeOutput* const* out, int n) const;
+  template <bool Orm>
   void shade_batch(const Fragments& in, ShadeOutput& out) const;
   // Two batches, stage by stage side by side (the same results as shade_batch of each).
+  template <bool Orm>
   void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
   struct Samples;
   shading::UvDerivatives derivatives(const Fragments& in) const;
@@ -34,13 +45,17 @@ private:
   void albedo_lods(const shading::UvDerivatives& a, const shading::UvDerivatives& b, simd::Float& lod_a,
                    simd::Float& lod_b) const;
   simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  simd::Float orm_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  template <bool Orm>
   void sample(const Fragments& in, const shading::UvDerivatives& d, const simd::Float& albedo_lod,
               Samples& out) const;
   // Lights a batch whose frame, shading normal and view vector are computed (shade_pair computes two batches'
   // side by side).
+  template <bool Orm>
   void light(const Fragments& in, const Samples& samples, const shading::TangentFrame& frame,
              const shading::Vec3& shading_normal, const shading::Vec3& view, ShadeOutput& out) const;
   // shade_pair() of two batches whose covered lanes fit in one (small triangles).
+  template <bool Orm>
   void shade_packed(const Fragments& a, const shading::UvDerivatives& da, const simd::Float& lod_a, ShadeOutput& out_a,
                     const Fragments& b, const shading::UvDerivatives& db, const simd::Float& lod_b, ShadeOutput& out_b,
                     const simd::LanePacking& packing) const;
@@ -50,6 +65,8 @@ private:
   LightingModel lighting_model_;
   LightingParams lighting_;
   SpecularFromAlbedo specular_;
+  std::optional<TextureSampler> orm_;
+  OrmParams orm_params_;
   LightRig lights_;
 };
 

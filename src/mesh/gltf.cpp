@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <memory>
 #include <span>
 #include <set>
@@ -941,6 +942,42 @@ private:
     return t;
   }
 
+  // The layer's orm texture (LayerDesc::orm) from a material's metallicRoughnessTexture (G roughness, B metalness)
+  // and occlusionTexture (R): one image when both name the same; else the occlusion's R replaces the orm's (an
+  // image of another size is not applied, with a note); a missing one leaves its channels at 1.
+  void convert_orm(const tinygltf::Material& g, const std::string& at, const std::string& name, double metallic,
+                   LayerDesc& layer) {
+    const tinygltf::TextureInfo& mr = g.pbrMetallicRoughness.metallicRoughnessTexture;
+    const tinygltf::OcclusionTextureInfo& occlusion = g.occlusionTexture;
+    layer.metallic = float(metallic);
+    std::optional<ImageHeader> mr_header;
+    if (mr.index >= 0) {
+      layer.orm = texture(mr.index, at + "/pbrMetallicRoughness/metallicRoughnessTexture", false);
+      mr_header = read_image_header(layer.orm.file, where_ + ": /images");
+      if (mr_header->channels < 3) asset_.fail(at + "/pbrMetallicRoughness/metallicRoughnessTexture", "its image has fewer than 3 channels (G is roughness, B metalness)");
+    }
+    if (occlusion.index < 0) {
+      layer.occlusion.source = TextureSource::Constant;  // the metallicRoughnessTexture's R is not occlusion
+      layer.occlusion.constant = glm::vec4(1.0f);
+      return;
+    }
+    if (!(occlusion.strength >= 0.0 && occlusion.strength <= 1.0)) asset_.fail(at + "/occlusionTexture/strength", "must be in [0, 1]");
+    layer.occlusion_strength = float(occlusion.strength);
+    const TextureDesc occ = texture(occlusion.index, at + "/occlusionTexture", false);
+    if (mr_header && occ.file == layer.orm.file) return;  // one image: R occlusion, G roughness, B metalness
+    const ImageHeader occ_header = read_image_header(occ.file, where_ + ": /images");
+    if (mr_header && (occ_header.width != mr_header->width || occ_header.height != mr_header->height)) {
+      note("material '" + name + "': occlusionTexture not applied (its image is " + std::to_string(occ_header.width) +
+           "x" + std::to_string(occ_header.height) + ", the metallicRoughnessTexture's " + std::to_string(mr_header->width) +
+           "x" + std::to_string(mr_header->height) + ")");
+      layer.occlusion.source = TextureSource::Constant;
+      layer.occlusion.constant = glm::vec4(1.0f);
+      return;
+    }
+    layer.occlusion = occ;
+    layer.occlusion.channel = Channel::R;
+  }
+
   MaterialDesc convert_material(int index) {
     const tinygltf::Material& g = model_.materials[std::size_t(index)];
     const std::string at = "/materials/" + std::to_string(index);
@@ -965,6 +1002,9 @@ private:
     };
     consider("baseColorTexture", pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions);
     consider("normalTexture", g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions);
+    consider("metallicRoughnessTexture", pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+             pbr.metallicRoughnessTexture.extensions);
+    consider("occlusionTexture", g.occlusionTexture.index, g.occlusionTexture.texCoord, g.occlusionTexture.extensions);
     if (!used.empty()) {
       has_textures_ = true;
       choice = used.front().second;
@@ -977,14 +1017,19 @@ private:
     uv_choices_.resize(std::size_t(index) + 1);
     uv_choices_[std::size_t(index)] = choice;
 
+    // With a metallicRoughnessTexture or an occlusionTexture the program applies the metalness per texel (the
+    // layer's orm: diffuse times 1 - m, F0 from 0.04 towards the base colour's luminance); without, the factors are
+    // constants folded in here: the same formulas.
+    const bool orm = pbr.metallicRoughnessTexture.index >= 0 || g.occlusionTexture.index >= 0;
+    const double diffuse = orm ? 1.0 : 1.0 - metallic;
     const double f0 = 0.04 + (0.2126 * color[0] + 0.7152 * color[1] + 0.0722 * color[2] - 0.04) * metallic;
     m.lighting.roughness = float(std::clamp(roughness, 0.02, 1.0));
-    m.lighting.specular = float(f0);
+    m.lighting.specular = orm ? 0.04f : float(f0);
+    if (orm) convert_orm(g, at, m.name, metallic, layer);
     if (pbr.baseColorTexture.index >= 0) {
       // The diffuse colour: the texture times baseColorFactor, less what the metal reflects specularly.
       layer.albedo = texture(pbr.baseColorTexture.index, at + "/pbrMetallicRoughness/baseColorTexture", true);
-      layer.albedo.factor = glm::vec3(float(color[0] * (1.0 - metallic)), float(color[1] * (1.0 - metallic)),
-                                      float(color[2] * (1.0 - metallic)));
+      layer.albedo.factor = glm::vec3(float(color[0] * diffuse), float(color[1] * diffuse), float(color[2] * diffuse));
       const int sampler = model_.textures[std::size_t(pbr.baseColorTexture.index)].sampler;
       if (sampler >= 0) {
         if (std::size_t(sampler) >= model_.samplers.size())
@@ -995,21 +1040,13 @@ private:
         if (s.wrapS != s.wrapT) note("material '" + m.name + "': wrapT differs from wrapS; qdmr addresses both axes with wrapS");
       }
     } else {
-      layer.albedo.constant = glm::vec4(float(color[0] * (1.0 - metallic)), float(color[1] * (1.0 - metallic)),
-                                        float(color[2] * (1.0 - metallic)), float(color[3]));
+      layer.albedo.constant =
+          glm::vec4(float(color[0] * diffuse), float(color[1] * diffuse), float(color[2] * diffuse), float(color[3]));
     }
     if (g.normalTexture.index >= 0) {
       layer.normal = texture(g.normalTexture.index, at + "/normalTexture", false);
       if (!std::isfinite(g.normalTexture.scale)) asset_.fail(at + "/normalTexture/scale", "must be finite");
       layer.normal_strength = float(std::max(0.0, g.normalTexture.scale));
-    }
-    if (pbr.metallicRoughnessTexture.index >= 0) {
-      static_cast<void>(image_file(pbr.metallicRoughnessTexture.index, at + "/pbrMetallicRoughness/metallicRoughnessTexture"));
-      note("material '" + m.name + "': metallicRoughnessTexture not applied (its factors are)");
-    }
-    if (g.occlusionTexture.index >= 0) {
-      static_cast<void>(image_file(g.occlusionTexture.index, at + "/occlusionTexture"));
-      note("material '" + m.name + "': occlusionTexture not applied (qdmr's ambient occlusion is the material's ao block)");
     }
     double emissive_strength = 1.0;
     if (const auto it = g.extensions.find("KHR_materials_emissive_strength"); it != g.extensions.end())

@@ -68,6 +68,7 @@ std::string request_key(const TextureDesc& d, TexturePurpose purpose, const Laye
     k << ":factor" << d.factor.x << "," << d.factor.y << "," << d.factor.z;
   if (purpose == TexturePurpose::Normal)
     k << ":conv" << int(layer.normal_convention) << ":strength" << layer.normal_strength;
+  if (purpose == TexturePurpose::Orm) k << "|occlusion:" << source_key(layer.occlusion);
   // What is made from the layer's heights (a procedural albedo is coloured by its own pattern, not by them).
   if (purpose == TexturePurpose::Height || d.source == TextureSource::FromHeight) k << "|height:" << height_key(layer);
   return k.str();
@@ -105,7 +106,9 @@ std::uint64_t texture_working_bytes(const TextureRequest& r, const SourceInfo& s
   const std::uint64_t texels = std::uint64_t(r.width) * std::uint64_t(r.height);
   const std::uint64_t height_image = texels * sizeof(float), colour_image = 3 * height_image;
   std::uint64_t peak = 0;
-  if (r.purpose == TexturePurpose::Height) {
+  if (r.purpose == TexturePurpose::Orm) {
+    peak = std::max(orm_source(r.layer, r.where).build_bytes, colour_image + r.bytes);
+  } else if (r.purpose == TexturePurpose::Height) {
     // The layer's heights, then that image while the chain is made from it.
     peak = std::max(make_texture_bytes(r.desc, r.purpose, r.width, r.height, file), height_image + r.bytes);
   } else if (r.desc.source == TextureSource::FromHeight) {
@@ -181,7 +184,14 @@ int add_request(std::vector<TextureRequest>& textures, const TextureDesc& desc, 
   r.desc = desc;
   r.layer = layer;
   r.where = where;
-  const SourceInfo source = texture_source(desc, layer, where);
+  SourceInfo source;
+  if (purpose == TexturePurpose::Orm) {
+    const OrmSource orm = orm_source(layer, where);
+    source.width = orm.width;
+    source.height = orm.height;
+  } else {
+    source = texture_source(desc, layer, where);
+  }
   r.width = source.width;
   r.height = source.height;
   r.reduce = reduce;
@@ -531,6 +541,8 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
                             layer_where + "/albedo", material.name);
     lp.normal = add_request(textures, layer.normal, TexturePurpose::Normal, MipReduce::BoxNormal, layer,
                             layer_where + "/normal", material.name);
+    if (plan.key.orm)
+      lp.orm = add_request(textures, layer.orm, TexturePurpose::Orm, MipReduce::Box, layer, layer_where, material.name);
     if (displaced || blend_by_height) {
       if (layer.height.source == TextureSource::None)
         throw Error(layer_where + "/height", displaced ? std::string("technique '") + technique_name(kind) + "' needs a height map"
@@ -748,6 +760,7 @@ std::string FramePlan::describe() const {
       if (l.height >= 0) s << ", height: texture " << l.height;
       if (l.height_max >= 0) s << ", max-quadtree: texture " << l.height_max;
       if (l.ao >= 0) s << ", ao: derived " << l.ao;
+      if (l.orm >= 0) s << ", orm: texture " << l.orm;
       s << "\n";
     }
     if (m.blend)
@@ -771,6 +784,8 @@ std::string FramePlan::describe() const {
     if (t.working_bytes >= (1 << 20) / 100) s << " (" << mib(t.working_bytes) << " more while it is built)";
     s << "  <- " << t.where;
     if (t.desc.source == TextureSource::File) s << " (" << t.desc.file.filename().string() << ")";
+    if (t.purpose == TexturePurpose::Orm && t.layer.occlusion.source == TextureSource::File)
+      s << " (occlusion from " << t.layer.occlusion.file.filename().string() << ")";
     if (t.dynamic) s << ", dynamic (rebuilt every frame)";
     s << "\n";
   }
@@ -839,6 +854,7 @@ nlohmann::json FramePlan::to_json() const {
     for (const LayerPlan& l : m.layers)
       layers.push_back({{"albedo", l.albedo}, {"normal", l.normal}, {"height", l.height}, {"height_max", l.height_max},
                         {"field", l.field}, {"ao", l.ao}});
+    if (!m.layers.empty() && m.layers.front().orm >= 0) layers.front()["orm"] = m.layers.front().orm;
     j["materials"].push_back({{"name", m.name}, {"variant", m.variant}, {"technique", technique_name(m.technique)},
                               {"layers", layers}, {"reference", m.reference},
                               {"derived", {{"weights", m.weights}, {"combined_surface", m.combined_surface},

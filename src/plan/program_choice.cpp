@@ -19,6 +19,7 @@ ProgramKey program_key(const MaterialDesc& material) {
   key.ao = material.ao.mode;
   key.lighting = material.lighting.model;
   key.filter = material.sampling.filter;
+  key.orm = key.layers == 1 && material.layers.front().has_orm();
   return key;
 }
 
@@ -72,6 +73,9 @@ ProgramParams program_params(const MaterialDesc& material) {
   p.sampling = material.sampling;
   p.lighting = lighting_params(material.lighting);
   for (const LayerDesc& layer : material.layers) p.specular.push_back(layer.specular);
+  if (material.layers.size() == 1 && material.layers.front().has_orm())
+    p.orm = {.metallic = material.layers.front().metallic,
+             .occlusion_strength = material.layers.front().occlusion_strength};
   p.shadow = shadow_params(material.shadow);
   p.ao = ao_params(material.ao);
   if (material.layers.size() > 1)

@@ -20,6 +20,7 @@ struct LayerInputs {
   const Texture* height_max = nullptr;  // max-quadtree (QDM, shadows, AO); power-of-two sizes
   const Texture* ao = nullptr;          // baked AO of this layer's heights (R16), when the material bakes AO
   const float* twin_texels = nullptr;   // albedo and normal map interleaved (texture/twin_texels.hpp), or null
+  const Texture* orm = nullptr;         // RGBA8 linear: occlusion, roughness, metalness (ProgramKey::orm), or null
 };
 
 struct DisplacementInputs {

@@ -78,6 +78,7 @@ std::string variant_name(const ProgramKey& key) {
   if (key.shadow != ShadowMode::Off) variant += std::string(" | shadow ") + shadow_name(key.shadow);
   if (key.ao != AoMode::Off) variant += std::string(" | ao ") + (key.ao == AoMode::Baked ? "baked" : "frame");
   variant += std::string(" | ") + lighting_name(key.lighting) + " | " + filter_name(key.filter);
+  if (key.orm) variant += " | orm";
   return variant;
 }
 

@@ -217,7 +217,7 @@ LightsDesc read_lights(const Value& value) {
   return lights;
 }
 
-enum class Slot { Albedo, Normal, Height };
+enum class Slot { Albedo, Normal, Height, Orm, Occlusion };
 
 // Height storage: "format" (auto, r8, r16, r32f) and "compression" (none, bc3).
 void read_height_storage(const Object& object, TextureDesc& texture) {
@@ -283,9 +283,10 @@ void read_height_file(const Value& file, const std::optional<Value>& frames, Tex
 }
 
 void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
-  const Object object = slot == Slot::Albedo   ? Object(value, {"file", "channel", "srgb", "factor"})
-                        : slot == Slot::Height ? Object(value, {"file", "frames", "channel", "format", "compression"})
-                                               : Object(value, {"file"});
+  const Object object = slot == Slot::Albedo      ? Object(value, {"file", "channel", "srgb", "factor"})
+                        : slot == Slot::Height    ? Object(value, {"file", "frames", "channel", "format", "compression"})
+                        : slot == Slot::Occlusion ? Object(value, {"file", "channel"})
+                                                  : Object(value, {"file"});
   texture.source = TextureSource::File;
   if (slot == Slot::Height)
     read_height_file(object.required("file"), object.find("frames"), texture);
@@ -298,8 +299,9 @@ void read_texture_file(const Value& value, Slot slot, TextureDesc& texture) {
                                           {"a", Channel::A},
                                           {"rgb", Channel::RGB},
                                           {"rgba", Channel::RGBA}});
-    v->require(slot != Slot::Height || (texture.channel != Channel::RGB && texture.channel != Channel::RGBA),
-               "a height reads one channel: r, g, b or a");
+    v->require((slot != Slot::Height && slot != Slot::Occlusion) ||
+                   (texture.channel != Channel::RGB && texture.channel != Channel::RGBA),
+               slot == Slot::Height ? "a height reads one channel: r, g, b or a" : "an occlusion reads one channel: r, g, b or a");
   }
   if (auto v = object.find("srgb")) texture.srgb = v->boolean();
   if (auto v = object.find("factor")) texture.factor = v->color();
@@ -379,7 +381,7 @@ void read_constant(const Value& value, Slot slot, TextureDesc& texture) {
   const Object object(value, {"constant"});
   const Value constant = object.required("constant");
   texture.source = TextureSource::Constant;
-  if (slot == Slot::Height) {
+  if (slot == Slot::Height || slot == Slot::Occlusion) {
     const float h = static_cast<float>(constant.number_in(0.0, 1.0));
     texture.constant = {h, h, h, 1.0f};
     return;
@@ -394,7 +396,8 @@ void read_constant(const Value& value, Slot slot, TextureDesc& texture) {
                    std::string("expected a number or an array of 3 or 4 numbers, got ") +
                        (constant.json().is_array() ? "an array of " + std::to_string(n) : constant.json().type_name()));
   for (std::size_t i = 0; i < n; ++i)
-    texture.constant[static_cast<int>(i)] = static_cast<float>(constant.element(i).non_negative());
+    texture.constant[static_cast<int>(i)] = static_cast<float>(
+        slot == Slot::Orm ? constant.element(i).number_in(0.0, 1.0) : constant.element(i).non_negative());
 }
 
 // TEX: "path" | "from_height" (normals) | {"file": ...} | {"procedural": ...} | {"constant": ...}
@@ -421,6 +424,8 @@ TextureDesc read_texture(const Value& value, Slot slot) {
   value.require(int(file) + int(procedural) + int(constant) == 1,
                 "expected exactly one of the keys 'file', 'procedural' or 'constant'");
   value.require(slot != Slot::Normal || file, "a normal map is a file path or \"from_height\"");
+  value.require((slot != Slot::Orm && slot != Slot::Occlusion) || !procedural,
+                slot == Slot::Orm ? "an orm texture is a file path or a constant" : "an occlusion is a file path or a constant");
   if (file)
     read_texture_file(value, slot, texture);
   else if (procedural)
@@ -430,10 +435,18 @@ TextureDesc read_texture(const Value& value, Slot slot) {
   return texture;
 }
 
+// The keys of an occlusion-roughness-metal texture (LayerDesc::orm).
+void read_orm_keys(const Object& object, LayerDesc& layer) {
+  if (auto v = object.find("orm")) layer.orm = read_texture(*v, Slot::Orm);
+  if (auto v = object.find("occlusion")) layer.occlusion = read_texture(*v, Slot::Occlusion);
+  if (auto v = object.find("metallic")) layer.metallic = static_cast<float>(v->number_in(0.0, 1.0));
+  if (auto v = object.find("occlusion_strength")) layer.occlusion_strength = static_cast<float>(v->number_in(0.0, 1.0));
+}
+
 LayerDesc read_layer(const Value& value) {
   const Object object(
       value, {"albedo", "normal", "normal_convention", "normal_strength", "height", "height_scale", "height_offset",
-              "specular"});
+              "specular", "orm", "occlusion", "metallic", "occlusion_strength"});
   LayerDesc layer;
   layer.albedo.source = TextureSource::Constant;
   if (auto v = object.find("albedo")) layer.albedo = read_texture(*v, Slot::Albedo);
@@ -458,6 +471,7 @@ LayerDesc read_layer(const Value& value) {
     if (auto s = specular.find("scale")) layer.specular.scale = static_cast<float>(s->number_in(0.0, 16.0));
     if (auto s = specular.find("invert")) layer.specular.invert = s->boolean();
   }
+  read_orm_keys(object, layer);
   return layer;
 }
 
@@ -652,6 +666,9 @@ MaterialDesc read_material(const Value& value, const std::string& name) {
       !items.empty() && items.size() <= static_cast<std::size_t>(limits::kMaxLayers),
       "expected 1 to " + std::to_string(limits::kMaxLayers) + " layers, got " + std::to_string(items.size()));
   for (const Value& item : items) material.layers.push_back(read_layer(item));
+  for (std::size_t i = 0; i < items.size() && items.size() > 1; ++i)
+    for (const char* key : {"orm", "occlusion"})
+      if (auto v = items[i].member(key)) v->fail("an orm texture is read on a material of one layer, not on a blend");
 
   if (auto v = object.find("technique")) read_technique(*v, material.technique);
   if (auto v = object.find("sampling")) read_sampling(*v, material.sampling);

@@ -6,6 +6,7 @@
 #include <array>
 #include <utility>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "qdmr/core/error.hpp"
@@ -242,6 +243,55 @@ Image height_texture(const TextureDesc& desc, const LayerDesc& layer, const std:
   return out;
 }
 
+// The occlusion channel of a layer: 1 channel, its file's selected channel (default R) or its constant.
+Image occlusion_texture(const TextureDesc& desc, const std::string& where) {
+  if (desc.source == TextureSource::Constant) return constant({desc.constant.x});
+  Image file = read_image(desc.file, where);
+  const std::vector<int> channels = select_channels(file, desc.channel, 1, desc, where);
+  return pick(std::move(file), channels);
+}
+
+std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+
+// RGB of the orm texture (none: 1, 1, 1) with R from the occlusion texture when the layer has one.
+Image orm_texture(const LayerDesc& layer, const std::string& where) {
+  const TextureDesc& desc = layer.orm;
+  Image rgb;
+  switch (desc.source) {
+    case TextureSource::None: rgb = constant({1.0f, 1.0f, 1.0f}); break;
+    case TextureSource::Constant: rgb = constant({desc.constant.r, desc.constant.g, desc.constant.b}); break;
+    case TextureSource::File: {
+      Image file = read_image(desc.file, where + "/orm");
+      if (file.channels < 3)
+        throw Error(where + "/orm", "'" + desc.file.string() + "' has " + std::to_string(file.channels) +
+                                        " channel(s); an orm texture needs 3 (occlusion, roughness, metalness)");
+      rgb = pick(std::move(file), {0, 1, 2});
+      break;
+    }
+    default: throw Error(where + "/orm", "an orm texture is a file or a constant");
+  }
+  if (layer.occlusion.source == TextureSource::None) return rgb;
+  const Image occlusion = occlusion_texture(layer.occlusion, where + "/occlusion");
+  if (rgb.width == 1 && rgb.height == 1 && desc.source != TextureSource::File) {
+    // A constant orm takes the occlusion's size.
+    Image out(occlusion.width, occlusion.height, 3);
+    for (std::size_t i = 0; i < out.texels.size(); ++i) out.texels[i] = rgb.texels[i % 3];
+    rgb = std::move(out);
+  }
+  if (occlusion.width != 1 || occlusion.height != 1 || layer.occlusion.source == TextureSource::File) {
+    if (occlusion.width != rgb.width || occlusion.height != rgb.height)
+      throw Error(where + "/occlusion", "'" + layer.occlusion.file.string() + "' is " +
+                                            size_text(occlusion.width, occlusion.height) + ", the layer's orm " +
+                                            size_text(rgb.width, rgb.height) + ": they must be the same size");
+    for_rows(rgb.height, [&](int y) {
+      for (int x = 0; x < rgb.width; ++x) rgb.at(x, y, 0) = occlusion.at(x, y, 0);
+    });
+  } else {
+    for (std::size_t i = 0; i < rgb.texels.size(); i += 3) rgb.texels[i] = occlusion.texels[0];
+  }
+  return rgb;
+}
+
 }  // namespace
 
 namespace texture_detail {
@@ -264,6 +314,7 @@ const char* purpose_name(TexturePurpose purpose) {
     case TexturePurpose::Albedo: return "albedo";
     case TexturePurpose::Normal: return "normal";
     case TexturePurpose::Height: return "height";
+    case TexturePurpose::Orm: return "orm";
   }
   return "?";
 }
@@ -274,12 +325,40 @@ Image make_texture(const TextureDesc& desc, TexturePurpose purpose, const LayerD
     case TexturePurpose::Albedo: return albedo_texture(desc, where);
     case TexturePurpose::Normal: return normal_texture(desc, layer, height, where);
     case TexturePurpose::Height: return height_texture(desc, layer, where);
+    case TexturePurpose::Orm: return orm_texture(layer, where);
   }
   throw Error(where, "unknown texture purpose");
 }
 
 Image make_layer_height(const LayerDesc& layer, const std::string& where) {
   return make_texture(layer.height, TexturePurpose::Height, layer, nullptr, where);
+}
+
+OrmSource orm_source(const LayerDesc& layer, const std::string& where) {
+  std::optional<ImageHeader> orm, occlusion;
+  if (layer.orm.source == TextureSource::File) orm = read_image_header(layer.orm.file, where + "/orm/file");
+  if (layer.occlusion.source == TextureSource::File)
+    occlusion = read_image_header(layer.occlusion.file, where + "/occlusion/file");
+  if (orm && occlusion && (orm->width != occlusion->width || orm->height != occlusion->height))
+    throw Error(where + "/occlusion/file", "'" + layer.occlusion.file.string() + "' is " +
+                                               size_text(occlusion->width, occlusion->height) + ", the layer's orm " +
+                                               size_text(orm->width, orm->height) + ": they must be the same size");
+  OrmSource source;
+  if (orm || occlusion) {
+    source.width = orm ? orm->width : occlusion->width;
+    source.height = orm ? orm->height : occlusion->height;
+  }
+  // orm_texture step by step: the orm file read (or the constant spread), then the occlusion read beside it.
+  const std::uint64_t texels = std::uint64_t(source.width) * std::uint64_t(source.height);
+  const std::uint64_t out = texels * 3 * sizeof(float);
+  const std::uint64_t rgb = orm ? std::max(read_image_bytes(*orm), texels * std::uint64_t(orm->channels) * sizeof(float) +
+                                                                       (orm->channels == 3 ? 0 : out))
+                                : out;
+  const std::uint64_t occ = occlusion ? std::max(read_image_bytes(*occlusion),
+                                                 texels * std::uint64_t(occlusion->channels + 1) * sizeof(float))
+                                      : sizeof(float);
+  source.build_bytes = std::max(rgb, out + occ);
+  return source;
 }
 
 // Mirrors the slot functions above step by step: each step's peak is what it allocates plus what is still held.

@@ -201,6 +201,7 @@ roles = {
     "albedo": lambda f: ["--set", "/materials/m/layers/0/albedo=" + f],
     "height": lambda f: ["--set", '/materials/m/layers/0/height={"file": "%s"}' % f],
     "normal": lambda f: ["--set", "/materials/m/layers/0/normal=" + f],
+    "orm": lambda f: ["--set", "/materials/m/layers/0/orm=" + f],
 }
 for name, _, reason in images:
     stem = name.replace(".", "_")
@@ -458,6 +459,24 @@ shutil.copy(os.path.join(FILES, "images/good.png"), os.path.join(FILES, "obj/tex
 put("obj/textured.mtl", "newmtl a\nmap_Kd textured.png\n")
 put("obj/textured.obj", "mtllib textured.mtl\n" + tri + "vt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n")
 
+# The orm texture (occlusion, roughness, metalness) and its occlusion.
+orm = "/materials/m/layers/0/orm="
+for name, args, message in [
+    ("orm_missing", ["--set", orm + "images/none.png"], "/materials/m/layers/0/orm: file not found"),
+    ("orm_one_channel", ["--set", orm + "images/good.exr"], "has 1 channel(s); an orm texture needs 3"),
+    ("orm_occlusion_other_size", ["--set", orm + "images/good.png", "--set", '/materials/m/layers/0/occlusion={"file": "images/good.exr"}'],
+     "is 16x16, the layer's orm 64x64: they must be the same size"),
+    ("orm_occlusion_missing", ["--set", '/materials/m/layers/0/occlusion={"file": "images/none.png"}'], "/materials/m/layers/0/occlusion/file: file not found"),
+    ("orm_occlusion_rgb", ["--set", '/materials/m/layers/0/occlusion={"file": "images/good.png", "channel": "rgb"}'],
+     "an occlusion reads one channel: r, g, b or a"),
+    ("orm_constant_above_1", ["--set", orm + '{"constant": [1, 2, 1]}'], "/materials/m/layers/0/orm/constant/1"),
+    ("orm_procedural", ["--set", orm + '{"procedural": "noise"}'], "an orm texture is a file path or a constant"),
+    ("orm_metallic_above_1", ["--set", "/materials/m/layers/0/metallic=1.5"], "/materials/m/layers/0/metallic"),
+    ("orm_on_blend", ["--set", orm + "images/good.png", "--set", '/materials/m/layers/-={"height": {"file": "images/good_h.png"}}'],
+     "/materials/m/layers/0/orm: an orm texture is read on a material of one layer, not on a blend"),
+]:
+    case(name, render(*args), message)
+
 # --- glTF 2.0 assets (mesh/gltf.cpp): each a copy of tests/gltf/assets/quad_embedded.gltf (buffer and image as
 # data: URIs, so each file stands alone) or quad.glb with one element broken; rendered on their own ----------------
 GLTF_ASSETS = os.path.join(os.path.dirname(HERE), "gltf", "assets")
@@ -507,6 +526,12 @@ gltf_cases = [
     ("uri_file_scheme", lambda d: set_(d["images"][0], "uri", "file:///etc/passwd"), "names a scheme"),
     ("embedded_image_not_png", lambda d: set_(d["images"][0], "uri", "data:image/png;base64,AAAAAAAA"), "/images/0: an embedded image must be PNG or JPEG"),
     ("no_position", lambda d: prim(d)["attributes"].pop("POSITION"), "/meshes/0/primitives/0/attributes: no POSITION"),
+    ("metallic_roughness_texture_missing", lambda d: set_(d["materials"][0]["pbrMetallicRoughness"], "metallicRoughnessTexture", {"index": 9}),
+     "/materials/0/pbrMetallicRoughness/metallicRoughnessTexture/index: texture 9 does not exist"),
+    ("occlusion_texture_missing", lambda d: set_(d["materials"][0], "occlusionTexture", {"index": 9}),
+     "/materials/0/occlusionTexture/index: texture 9 does not exist"),
+    ("occlusion_strength_above_1", lambda d: set_(d["materials"][0], "occlusionTexture", {"index": 0, "strength": 2}),
+     "/materials/0/occlusionTexture/strength: must be in [0, 1]"),
 ]
 for name, edit, message in gltf_cases:
     gltf_case(name, edit, message)

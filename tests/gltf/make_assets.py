@@ -8,6 +8,12 @@ tests/golden/gltf_assets.json and the expectations of tests/mesh/gltf_test.cpp a
   quad_tinted.gltf                     the quad with a baseColorFactor over its texture, and metal; ../quad_tinted_gltf.json
                                        draws it, ../quad_tinted_obj.json the OBJ quad with the qdmr material it maps to
                                        (albedo file x factor, Cook-Torrance F0 and roughness): the same bits
+  quad_orm.gltf + orm.png              the quad with one image as metallicRoughnessTexture and occlusionTexture (R
+                                       occlusion, G roughness, B metalness: gradients and a metal half)
+  quad_orm_split.gltf                  the same with occlusion.png (grey: orm.png's R) and metal_rough.png (orm.png's
+                                       G and B, R not occlusion): qdmr packs them into orm.png's texture, the same bits
+  quad_orm_white.gltf + white.png      quad.gltf's material with a white 1x1 metallicRoughnessTexture and
+                                       occlusionTexture (metallicFactor 0): quad.gltf's bits (the texture changes nothing)
   quad.glb                             the same asset as one .glb: the buffer in the BIN chunk, the image in a buffer view
   hierarchy.gltf                       a node hierarchy (TRS with a quaternion, a matrix, a scale) and a camera node
   indices.gltf                         four quads: 8-, 16-, 32-bit indices and none; normals left out of the last (flat)
@@ -215,6 +221,62 @@ def tinted_assets():
     write("quad_tinted_obj.json", text(obj_scene), HERE)
 
 
+def orm_texels(size=16):
+    """R occlusion falling from 1 to 1/4 along x, G roughness rising along y, B metal on the right half."""
+    out = []
+    for y in range(size):
+        for x in range(size):
+            out += [255 - 12 * x, 40 + 13 * y, 255 if x >= size // 2 else 0]
+    return out
+
+
+def orm_assets():
+    size = 16
+    texels = orm_texels(size)
+    write("orm.png", png(size, size, 3, texels))
+    write("occlusion.png", png(size, size, 1, texels[0::3]))
+    rough_metal = []
+    for i in range(size * size):  # R is not occlusion in a metallicRoughnessTexture: something else there
+        rough_metal += [(37 * i) % 256, texels[3 * i + 1], texels[3 * i + 2]]
+    write("metal_rough.png", png(size, size, 3, rough_metal))
+    write("white.png", png(1, 1, 3, [255, 255, 255]))
+    for name, images, occlusion, metallic in (("quad_orm", ["orm.png"], 1, 1.0),
+                                              ("quad_orm_split", ["metal_rough.png", "occlusion.png"], 2, 1.0),
+                                              ("quad_orm_white", ["white.png"], 1, 0.0)):
+        buf = Buffer()
+        prim = quad_primitive(buf)
+        material = quad_material()
+        material["pbrMetallicRoughness"].update(metallicRoughnessTexture={"index": 1}, metallicFactor=metallic)
+        material["occlusionTexture"] = {"index": occlusion, "strength": 1.0}
+        if name != "quad_orm_white":
+            material["pbrMetallicRoughness"]["roughnessFactor"] = 1.0
+        extra = {"scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "quad"}],
+                 "meshes": [{"name": "quad", "primitives": [prim]}], "materials": [material],
+                 "textures": [{"source": i} for i in range(len(images) + 1)],
+                 "images": [{"uri": "checker.png"}] + [{"uri": u} for u in images]}
+        write(name + ".gltf", text(document(buf, extra, "quad.bin")))
+    view = {"output": {"width": 160, "height": 90},
+            "camera": {"position": [0.4, -2.2, 1.4], "target": [0, 0, 0], "up": [0, 0, 1], "fov_deg": 50}}
+    write("quad_orm_gltf.json", text(dict(view, comment="assets/quad_orm.gltf; quad_orm_obj.json gives the same bits (make_assets.py)",
+                                          objects=[{"name": "quad", "mesh": {"type": "gltf", "file": "assets/quad_orm.gltf"}}])), HERE)
+    write("quad_orm_obj.json", text(dict(
+        view, comment="The OBJ quad with the scene material quad_orm.gltf's maps to: orm.png as the layer's orm, metallic 1, "
+                      "Cook-Torrance with the dielectric F0 0.04 and roughness 1 (make_assets.py)",
+        materials={"orm": {"layers": [{"albedo": "assets/checker.png", "orm": "assets/orm.png", "metallic": 1.0,
+                                       "occlusion_strength": 1.0}],
+                           "lighting": {"model": "cook_torrance", "specular": 0.04, "roughness": 1.0}}},
+        objects=[{"name": "quad", "mesh": {"type": "obj", "file": "assets/quad.obj"}, "material": "orm"}])), HERE)
+    # Displaced (qdm with per-frame AO, which the ORM occlusion multiplies): quad_orm, and the white ORM against none.
+    for name, asset in (("displaced_orm", "quad_orm"), ("displaced_orm_white", "quad_orm_white"), ("displaced_quad", "quad")):
+        comment = {"displaced_orm": "quad_orm.gltf displaced from the scene: the ORM texture sampled at the hit",
+                   "displaced_orm_white": "quad_orm_white.gltf displaced: displaced_quad.json's bits (a white ORM without metal changes nothing)",
+                   "displaced_quad": "quad.gltf displaced as displaced_orm_white.json"}[name]
+        write(name + ".json", text(dict(view, comment=comment + " (make_assets.py)", objects=[
+            {"name": "quad", "mesh": {"type": "gltf", "file": "assets/" + asset + ".gltf"},
+             "materials": {"checker": {"height": "assets/wall_height.png", "technique": {"name": "qdm", "depth_scale": 0.08},
+                                       "ao": {"mode": "frame"}}}}])), HERE)
+
+
 def colour(name, rgb):
     return {"name": name, "pbrMetallicRoughness": {"baseColorFactor": rgb + [1.0], "metallicFactor": 0.0,
                                                    "roughnessFactor": 0.5}}
@@ -305,6 +367,7 @@ def fuzz_seeds():
 
 quad_assets()
 tinted_assets()
+orm_assets()
 hierarchy_asset()
 indices_asset()
 sparse_asset()

@@ -78,16 +78,25 @@ void expect_same_covered_lanes(const ShadeOutput& alone, const ShadeOutput& pair
   EXPECT_EQ(alone.writes_depth, paired.writes_depth);
 }
 
-void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbedo& specular, unsigned seed) {
-  std::mt19937 rng(seed);
-  const Texture albedo = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, true, MipReduce::Box);
-  const Texture normal = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, false, MipReduce::Box);
+LightRig test_lights() {
   LightRig lights;
   lights.directional.push_back({glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)), glm::vec3(1.0f, 0.9f, 0.8f)});
   lights.ambient = glm::vec3(0.1f);
   lights.camera_position = glm::vec3(0.2f, -0.4f, 3.0f);
-  const NormalMappingProgram program("test", albedo, normal, nullptr, SamplingDesc{}, lighting.model,
-                                     lighting_params(lighting), specular, lights);
+  return lights;
+}
+
+// with_orm: a random ORM texture of another size than the albedo (its own LOD) is sampled and applied.
+void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbedo& specular, unsigned seed,
+                           bool with_orm = false) {
+  std::mt19937 rng(seed);
+  const Texture albedo = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, true, MipReduce::Box);
+  const Texture normal = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, false, MipReduce::Box);
+  const Texture orm = make_mip_texture(random_image(32, rng), TexelFormat::RGBA8, false, MipReduce::Box);
+  const LightRig lights = test_lights();
+  const NormalMappingProgram program("test", albedo, normal, nullptr, with_orm ? &orm : nullptr,
+                                     OrmParams{.metallic = 0.75f, .occlusion_strength = 0.5f}, SamplingDesc{},
+                                     lighting.model, lighting_params(lighting), specular, lights);
   ASSERT_EQ(program.grouping().batches, 2);
   const std::uint32_t all = (1u << kLanes) - 1u;
   int packed = 0, side_by_side = 0;
@@ -122,6 +131,78 @@ TEST(NormalMappingPair, SameBitsAsEachBatchAloneCookTorranceWithSpecularFromAlbe
   specular.enabled = true;
   specular.power = 2.0f;
   expect_pairs_as_alone(lighting, specular, 4);
+}
+
+TEST(NormalMappingPair, SameBitsAsEachBatchAloneWithAnOrmTexture) {
+  LightingDesc lighting;
+  lighting.model = LightingModel::CookTorrance;
+  expect_pairs_as_alone(lighting, SpecularFromAlbedo{}, 5, true);
+}
+
+// Shades random batches with and without an ORM texture of one texel `orm` (RGBA8 linear, so each channel is a code
+// k / 255) and the given factors.
+struct OrmShades {
+  std::vector<ShadeOutput> with, without;
+};
+OrmShades shade_with_and_without_orm(const glm::vec4& orm_texel, const OrmParams& factors, LightRig lights,
+                                     LightingModel model) {
+  std::mt19937 rng(11);
+  const Texture albedo = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, true, MipReduce::Box);
+  const Texture normal = make_mip_texture(random_image(64, rng), TexelFormat::RGBA8, false, MipReduce::Box);
+  Image one(1, 1, 4);
+  for (int c = 0; c < 4; ++c) one.texels[std::size_t(c)] = orm_texel[c];
+  const Texture orm = make_mip_texture(one, TexelFormat::RGBA8, false, MipReduce::Box);
+  LightingParams lighting;
+  lighting.roughness = 0.37f;
+  lighting.specular = 0.04f;
+  const NormalMappingProgram plain("test", albedo, normal, nullptr, nullptr, OrmParams{}, SamplingDesc{}, model,
+                                   lighting, SpecularFromAlbedo{}, lights);
+  const NormalMappingProgram textured("test", albedo, normal, nullptr, &orm, factors, SamplingDesc{}, model, lighting,
+                                      SpecularFromAlbedo{}, lights);
+  OrmShades shades;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Fragments in = random_fragments(rng, (1u << kLanes) - 1u);
+    shades.with.emplace_back();
+    shades.without.emplace_back();
+    textured.shade_one(in, shades.with.back());
+    plain.shade_one(in, shades.without.back());
+  }
+  return shades;
+}
+
+// An ORM texture of (1, 1, 1) with metallic 0 changes nothing: the roughness it gives is 1 * roughness, the albedo
+// times 1 - 0, F0 plus 0, the occlusion 1 (apply_orm): the same bits as the constant-roughness material.
+TEST(NormalMappingOrm, WhiteOrmWithoutMetalGivesTheBitsOfConstantRoughness) {
+  for (const LightingModel model : {LightingModel::CookTorrance, LightingModel::BlinnPhong}) {
+    const OrmShades s = shade_with_and_without_orm(glm::vec4(1.0f), OrmParams{.metallic = 0.0f, .occlusion_strength = 1.0f},
+                                                   test_lights(), model);
+    for (std::size_t t = 0; t < s.with.size(); ++t) expect_same_covered_lanes(s.without[t], s.with[t], (1u << kLanes) - 1u, int(t));
+  }
+}
+
+// Occlusion R = 128/255 (the code nearest 0.5), metalness 0, under ambient light only: the colour is albedo * (ambient *
+// ao) with ao = 1 + (R - 1) = R exactly (both steps exact in float), so it is the ORM-less colour times R: with an
+// ambient of 0.5 (a power of two) both round the one exact product albedo * R / 2, so the bits are equal.
+TEST(NormalMappingOrm, OcclusionScalesTheAmbientTerm) {
+  LightRig ambient_only = test_lights();
+  ambient_only.directional.clear();
+  ambient_only.ambient = glm::vec3(0.5f);
+  const float r = 128.0f / 255.0f;
+  const OrmShades s = shade_with_and_without_orm(glm::vec4(r, 1.0f, 0.0f, 1.0f), OrmParams{}, ambient_only,
+                                                 LightingModel::CookTorrance);
+  int lanes = 0;
+  for (std::size_t t = 0; t < s.with.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      alignas(64) float with[kLanes], without[kLanes], ao[kLanes];
+      s.with[t].color[c].store_aligned(with);
+      s.without[t].color[c].store_aligned(without);
+      s.with[t].ao.store_aligned(ao);
+      for (int l = 0; l < kLanes; ++l, ++lanes) {
+        ASSERT_EQ(ao[l], r);  // the AO AOV is the occlusion
+        ASSERT_EQ(with[l], without[l] * r) << "trial " << t << " lane " << l;
+      }
+    }
+  EXPECT_GT(lanes, 1000);
 }
 
 }  // namespace

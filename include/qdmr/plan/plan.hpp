@@ -99,6 +99,7 @@ struct LayerPlan {
   int field = -1;            // derived HeightField of the height (layer 0: reference, cones; any: baked AO)
   int ao = -1;               // derived LayerAoMap
   int twin = -1;             // derived TwinTexels
+  int orm = -1;              // occlusion, roughness, metalness (ProgramKey::orm)
 };
 
 struct MaterialPlan {

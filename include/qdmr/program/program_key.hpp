@@ -33,6 +33,8 @@ struct ProgramKey {
   AoMode ao = AoMode::Off;
   LightingModel lighting = LightingModel::BlinnPhong;
   Filter filter = Filter::Trilinear;
+  // A single layer's occlusion-roughness-metal texture is sampled beside the albedo (LayerDesc::orm).
+  bool orm = false;
   // Normal mapping runs its own program; every other key a displacement program.
   bool normal_mapping() const { return trace.technique == TechniqueKind::Normal && layers == 1; }
   bool operator==(const ProgramKey&) const = default;
@@ -41,7 +43,7 @@ struct ProgramKey {
 // "relief", "pom", "csm", "rcsm", "normal", "qdm<int_cells,max_fetch,level_up_one>" (sm3_cells, fp64_walls).
 std::string trace_variant_name(const TraceOptions& options);
 // The key printed: "normal_mapping" or "displacement:<trace variant>", then " | "-separated blend, shadow, AO,
-// lighting model and filter, e.g. "displacement:pom | shadow hard | blinn_phong | trilinear".
+// lighting model, filter and "orm" when set, e.g. "displacement:pom | shadow hard | blinn_phong | trilinear".
 std::string variant_name(const ProgramKey& key);
 
 const char* technique_name(TechniqueKind kind);  // "normal", "relief", "pom", "csm", "rcsm", "qdm"

@@ -33,6 +33,12 @@ struct LightingParams {
   float roughness = 0.5f;   // Cook-Torrance
 };
 
+// The factors of an ORM texture (ProgramKey::orm; LayerDesc documents them).
+struct OrmParams {
+  float metallic = 1.0f;
+  float occlusion_strength = 1.0f;
+};
+
 // Self-shadowing (scene.hpp's ShadowDesc documents each); the mode is the key's.
 struct ShadowParams {
   float strength = 8.0f;
@@ -66,6 +72,7 @@ struct ProgramParams {
   SamplingDesc sampling;
   LightingParams lighting;
   std::vector<SpecularFromAlbedo> specular;  // per layer
+  OrmParams orm;                             // ProgramKey::orm
   ShadowParams shadow;
   AoParams ao;
   BlendParams blend;

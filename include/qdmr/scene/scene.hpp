@@ -165,6 +165,15 @@ struct LayerDesc {
   float height_scale = 1.0f;     // h' = h * height_scale + height_offset
   float height_offset = 0.0f;
   SpecularFromAlbedo specular;
+  // Occlusion, roughness and metalness per texel (glTF's packing, linear): R multiplies the ambient light by
+  // 1 + occlusion_strength (R - 1), G the lighting's roughness, B `metallic`. `occlusion`, when set, gives R
+  // instead (one channel of an image of the orm's size). Either makes the program sample them (ProgramKey::orm);
+  // single-layer materials only.
+  TextureDesc orm;                 // default: none
+  TextureDesc occlusion;           // default: none (R from orm, or 1)
+  float metallic = 1.0f;           // metalness = B * metallic: diffuse * (1 - m), F0 lerped towards the albedo's luminance
+  float occlusion_strength = 1.0f;
+  bool has_orm() const { return orm.source != TextureSource::None || occlusion.source != TextureSource::None; }
 };
 
 // The intersection technique and its speed/accuracy knobs. Depth is in UV units of one texture repeat:
