@@ -302,8 +302,21 @@ QDMR_SAMPLER_INLINE Float sample_wrap_footprints(const float* footprints, const 
   static_assert(K.filter == Filter::Bilinear && K.address == AddressMode::Wrap && channel_count(K.format) == 1);
   Int x0, y0;
   Float wx, wy;
-  split(reduce(u, K.address), w, true, 0.5f, K.fraction_bits, K.exact_texel, x0, wx);
-  split(reduce(v, K.address), h, true, 0.5f, K.fraction_bits, K.exact_texel, y0, wy);
+  if constexpr (K.fraction_bits > 0 && K.exact_texel) {
+    // split()'s result is the exact coordinate's fixed point floor((ru n - 1/2) 2^bits); with ru in [0, 1] (wrap)
+    // and n a power of two, ru n 2^bits is exact, so that is its floor minus 2^(bits - 1), with no correction.
+    constexpr int bits = K.fraction_bits;
+    const auto fixed_split = [](const Float& ru, const Float& n, Int& index, Float& weight) {
+      const Int f = xsimd::to_int(xsimd::floor(ru * (n * Float(float(1 << bits))))) - Int(1 << (bits - 1));
+      index = f >> bits;
+      weight = xsimd::to_float(f & Int((1 << bits) - 1)) * Float(1.0f / float(1 << bits));
+    };
+    fixed_split(reduce(u, K.address), w, x0, wx);
+    fixed_split(reduce(v, K.address), h, y0, wy);
+  } else {
+    split(reduce(u, K.address), w, true, 0.5f, K.fraction_bits, K.exact_texel, x0, wx);
+    split(reduce(v, K.address), h, true, 0.5f, K.fraction_bits, K.exact_texel, y0, wy);
+  }
   const Int xa = address(x0, level0.width, K.address, true), ya = address(y0, level0.height, K.address, true);
   Float t[4];  // (xa, ya), (xb, ya), (xa, yb), (xb, yb)
   simd::load_f32x4(footprints, (ya * level0.width + xa) * Int(4), K.fetch, t);

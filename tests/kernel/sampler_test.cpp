@@ -709,6 +709,12 @@ TEST(TextureSampler, SurfaceHeightIsTheHeightSamplers) {
             if (round == 1)  // the last column and row: the footprints' wrapped neighbours
               for (std::size_t l = 0; l < std::size_t(kLanes); ++l)
                 u[l] = 1.0f - 0.1f / 32.0f, v[l] = float(l % 3) - 0.2f / 16.0f;
+            if (round == 2 || round == 3)  // a float either side of texel centres and 8-bit steps, and just above 0
+              for (std::size_t l = 0; l < std::size_t(kLanes); ++l) {
+                const float centre = (float(l) + 0.5f + (round == 3 ? 1.0f / 256.0f : 0.0f)) / 32.0f;
+                u[l] = l % 3 == 0 ? centre : std::nextafter(centre, l % 3 == 1 ? 0.0f : 1.0f);
+                v[l] = l % 2 == 0 ? std::ldexp(1.0f, -20 - int(l)) : 1.0f - std::ldexp(1.0f, -24 + int(l % 4));
+              }
             Float expected[4];
             textures.height.sample(load(u), load(v), Float(0.0f), expected);
             const Lanes want = lanes(expected[0]), got = lanes(surface.height(load(u), load(v), Float(0.0f)));
