@@ -15,6 +15,7 @@
 #include "qdmr/program/program_params.hpp"
 #include "bake/ao_map.hpp"
 #include "qdmr/core/isa.hpp"
+#include "qdmr/texture/bc3.hpp"
 #include "texture/blend_box_values.hpp"
 #include "texture/height_rows.hpp"
 #include "qdmr/texture/mip_texture.hpp"
@@ -50,6 +51,8 @@ public:
   virtual AoMapRow ao_map_row() const = 0;
   // Preparation: the rows of a dynamic height's rebuild (texture/height_family.hpp).
   virtual const HeightRows& height_rows() const = 0;
+  // Preparation: BC3 alpha blocks of compressed heights (the blocks of encode_bc3_alpha), for make_height_texture.
+  virtual Bc3Encode bc3_encode() const = 0;
   virtual const KernelCalls& calls() const = 0;
 };
 

@@ -48,6 +48,8 @@ public:
 
   const HeightRows& height_rows() const override { return qdmr::QDMR_ISA::height_rows(); }
 
+  Bc3Encode bc3_encode() const override { return &qdmr::QDMR_ISA::bc3_encode; }
+
   const KernelCalls& calls() const override { return kernel_calls; }
 };
 

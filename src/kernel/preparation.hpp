@@ -1,8 +1,10 @@
 #pragma once
-// The per-ISA work of preparation, behind Kernel::blend_box_values, Kernel::mip_extremum and Kernel::height_rows.
+// The per-ISA work of preparation, behind Kernel::blend_box_values, Kernel::mip_extremum, Kernel::height_rows and
+// Kernel::bc3_encode.
 #include <cstdint>
 
 #include "core/isa_namespace.hpp"
+#include "qdmr/texture/bc3.hpp"
 #include "texture/blend_box_values.hpp"
 #include "qdmr/texture/format.hpp"
 #include "texture/height_rows.hpp"
@@ -19,5 +21,8 @@ void mip_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w
 
 // The rows of a dynamic height's rebuild on this kernel's vectors (kernel/height_rows.cpp).
 const HeightRows& height_rows();
+
+// A BC3 alpha block encoded as encode_bc3_alpha encodes it, on this kernel's vectors (kernel/bc3_encode.cpp).
+Bc3AlphaBlock bc3_encode(const std::uint8_t texels[16]);
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -36,11 +36,12 @@ Image layer_height(const TextureRequest& request, const SharedHeight* shared) {
 
 // A layer's heights through the storage the scene asks for (quantisation, BC3), so what is rendered is what a
 // GPU would sample; the BC3 error goes to `stat`.
-HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, MipExtremum extremum, TextureStat& stat,
+HeightTexture stored_height(const TextureRequest& request, MipReduce reduce, const Kernel& kernel, TextureStat& stat,
                             const SharedHeight* shared) {
   HeightTexture stored = shared && shared->stored_box && reduce == MipReduce::Box
                              ? *shared->stored_box
-                             : make_height_texture(layer_height(request, shared), request.layer.height, reduce, extremum);
+                             : make_height_texture(layer_height(request, shared), request.layer.height, reduce,
+                                                   kernel.mip_extremum(), kernel.bc3_encode());
   stat.height_format = format_name(stored.texture.format);
   if (stored.bc3) {
     stat.bc3 = true;
@@ -54,24 +55,24 @@ void describe(TextureStat& stat, const TextureRequest& request, const Texture& t
 
 // Builds one requested texture. Each step's temporaries are freed before the next step allocates: the plan's
 // texture_working_bytes counts the most this holds at once, step by step.
-Texture build_texture(const TextureRequest& request, MipExtremum extremum, TextureStat& stat, const SharedHeight* shared) {
+Texture build_texture(const TextureRequest& request, const Kernel& kernel, TextureStat& stat, const SharedHeight* shared) {
   Texture texture;
   if (request.purpose == TexturePurpose::Height) {
-    texture = stored_height(request, request.reduce, extremum, stat, shared).texture;
+    texture = stored_height(request, request.reduce, kernel, stat, shared).texture;
     add_linear_copy(texture);
     if (request.wrap_footprints) add_wrap_footprints(texture);
   } else {
     Image level0;
     if (request.desc.source == TextureSource::FromHeight) {
       // Behind a from_height normal map only level 0 is used: any reduction will do.
-      const Image height = stored_height(request, MipReduce::Box, extremum, stat, shared).texture.level_image(0);
+      const Image height = stored_height(request, MipReduce::Box, kernel, stat, shared).texture.level_image(0);
       level0 = make_texture(request.desc, request.purpose, request.layer, &height, request.where);
     } else {
       level0 = make_texture(request.desc, request.purpose, request.layer, nullptr, request.where);
     }
     if (request.purpose == TexturePurpose::Normal)
       for (float& v : level0.texels) v = 0.5f + 0.5f * v;  // stored as UNORM, as normal maps are
-    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce, extremum);
+    texture = make_mip_texture(level0, request.format, request.srgb, request.reduce, kernel.mip_extremum());
     add_linear_copy(texture);
   }
   describe(stat, request, texture);
@@ -242,7 +243,8 @@ private:
       const TextureRequest& r = plan_.textures[i];
       return r.purpose != TexturePurpose::Height || r.reduce == MipReduce::Box;
     });
-    if (box) s.stored_box = make_height_texture(*s.level0, first.layer.height, MipReduce::Box, kernel_.mip_extremum());
+    if (box) s.stored_box = make_height_texture(*s.level0, first.layer.height, MipReduce::Box, kernel_.mip_extremum(),
+                                                 kernel_.bc3_encode());
     return s;
   }
 
@@ -339,7 +341,7 @@ private:
                                         std::to_string(request.height) + " (" + request.where +
                                         ")");  // a line on a terminal when it takes seconds
                 assets_.textures[i] = std::make_shared<Texture>(
-                    build_texture(request, kernel_.mip_extremum(), assets_.texture_stats[i], &shared));
+                    build_texture(request, kernel_, assets_.texture_stats[i], &shared));
                 record("texture " + request.key, plan_.meshes.size() + i,
                        {"texture " + std::to_string(i), purpose_name(request.purpose), request.where}, start);
                 start = Clock::now();

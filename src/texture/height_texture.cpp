@@ -16,7 +16,7 @@ TexelFormat height_format(const TextureDesc& desc, int source_bits) {
 }
 
 HeightTexture make_height_texture(const Image& height, const TextureDesc& desc, MipReduce reduce,
-                                  MipExtremum extremum) {
+                                  MipExtremum extremum, Bc3Encode bc3) {
   HeightTexture result;
   const TexelFormat format = height_format(desc, height.source_bits);
   if (desc.compression != Compression::Bc3) {
@@ -26,7 +26,7 @@ HeightTexture make_height_texture(const Image& height, const TextureDesc& desc, 
   // Quantise level 0 only, round-trip it through BC3, then build the chain from the decoded texels.
   Texture texture = make_mip_texture(height, TexelFormat::R8, false, reduce, extremum);
   const TextureLevel& level0 = texture.levels[0];
-  result.bc3 = bc3_roundtrip(texture.storage.data() + level0.offset, level0.width, level0.height);
+  result.bc3 = bc3_roundtrip(texture.storage.data() + level0.offset, level0.width, level0.height, bc3);
   build_mip_levels(texture, reduce, extremum);
   result.texture = std::move(texture);
   return result;

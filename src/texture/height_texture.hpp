@@ -19,8 +19,8 @@ struct HeightTexture {
   std::optional<Bc3Report> bc3;  // the encode error, when compressed
 };
 
-// The chain's Max / Min levels by `extremum` (make_mip_texture).
+// The chain's Max / Min levels by `extremum` (make_mip_texture); BC3 blocks by `bc3` (bc3_roundtrip).
 HeightTexture make_height_texture(const Image& height, const TextureDesc& desc, MipReduce reduce,
-                                  MipExtremum extremum = nullptr);
+                                  MipExtremum extremum = nullptr, Bc3Encode bc3 = nullptr);
 
 }  // namespace qdmr
