@@ -253,6 +253,13 @@ Image occlusion_texture(const TextureDesc& desc, const std::string& where) {
 
 std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
 
+// The error of an occlusion file whose size is not the orm texture's (the plan reads the headers, prepare the pixels).
+Error occlusion_size_error(const std::string& where, const LayerDesc& layer, int width, int height, int orm_width,
+                           int orm_height) {
+  return Error(where, "'" + layer.occlusion.file.string() + "' is " + size_text(width, height) + ", the layer's orm " +
+                          size_text(orm_width, orm_height) + ": they must be the same size");
+}
+
 // RGB of the orm texture (none: 1, 1, 1) with R from the occlusion texture when the layer has one.
 Image orm_texture(const LayerDesc& layer, const std::string& where) {
   const TextureDesc& desc = layer.orm;
@@ -280,9 +287,8 @@ Image orm_texture(const LayerDesc& layer, const std::string& where) {
   }
   if (occlusion.width != 1 || occlusion.height != 1 || layer.occlusion.source == TextureSource::File) {
     if (occlusion.width != rgb.width || occlusion.height != rgb.height)
-      throw Error(where + "/occlusion", "'" + layer.occlusion.file.string() + "' is " +
-                                            size_text(occlusion.width, occlusion.height) + ", the layer's orm " +
-                                            size_text(rgb.width, rgb.height) + ": they must be the same size");
+      throw occlusion_size_error(where + "/occlusion", layer, occlusion.width, occlusion.height, rgb.width,
+                                 rgb.height);
     for_rows(rgb.height, [&](int y) {
       for (int x = 0; x < rgb.width; ++x) rgb.at(x, y, 0) = occlusion.at(x, y, 0);
     });
@@ -340,9 +346,8 @@ OrmSource orm_source(const LayerDesc& layer, const std::string& where) {
   if (layer.occlusion.source == TextureSource::File)
     occlusion = read_image_header(layer.occlusion.file, where + "/occlusion/file");
   if (orm && occlusion && (orm->width != occlusion->width || orm->height != occlusion->height))
-    throw Error(where + "/occlusion/file", "'" + layer.occlusion.file.string() + "' is " +
-                                               size_text(occlusion->width, occlusion->height) + ", the layer's orm " +
-                                               size_text(orm->width, orm->height) + ": they must be the same size");
+    throw occlusion_size_error(where + "/occlusion/file", layer, occlusion->width, occlusion->height, orm->width,
+                               orm->height);
   OrmSource source;
   if (orm || occlusion) {
     source.width = orm ? orm->width : occlusion->width;
