@@ -59,12 +59,16 @@ def run(build_dir, *extra):
                           check=True, stdout=subprocess.PIPE, text=True, env=env).stdout
 
 
-def cpu_model():
+def cpu_fields():
+    """The first processor's /proc/cpuinfo fields."""
+    fields = {}
     with open("/proc/cpuinfo") as f:
         for line in f:
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return "unknown CPU"
+            if not line.strip():
+                break
+            key, _, value = line.partition(":")
+            fields[key.strip()] = value.strip()
+    return fields
 
 
 def table_rows(out):
@@ -94,6 +98,12 @@ def test_both_pairs_each_like_for_like(build):
 def test_machine_and_kernel_beside_the_table(build):
     build_dir, _ = build
     out = run(build_dir, "--isa", "avx2", "--pairs", "hw8")
-    assert f"CPU: {cpu_model()}; qdmr: avx2 kernel" in out
+    # The model name alone does not tell the class apart (a VM may say only "AMD EPYC"): family and model, and
+    # whether the CPU has AVX-512, are printed beside it.
+    fields = cpu_fields()
+    cpu_line = next(line for line in out.splitlines() if line.startswith("CPU: "))
+    assert cpu_line.startswith(f"CPU: {fields['model name']} (family {fields['cpu family']} model {fields['model']} ")
+    assert ("no AVX-512" in cpu_line) == ("avx512f" not in fields["flags"].split())
+    assert "; qdmr: avx2 kernel" in cpu_line
     assert len(table_rows(out)) == 8 and all(r[0].strip() == "hw8 / 8-bit" for r in table_rows(out))
     assert "qdmr: avx512 kernel" in run(build_dir, "--pairs", "exact")
