@@ -94,7 +94,8 @@ void bench_sample(benchmark::State& state, Filter filter, Format format, int sid
   SamplingDesc desc;
   desc.filter = filter;
   desc.address = AddressMode::Wrap;
-  SamplerState simd_state = SamplerState::from(desc);
+  SamplerState simd_state;  // desc's
+  simd_state.filter = filter;
   if (impl == Impl::Portable) simd_state.fetch = simd::FetchPath::Portable;
   const TextureSampler bound(texture, simd_state);
   const Points points = make_points(texture, access);
@@ -148,10 +149,9 @@ const std::pair<Texture, Texture>& albedo_and_normal(int side) {
 
 void bench_twin(benchmark::State& state, Filter filter, int side, Access access, bool twin) {
   const auto& [albedo, normal] = albedo_and_normal(side);
-  SamplingDesc desc;
-  desc.filter = filter;
-  desc.address = AddressMode::Wrap;
-  const SamplerState sampler_state = SamplerState::from(desc);
+  SamplerState sampler_state;
+  sampler_state.filter = filter;
+  sampler_state.address = AddressMode::Wrap;
   const TwinSampler both(albedo, normal, sampler_state);
   if (!both.shares_addresses()) {
     state.SkipWithError("the two textures do not share addresses");

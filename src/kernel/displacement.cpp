@@ -54,8 +54,8 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
                                                                                    : kBaseVaryingCount),
       shade_(variant.shade), cones_(inputs.cones),
       reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo),
-      reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(params.sampling)),
-      lod_mode_(params.sampling.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
+      reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(key.sampler, params.sampler)),
+      lod_mode_(key.sampler.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
       orm_params_(params.orm), blend_(params.blend), shadow_(params.shadow), ao_(params.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
@@ -67,7 +67,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
     const LayerInputs& l = inputs.layers[i];
     Layer layer{TwinSampler(*l.albedo, *l.normal, sampler_, l.twin_texels), std::nullopt, std::nullopt,
                 i < params.specular.size() ? params.specular[i] : SpecularFromAlbedo{}, std::nullopt};
-    if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, trace_.height_fetch);
+    if (l.height) layer.height.emplace(*l.height, l.height_max, sampler_, key_.sampler.heights);
     if (l.ao) layer.ao.emplace(*l.ao, ao_sampler);
     if (l.orm) layer.orm.emplace(*l.orm, sampler_);
     layers_.push_back(std::move(layer));

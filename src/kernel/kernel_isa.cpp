@@ -27,8 +27,8 @@ public:
       const LayerInputs& l = inputs.layers[0];
       if (key.orm != (l.orm != nullptr)) throw Error("normal mapping program", "the key's orm and the inputs' differ");
       return std::make_unique<NormalMappingProgram>(variant_name(key), *l.albedo, *l.normal, l.twin_texels, l.orm,
-                                                    params.orm, params.sampling, key.lighting, params.lighting,
-                                                    params.specular[0], lights);
+                                                    params.orm, key.sampler, params.sampler, key.lighting,
+                                                    params.lighting, params.specular[0], lights);
     }
     return std::make_unique<DisplacementProgram>(inputs, key, params, lights);
   }

@@ -16,15 +16,17 @@ class NormalMappingProgram final : public ShadingProgram {
 public:
   // albedo: RGBA8 sRGB; normal: RGBA8 holding 0.5 + 0.5 n of tangent-space unit normals.
   // twin_texels: the two maps interleaved (texture/twin_texels.hpp), or null. orm: RGBA8 linear occlusion,
-  // roughness and metalness sampled beside the albedo (ProgramKey::orm), or null.
+  // roughness and metalness sampled beside the albedo (ProgramKey::orm), or null. sampler: the key's modes (the
+  // height fetch unread), sampler_params the LOD bias and clamp.
   NormalMappingProgram(const std::string& variant, const Texture& albedo, const Texture& normal, const float* twin_texels,
-                       const Texture* orm, const OrmParams& orm_params, const SamplingDesc& sampling,
-                       LightingModel lighting_model, const LightingParams& lighting, const SpecularFromAlbedo& specular,
-                       const LightRig& lights)
-      : ShadingProgram(variant, kBaseVaryingCount), textures_(albedo, normal, SamplerState::from(sampling), twin_texels),
-        lod_mode_(sampling.lod), lighting_model_(lighting_model), lighting_(lighting), specular_(specular),
-        orm_params_(orm_params), lights_(lights) {
-    if (orm) orm_.emplace(*orm, SamplerState::from(sampling));
+                       const Texture* orm, const OrmParams& orm_params, const SamplerModes& sampler,
+                       const SamplerParams& sampler_params, LightingModel lighting_model, const LightingParams& lighting,
+                       const SpecularFromAlbedo& specular, const LightRig& lights)
+      : ShadingProgram(variant, kBaseVaryingCount),
+        textures_(albedo, normal, SamplerState::from(sampler, sampler_params), twin_texels), lod_mode_(sampler.lod),
+        lighting_model_(lighting_model), lighting_(lighting), specular_(specular), orm_params_(orm_params),
+        lights_(lights) {
+    if (orm) orm_.emplace(*orm, SamplerState::from(sampler, sampler_params));
   }
   BatchGrouping grouping() const override { return {2, 2 * simd::kLanes}; }
   void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override;

@@ -10,6 +10,8 @@
 #include "kernel/gather.hpp"
 #include "core/simd.hpp"
 #include "qdmr/core/sampling.hpp"
+#include "qdmr/program/program_key.hpp"
+#include "qdmr/program/program_params.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 #include "kernel/fetch_trace.hpp"
 
@@ -48,15 +50,16 @@ struct SamplerState {
   float min_lod = 0.0f, max_lod = 16.0f;
   simd::FetchPath fetch = simd::kHasHardwareGather ? simd::FetchPath::Gather : simd::FetchPath::Portable;
 
-  static SamplerState from(const SamplingDesc& d) {
+  // A material's: its key's sampler modes and its parameters' numbers (the plan splits the scene's sampling so).
+  static SamplerState from(const SamplerModes& modes, const SamplerParams& params) {
     SamplerState s;
-    s.filter = d.filter;
-    s.address = d.address;
-    s.precision = d.precision;
-    s.math = d.math;
-    s.lod_bias = d.lod_bias;
-    s.min_lod = d.min_lod;
-    s.max_lod = d.max_lod;
+    s.filter = modes.filter;
+    s.address = modes.address;
+    s.precision = modes.precision;
+    s.math = modes.fp32_texels ? MathMode::Sm3 : MathMode::Sm4;
+    s.lod_bias = params.lod_bias;
+    s.min_lod = params.min_lod;
+    s.max_lod = params.max_lod;
     return s;
   }
 };

@@ -18,9 +18,23 @@ ProgramKey program_key(const MaterialDesc& material) {
   key.shadow = material.shadow.mode;
   key.ao = material.ao.mode;
   key.lighting = material.lighting.model;
-  key.filter = material.sampling.filter;
   key.orm = key.layers == 1 && material.layers.front().has_orm();
+  key.sampler = sampler_modes(material.sampling, key.normal_mapping() ? HeightFetch::Bilinear
+                                                                       : material.technique.height_fetch);
   return key;
+}
+
+SamplerModes sampler_modes(const SamplingDesc& s, HeightFetch heights) {
+  return {.filter = s.filter,
+          .address = s.address,
+          .precision = s.precision,
+          .lod = s.lod,
+          .fp32_texels = s.math == MathMode::Sm3,
+          .heights = heights};
+}
+
+SamplerParams sampler_params(const SamplingDesc& s) {
+  return {.lod_bias = s.lod_bias, .min_lod = s.min_lod, .max_lod = s.max_lod};
 }
 
 // Named, in declaration order: the compiler checks every field against its name.
@@ -36,7 +50,6 @@ TraceParams trace_params(const TechniqueDesc& t) {
           .lod_fade = t.lod_fade,
           .max_iterations = t.max_iterations,
           .refinement = t.refinement,
-          .height_fetch = t.height_fetch,
           .lod_stop = t.lod_stop,
           .min_iterations = t.min_iterations,
           .fade_start = t.fade_start,
@@ -70,7 +83,7 @@ AoParams ao_params(const AoDesc& a) {
 ProgramParams program_params(const MaterialDesc& material) {
   ProgramParams p;
   p.trace = trace_params(material.technique);
-  p.sampling = material.sampling;
+  p.sampler = sampler_params(material.sampling);
   p.lighting = lighting_params(material.lighting);
   for (const LayerDesc& layer : material.layers) p.specular.push_back(layer.specular);
   if (material.layers.size() == 1 && material.layers.front().has_orm())

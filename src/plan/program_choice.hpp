@@ -11,6 +11,11 @@ namespace qdmr {
 ProgramKey program_key(const MaterialDesc& material);
 ProgramParams program_params(const MaterialDesc& material);
 
+// The material's sampling split into the key's modes (with the technique's height fetch, or bilinear where no
+// heights are read) and the parameters' numbers.
+SamplerModes sampler_modes(const SamplingDesc& sampling, HeightFetch heights);
+SamplerParams sampler_params(const SamplingDesc& sampling);
+
 // The parts of program_params, each from its part of the material.
 TraceParams trace_params(const TechniqueDesc& technique);
 LightingParams lighting_params(const LightingDesc& lighting);

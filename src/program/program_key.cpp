@@ -58,6 +58,21 @@ const char* level_up_name(QdmLevelUp l) {
   return "?";
 }
 
+// The filter, then each sampler state that is not its default (variant_name in program_key.hpp).
+std::string sampler_name(const ProgramKey& key) {
+  const SamplerModes& s = key.sampler;
+  std::string name = filter_name(s.filter);
+  if (s.address != AddressMode::Wrap) name += s.address == AddressMode::Clamp ? " clamp" : " mirror";
+  if (s.precision != SamplePrecision::Exact) name += s.precision == SamplePrecision::Hw8 ? " hw8" : " hw6";
+  if (s.lod == LodMode::PerPixel) name += " per_pixel_lod";
+  // QDM's trace variant already says sm3_cells and filtered_max.
+  const bool qdm = key.trace.technique == TechniqueKind::Qdm;
+  if (s.fp32_texels && !qdm) name += " sm3_texels";
+  if (s.heights == HeightFetch::Point) name += " point_heights";
+  if (s.heights == HeightFetch::Trilinear && !qdm) name += " trilinear_heights";
+  return name;
+}
+
 }  // namespace
 
 std::string trace_variant_name(const TraceOptions& o) {
@@ -77,7 +92,7 @@ std::string variant_name(const ProgramKey& key) {
                (key.weights == WeightMode::Vertex ? " per vertex" : " per pixel");
   if (key.shadow != ShadowMode::Off) variant += std::string(" | shadow ") + shadow_name(key.shadow);
   if (key.ao != AoMode::Off) variant += std::string(" | ao ") + (key.ao == AoMode::Baked ? "baked" : "frame");
-  variant += std::string(" | ") + lighting_name(key.lighting) + " | " + filter_name(key.filter);
+  variant += std::string(" | ") + lighting_name(key.lighting) + " | " + sampler_name(key);
   if (key.orm) variant += " | orm";
   return variant;
 }

@@ -30,7 +30,7 @@ float sample_at(const TextureView& view, Filter filter, MathMode math, SamplePre
   d.math = math;
   d.precision = precision;
   Float out[4];
-  sample(view, SamplerState::from(d), Float(u), Float(0.5f), Float(0.0f), out);
+  sample(view, test::sampler_state(d), Float(u), Float(0.5f), Float(0.0f), out);
   float lanes[simd::kLanes];
   out[0].store_unaligned(lanes);
   return lanes[0];

@@ -95,7 +95,7 @@ void expect_pairs_as_alone(const LightingDesc& lighting, const SpecularFromAlbed
   const Texture orm = make_mip_texture(random_image(32, rng), TexelFormat::RGBA8, false, MipReduce::Box);
   const LightRig lights = test_lights();
   const NormalMappingProgram program("test", albedo, normal, nullptr, with_orm ? &orm : nullptr,
-                                     OrmParams{.metallic = 0.75f, .occlusion_strength = 0.5f}, SamplingDesc{},
+                                     OrmParams{.metallic = 0.75f, .occlusion_strength = 0.5f}, SamplerModes{}, SamplerParams{},
                                      lighting.model, lighting_params(lighting), specular, lights);
   ASSERT_EQ(program.grouping().batches, 2);
   const std::uint32_t all = (1u << kLanes) - 1u;
@@ -155,9 +155,9 @@ OrmShades shade_with_and_without_orm(const glm::vec4& orm_texel, const OrmParams
   LightingParams lighting;
   lighting.roughness = 0.37f;
   lighting.specular = 0.04f;
-  const NormalMappingProgram plain("test", albedo, normal, nullptr, nullptr, OrmParams{}, SamplingDesc{}, model,
+  const NormalMappingProgram plain("test", albedo, normal, nullptr, nullptr, OrmParams{}, SamplerModes{}, SamplerParams{}, model,
                                    lighting, SpecularFromAlbedo{}, lights);
-  const NormalMappingProgram textured("test", albedo, normal, nullptr, &orm, factors, SamplingDesc{}, model, lighting,
+  const NormalMappingProgram textured("test", albedo, normal, nullptr, &orm, factors, SamplerModes{}, SamplerParams{}, model, lighting,
                                       SpecularFromAlbedo{}, lights);
   OrmShades shades;
   for (int trial = 0; trial < 50; ++trial) {

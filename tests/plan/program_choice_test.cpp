@@ -16,12 +16,12 @@ MaterialDesc material(TechniqueKind technique, int layers = 1) {
 }
 
 TEST(ProgramChoice, TheKeyIgnoresWhatTheProgramIgnores) {
-  // The QDM options of another technique.
+  // The QDM options of another technique (exact math's fp64 walls; sm3 math's fp32 texel addresses are the
+  // samplers' too: SamplerStatesAreKeys).
   MaterialDesc pom = material(TechniqueKind::Pom);
   MaterialDesc pom_qdm_options = pom;
-  pom_qdm_options.sampling.math = MathMode::Sm3;
+  pom_qdm_options.sampling.math = MathMode::Exact;
   pom_qdm_options.technique.level_up = QdmLevelUp::Aligned;
-  pom_qdm_options.technique.height_fetch = HeightFetch::Trilinear;
   EXPECT_EQ(program_key(pom), program_key(pom_qdm_options));
   // The blend of a single layer.
   MaterialDesc single = pom;
@@ -68,6 +68,62 @@ TEST(ProgramChoice, TheVariantIsTheKeyPrinted) {
             "displacement:normal | blend height x2 per pixel | blinn_phong | trilinear");
 }
 
+// Every sampler state that changes a program's code is in its key, and printed; the LOD bias and clamp are numbers.
+TEST(ProgramChoice, SamplerStatesAreKeys) {
+  MaterialDesc pom = material(TechniqueKind::Pom);
+  const auto key_with = [&](auto change) {
+    MaterialDesc m = pom;
+    change(m);
+    return program_key(m);
+  };
+  const ProgramKey plain = program_key(pom);
+  EXPECT_EQ(plain.sampler, SamplerModes{});
+  EXPECT_EQ(key_with([](MaterialDesc& m) { m.sampling.filter = Filter::PointMipLinear; }).sampler.filter,
+            Filter::PointMipLinear);
+  EXPECT_EQ(key_with([](MaterialDesc& m) { m.sampling.address = AddressMode::Clamp; }).sampler.address,
+            AddressMode::Clamp);
+  EXPECT_EQ(key_with([](MaterialDesc& m) { m.sampling.precision = SamplePrecision::Hw6; }).sampler.precision,
+            SamplePrecision::Hw6);
+  EXPECT_EQ(key_with([](MaterialDesc& m) { m.sampling.lod = LodMode::PerPixel; }).sampler.lod, LodMode::PerPixel);
+  EXPECT_TRUE(key_with([](MaterialDesc& m) { m.sampling.math = MathMode::Sm3; }).sampler.fp32_texels);
+  EXPECT_EQ(key_with([](MaterialDesc& m) { m.technique.height_fetch = HeightFetch::Point; }).sampler.heights,
+            HeightFetch::Point);
+  // The LOD bias and clamp are parameters.
+  EXPECT_EQ(key_with([](MaterialDesc& m) {
+              m.sampling.lod_bias = 1.5f;
+              m.sampling.min_lod = 1.0f;
+              m.sampling.max_lod = 4.0f;
+            }),
+            plain);
+  // Normal mapping reads no heights.
+  MaterialDesc normal = material(TechniqueKind::Normal), normal_point = normal;
+  normal_point.technique.height_fetch = HeightFetch::Point;
+  EXPECT_EQ(program_key(normal), program_key(normal_point));
+  // Printed after the filter where not the default.
+  MaterialDesc sampled = pom;
+  sampled.sampling = {.filter = Filter::Bilinear,
+                      .address = AddressMode::Mirror,
+                      .precision = SamplePrecision::Hw8,
+                      .lod = LodMode::PerPixel,
+                      .math = MathMode::Sm3};
+  sampled.technique.height_fetch = HeightFetch::Trilinear;
+  EXPECT_EQ(variant_name(program_key(sampled)),
+            "displacement:pom | blinn_phong | bilinear mirror hw8 per_pixel_lod sm3_texels trilinear_heights");
+  sampled.sampling.address = AddressMode::Clamp;
+  sampled.sampling.precision = SamplePrecision::Hw6;
+  sampled.technique.height_fetch = HeightFetch::Point;
+  EXPECT_EQ(variant_name(program_key(sampled)),
+            "displacement:pom | blinn_phong | bilinear clamp hw6 per_pixel_lod sm3_texels point_heights");
+  MaterialDesc biased = pom;
+  biased.sampling.lod_bias = -2.0f;
+  biased.sampling.min_lod = 0.5f;
+  biased.sampling.max_lod = 3.0f;
+  const SamplerParams p = program_params(biased).sampler;
+  EXPECT_EQ(p.lod_bias, -2.0f);
+  EXPECT_EQ(p.min_lod, 0.5f);
+  EXPECT_EQ(p.max_lod, 3.0f);
+}
+
 TEST(ProgramChoice, TheParametersCarryTheMaterialsNumbers) {
   MaterialDesc m = material(TechniqueKind::Pom, 2);
   m.technique.depth_scale = 0.125f;
@@ -91,8 +147,8 @@ TEST(ProgramChoice, TheParametersCarryTheMaterialsNumbers) {
   EXPECT_EQ(p.trace.min_steps, 3);
   EXPECT_EQ(p.trace.lod_threshold, 2.5f);
   EXPECT_EQ(p.trace.fade_end, 40.0f);
-  EXPECT_EQ(p.sampling.address, AddressMode::Mirror);
-  EXPECT_EQ(p.sampling.lod_bias, -0.5f);
+  EXPECT_EQ(p.sampler.lod_bias, -0.5f);
+  EXPECT_EQ(program_key(m).sampler.address, AddressMode::Mirror);
   EXPECT_EQ(p.lighting.roughness, 0.75f);
   ASSERT_EQ(p.specular.size(), 2u);
   EXPECT_FALSE(p.specular[0].enabled);

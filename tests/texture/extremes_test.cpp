@@ -52,7 +52,7 @@ std::vector<float> sample_checked(const Texture& texture, const TextureView& vie
       u[i] = p.u, v[i] = p.v, lod[i] = p.lod;
     }
     for (simd::FetchPath path : {simd::FetchPath::Gather, simd::FetchPath::Portable}) {
-      SamplerState state = SamplerState::from(desc);
+      SamplerState state = test::sampler_state(desc);
       state.fetch = path;
       Float out[4];
       sample(view, state, Float::load_aligned(u), Float::load_aligned(v), Float::load_aligned(lod), out);

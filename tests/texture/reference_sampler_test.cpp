@@ -103,7 +103,7 @@ std::string describe(const SamplingDesc& d, const Texture& t, int lane, int c, f
 void expect_batch_matches_reference(const Texture& texture, const TextureView& view, const SamplingDesc& desc,
                                     const Lanes& u, const Lanes& v, const Lanes& lod) {
   for (simd::FetchPath path : {simd::FetchPath::Gather, simd::FetchPath::Portable}) {
-    SamplerState state = SamplerState::from(desc);
+    SamplerState state = test::sampler_state(desc);
     state.fetch = path;
     Float out[4];
     sample(view, state, Float::load_unaligned(u.data()), Float::load_unaligned(v.data()),

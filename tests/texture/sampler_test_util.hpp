@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kernel/sampler.hpp"
+#include "plan/program_choice.hpp"
 
 namespace qdmr::test {
 
@@ -19,6 +20,11 @@ inline constexpr Filter kFilters[] = {Filter::Point,         Filter::Bilinear,  
 inline constexpr AddressMode kAddressModes[] = {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror};
 inline constexpr SamplePrecision kPrecisions[] = {SamplePrecision::Exact, SamplePrecision::Hw8, SamplePrecision::Hw6};
 inline constexpr MathMode kMathModes[] = {MathMode::Sm4, MathMode::Sm3, MathMode::Exact};
+
+// The sampler state of a material's sampling, split into key and parameters as the plan splits it.
+inline SamplerState sampler_state(const SamplingDesc& d) {
+  return SamplerState::from(sampler_modes(d, HeightFetch::Bilinear), sampler_params(d));
+}
 
 inline std::uint32_t bits(float f) {
   std::uint32_t b;

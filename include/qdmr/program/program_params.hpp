@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "qdmr/core/sampling.hpp"
 #include "qdmr/scene/material_modes.hpp"
 
 namespace qdmr {
@@ -21,10 +20,15 @@ struct TraceParams {
   float lod_threshold = 4.0f, lod_fade = 1.0f;  // pom: the LOD fade to normal mapping
   int max_iterations = 128;                 // csm, rcsm, qdm
   QdmRefinement refinement = QdmRefinement::Linear;
-  HeightFetch height_fetch = HeightFetch::Bilinear;
   bool lod_stop = false;
   int min_iterations = 0;
   float fade_start = 0.0f, fade_end = 0.0f;  // depth scale fading to 0 with view distance
+};
+
+// The sampler's numbers (scene.hpp's SamplingDesc documents each); its modes are the key's (SamplerModes).
+struct SamplerParams {
+  float lod_bias = 0.0f;
+  float min_lod = 0.0f, max_lod = 16.0f;  // LOD clamp, in levels
 };
 
 struct LightingParams {
@@ -69,7 +73,7 @@ struct BlendParams {
 
 struct ProgramParams {
   TraceParams trace;
-  SamplingDesc sampling;
+  SamplerParams sampler;
   LightingParams lighting;
   std::vector<SpecularFromAlbedo> specular;  // per layer
   OrmParams orm;                             // ProgramKey::orm
