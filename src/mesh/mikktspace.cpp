@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <emmintrin.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 
 #include <glm/geometric.hpp>
 
@@ -27,9 +29,6 @@ glm::vec3 unit_or_zero(const glm::vec3& v) {
   return not_zero(len) && std::isfinite(len) ? v / len : glm::vec3(0.0f);
 }
 
-// The component of v in the plane whose normal is n (unit), normalised (zero when v is along n).
-glm::vec3 in_plane(const glm::vec3& v, const glm::vec3& n) { return unit_or_zero(v - n * glm::dot(n, v)); }
-
 // A triangle's +u direction (unit, or zero) and UV orientation, as mikktspace.c's InitTriInfo computes them.
 struct Face {
   glm::vec3 along_u{0.0f};
@@ -37,7 +36,7 @@ struct Face {
   bool degenerate = true;   // no usable UV derivative
 };
 
-Face face_of(std::span<const glm::vec3> positions, std::span<const glm::vec2> uvs, const std::uint32_t* corner) {
+inline Face face_of(std::span<const glm::vec3> positions, std::span<const glm::vec2> uvs, const std::uint32_t* corner) {
   Face f;
   const glm::vec3 d1 = positions[corner[1]] - positions[corner[0]];
   const glm::vec3 d2 = positions[corner[2]] - positions[corner[0]];
@@ -55,49 +54,56 @@ Face face_of(std::span<const glm::vec3> positions, std::span<const glm::vec2> uv
 
 // Vertices with equal attributes are one vertex (mikktspace.c welds them): same[v] is the first vertex of v's kind.
 // A hash table (+0 and -0 alike, as mikktspace.c's == sees them) filled in vertex order, so the first of a kind is
-// the one in the table.
+// the one in the table. The table lives in `scratch` (the tangents, 16 bytes a vertex: 2 slots of 8 bytes, each the
+// hash's low half beside vertex + 1, so a probe compares a vertex's attributes only where the hashes agree).
+using Slot = std::uint64_t __attribute__((may_alias));  // the scratch holds floats before and after
+
 std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                                std::span<const glm::vec2> uvs) {
+                                std::span<const glm::vec2> uvs, std::span<glm::vec4> scratch) {
   const std::size_t n = positions.size();
   const auto key = [&](std::uint32_t v) {
     return std::array<float, 8>{positions[v].x + 0.0f, positions[v].y + 0.0f, positions[v].z + 0.0f,
                                 normals[v].x + 0.0f,   normals[v].y + 0.0f,   normals[v].z + 0.0f,
                                 uvs[v].x + 0.0f,       uvs[v].y + 0.0f};
   };
-  const auto hash = [&](std::uint32_t v) {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (const float f : key(v)) {
-      std::uint32_t bits = 0;
-      std::memcpy(&bits, &f, sizeof bits);
-      h = (h ^ bits) * 0x100000001b3ull;
-      h ^= h >> 29;
-    }
-    return h;
+  // Four independent products, then a mix (any hash gives the same kinds; this one is short).
+  const auto hash = [](const std::array<float, 8>& k) {
+    std::array<std::uint64_t, 4> w{};
+    std::memcpy(w.data(), k.data(), sizeof w);
+    std::uint64_t h = (w[0] * 0x9E3779B97F4A7C15ull) ^ (w[1] * 0xC2B2AE3D27D4EB4Full) ^
+                      (w[2] * 0x165667B19E3779F9ull) ^ (w[3] * 0xD6E8FEB86659FD93ull);
+    h ^= h >> 32;
+    h *= 0x9FB21C651E98DF25ull;
+    return h ^ (h >> 29);
   };
-  // Linear probing at most 2/3 full; a hash's slot is its top 32 bits scaled to the capacity.
-  const std::size_t capacity = n + n / 2 + 1;
-  std::vector<std::uint32_t> table(capacity, 0);  // vertex + 1, 0: empty
+  // Linear probing at most 1/2 full; a hash's slot is the hash scaled to the capacity.
+  const std::size_t capacity = 2 * n;
+  Slot* table = reinterpret_cast<Slot*>(scratch.data());
+  std::memset(static_cast<void*>(scratch.data()), 0, capacity * sizeof(Slot));
   std::vector<std::uint32_t> same(n);
   // Batches: the slots of a batch are asked for before they are probed.
   constexpr std::size_t kBatch = 32;
   std::array<std::size_t, kBatch> slot{};
+  std::array<std::uint64_t, kBatch> tag{};
   for (std::size_t first = 0; first < n; first += kBatch) {
     const std::size_t count = std::min(kBatch, n - first);
     for (std::size_t k = 0; k < count; ++k) {
-      slot[k] = std::size_t(((hash(std::uint32_t(first + k)) >> 32) * capacity) >> 32);
+      const std::uint64_t h = hash(key(std::uint32_t(first + k)));
+      slot[k] = std::size_t(((h >> 32) * capacity) >> 32);  // capacity < 2^32: 3 x kMaxTriangles vertices at most
+      tag[k] = h << 32;  // the low half
       __builtin_prefetch(&table[slot[k]]);
     }
     for (std::size_t k = 0; k < count; ++k) {
       const auto v = std::uint32_t(first + k);
-      const std::array<float, 8> mine = key(v);
       for (std::size_t at = slot[k];; at = at + 1 == capacity ? 0 : at + 1) {
-        if (table[at] == 0) {
-          table[at] = v + 1;
+        const std::uint64_t entry = table[at];
+        if (entry == 0) {
+          table[at] = tag[k] | (std::uint64_t(v) + 1);
           same[v] = v;
           break;
         }
-        if (key(table[at] - 1) == mine) {
-          same[v] = table[at] - 1;
+        if ((entry & ~0xffffffffull) == tag[k] && key(std::uint32_t(entry) - 1) == key(v)) {
+          same[v] = std::uint32_t(entry) - 1;
           break;
         }
       }
@@ -106,6 +112,112 @@ std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<
   return same;
 }
 
+// The corners of four faces at once, in three vectors of SSE2's four lanes (x86-64's baseline): each corner's
+// direction (its face's +u in the plane of the corner's normal, normalised) times its angle (between its edges
+// projected onto that plane). Every lane takes the scalar formulas' operations in their order (glm's dot is
+// (x x + y y) + z z, its length the square root of that, a vector over a scalar three divisions;
+// deterministic_acos's branches are both taken and one chosen), and SSE2 rounds as the scalar operations do: the
+// same bits. Three independent vectors keep the divisions and square roots busy.
+struct CornerBatch {
+  static constexpr int kFaces = 4, kGroups = 3, kLanes = 4 * kGroups;  // corner k of face i: lane 3 i + k
+  alignas(16) float px[kLanes]{}, py[kLanes]{}, pz[kLanes]{};  // the corner's position
+  alignas(16) float ax[kLanes]{}, ay[kLanes]{}, az[kLanes]{};  // corner k + 2's
+  alignas(16) float bx[kLanes]{}, by[kLanes]{}, bz[kLanes]{};  // corner k + 1's
+  alignas(16) float nx[kLanes]{}, ny[kLanes]{}, nz[kLanes]{};  // the corner's normal
+  alignas(16) float ux[kLanes]{}, uy[kLanes]{}, uz[kLanes]{};  // the face's +u
+  alignas(16) float wx[kLanes]{}, wy[kLanes]{}, wz[kLanes]{};  // the result
+
+  void set(int face, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+           const std::uint32_t* corner, const glm::vec3& along_u) {
+    for (int k = 0; k < 3; ++k) {
+      const int l = 3 * face + k;
+      const glm::vec3 &p = positions[corner[k]], &a = positions[corner[(k + 2) % 3]], &b = positions[corner[(k + 1) % 3]];
+      const glm::vec3& n = normals[corner[k]];
+      px[l] = p.x, py[l] = p.y, pz[l] = p.z, ax[l] = a.x, ay[l] = a.y, az[l] = a.z, bx[l] = b.x, by[l] = b.y, bz[l] = b.z;
+      nx[l] = n.x, ny[l] = n.y, nz[l] = n.z, ux[l] = along_u.x, uy[l] = along_u.y, uz[l] = along_u.z;
+    }
+  }
+
+  void compute() {
+    for (int g = 0; g < kGroups; ++g) compute(4 * g);
+  }
+
+private:
+  void compute(int l) {
+    const auto add = [](__m128 a, __m128 b) { return _mm_add_ps(a, b); };
+    const auto sub = [](__m128 a, __m128 b) { return _mm_sub_ps(a, b); };
+    const auto mul = [](__m128 a, __m128 b) { return _mm_mul_ps(a, b); };
+    const auto dot = [&](__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+      return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
+    };
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    // unit_or_zero, in place.
+    const auto unit = [&](__m128& x, __m128& y, __m128& z) {
+      const __m128 len = _mm_sqrt_ps(dot(x, y, z, x, y, z));
+      const __m128 a = _mm_and_ps(len, abs_mask);
+      const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(a, _mm_set1_ps(std::numeric_limits<float>::min())),
+                                   _mm_cmple_ps(a, _mm_set1_ps(std::numeric_limits<float>::max())));
+      x = _mm_and_ps(ok, _mm_div_ps(x, len));
+      y = _mm_and_ps(ok, _mm_div_ps(y, len));
+      z = _mm_and_ps(ok, _mm_div_ps(z, len));
+    };
+    __m128 nx_ = _mm_load_ps(nx + l), ny_ = _mm_load_ps(ny + l), nz_ = _mm_load_ps(nz + l);
+    unit(nx_, ny_, nz_);
+    // in_plane: v - n dot(n, v), normalised; the edges' projections alike (not normalised).
+    const auto project = [&](__m128& x, __m128& y, __m128& z) {
+      const __m128 d = dot(nx_, ny_, nz_, x, y, z);
+      x = sub(x, mul(nx_, d));
+      y = sub(y, mul(ny_, d));
+      z = sub(z, mul(nz_, d));
+    };
+    __m128 tx = _mm_load_ps(ux + l), ty = _mm_load_ps(uy + l), tz = _mm_load_ps(uz + l);
+    project(tx, ty, tz);
+    unit(tx, ty, tz);
+    const __m128 px_ = _mm_load_ps(px + l), py_ = _mm_load_ps(py + l), pz_ = _mm_load_ps(pz + l);
+    __m128 ax_ = sub(_mm_load_ps(ax + l), px_), ay_ = sub(_mm_load_ps(ay + l), py_), az_ = sub(_mm_load_ps(az + l), pz_);
+    __m128 bx_ = sub(_mm_load_ps(bx + l), px_), by_ = sub(_mm_load_ps(by + l), py_), bz_ = sub(_mm_load_ps(bz + l), pz_);
+    project(ax_, ay_, az_);
+    project(bx_, by_, bz_);
+    const __m128 aa = dot(ax_, ay_, az_, ax_, ay_, az_), bb = dot(bx_, by_, bz_, bx_, by_, bz_),
+                 ab = dot(ax_, ay_, az_, bx_, by_, bz_);
+    const __m128d low = angle(_mm_cvtps_pd(aa), _mm_cvtps_pd(bb), _mm_cvtps_pd(ab));
+    const __m128d high = angle(_mm_cvtps_pd(_mm_movehl_ps(aa, aa)), _mm_cvtps_pd(_mm_movehl_ps(bb, bb)),
+                               _mm_cvtps_pd(_mm_movehl_ps(ab, ab)));
+    const __m128 w = _mm_movelh_ps(_mm_cvtpd_ps(low), _mm_cvtpd_ps(high));
+    _mm_store_ps(wx + l, mul(w, tx));
+    _mm_store_ps(wy + l, mul(w, ty));
+    _mm_store_ps(wz + l, mul(w, tz));
+  }
+
+  // The corner's angle from its projected edges' dot products, in double, two lanes at a time: cosine
+  // ab / sqrt(aa bb) (0 when that is not positive and finite), then deterministic_acos.
+  static __m128d angle(__m128d aa, __m128d bb, __m128d ab) {
+    const __m128d lengths2 = _mm_mul_pd(aa, bb);
+    const __m128d ok = _mm_and_pd(_mm_cmpgt_pd(lengths2, _mm_setzero_pd()),
+                                  _mm_cmple_pd(lengths2, _mm_set1_pd(std::numeric_limits<double>::max())));
+    __m128d x = _mm_and_pd(ok, _mm_div_pd(ab, _mm_sqrt_pd(lengths2)));
+    // std::clamp (NaN passes), then both branches.
+    const __m128d one = _mm_set1_pd(1.0), minus_one = _mm_set1_pd(-1.0), half = _mm_set1_pd(0.5);
+    const auto select = [](__m128d mask, __m128d a, __m128d b) { return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b)); };
+    const __m128d below = _mm_cmplt_pd(x, minus_one), above = _mm_cmplt_pd(one, x);
+    x = select(below, minus_one, select(above, one, x));
+    const auto asin_small = [](__m128d a) {
+      const __m128d z = _mm_mul_pd(a, a);
+      __m128d p = _mm_add_pd(_mm_mul_pd(_mm_set1_pd(4.2163199048e-2), z), _mm_set1_pd(2.4181311049e-2));
+      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(4.5470025998e-2));
+      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(7.4953002686e-2));
+      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(1.6666752422e-1));
+      return _mm_add_pd(a, _mm_mul_pd(_mm_mul_pd(a, z), p));
+    };
+    const __m128d half_pi = _mm_set1_pd(1.57079632679489661923);
+    const __m128d a = _mm_and_pd(x, _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffll)));
+    const __m128d large =
+        _mm_sub_pd(half_pi, _mm_mul_pd(_mm_set1_pd(2.0), asin_small(_mm_sqrt_pd(_mm_mul_pd(_mm_sub_pd(one, a), half)))));
+    const __m128d asin_a = select(_mm_cmple_pd(a, half), asin_small(a), large);
+    return select(_mm_cmplt_pd(x, _mm_setzero_pd()), _mm_add_pd(half_pi, asin_a), _mm_sub_pd(half_pi, asin_a));
+  }
+};
+
 }  // namespace
 
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
@@ -113,60 +225,68 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
                                      std::span<glm::vec4> tangents) {
   const std::size_t n = positions.size(), faces = indices.size() / 3;
   const auto normal = [&](std::uint32_t v) { return unit_or_zero(normals[v]); };
-  const std::vector<std::uint32_t> same = weld(positions, normals, uvs);
-
-  // Whether any triangle has mirrored UVs (only then do vertices split, and need mirrored sums).
-  const bool any_mirrored = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, faces, 16384), false,
-      [&](const tbb::blocked_range<std::size_t>& range, bool mirrored) {
-        for (std::size_t f = range.begin(); f != range.end() && !mirrored; ++f) {
-          const Face face = face_of(positions, uvs, &indices[3 * f]);
-          mirrored = !face.degenerate && !face.preserving;
-        }
-        return mirrored;
-      },
-      [](bool a, bool b) { return a || b; });
+  const std::vector<std::uint32_t> same = weld(positions, normals, uvs, tangents);
 
   // Per vertex kind and orientation: the angle-weighted sum of its corners' directions, the preserving sums in
-  // `tangents` (xyz), the mirrored ones beside them. Each thread takes a range of kinds and sums their corners in
-  // triangle order. flags: bit 0 / 1 the kind has a preserving / mirrored sum; bits 2-3 the orientation of the
-  // vertex's own entry (1 preserving, 2 mirrored, 0 unset).
+  // `tangents` (xyz), the mirrored ones beside them (made when the first mirrored triangle is met: only then do
+  // vertices split). Each thread takes a range of kinds and sums their corners in triangle order. flags: bit 0 / 1
+  // the kind has a preserving / mirrored sum; bits 2-3 the orientation of the vertex's own entry (1 preserving, 2
+  // mirrored, 0 unset).
   std::fill(tangents.begin(), tangents.end(), glm::vec4(0.0f));
-  std::vector<glm::vec3> mirrored_sum(any_mirrored ? n : 0, glm::vec3(0.0f));
+  std::vector<glm::vec3> mirrored_sum;
+  std::once_flag mirrored_made;
   std::vector<std::uint8_t> flags(n, 0);
   const std::size_t parts = std::size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
     const std::uint32_t lo = std::uint32_t(n * part / parts), hi = std::uint32_t(n * (part + 1) / parts);
     const auto mine = [&](std::uint32_t v) { return same[v] >= lo && same[v] < hi; };
+    // Faces wait in a batch of four for their corners' directions, then are summed in order.
+    CornerBatch batch;
+    struct Waiting {
+      const std::uint32_t* corner;
+      bool own[3];
+      bool preserving;
+    };
+    std::array<Waiting, CornerBatch::kFaces> waiting{};
+    int count = 0;
+    const auto sum_batch = [&] {
+      batch.compute();
+      for (int i = 0; i < count; ++i) {
+        const Waiting& face = waiting[std::size_t(i)];
+        for (int k = 0; k < 3; ++k) {
+          if (!face.own[k]) continue;
+          const int l = 3 * i + k;
+          const std::uint32_t kind = same[face.corner[k]];
+          const auto add = [&](auto& sum) {
+            sum.x += batch.wx[l];
+            sum.y += batch.wy[l];
+            sum.z += batch.wz[l];
+          };
+          if (face.preserving) {
+            add(tangents[kind]);
+          } else {
+            add(mirrored_sum[kind]);
+          }
+          flags[kind] |= face.preserving ? 1 : 2;
+        }
+      }
+      count = 0;
+    };
     for (std::size_t f = 0; f < faces; ++f) {
       const std::uint32_t* corner = &indices[3 * f];
-      if (!(mine(corner[0]) || mine(corner[1]) || mine(corner[2]))) continue;
+      const Waiting w{corner, {mine(corner[0]), mine(corner[1]), mine(corner[2])}, false};
+      if (!(w.own[0] || w.own[1] || w.own[2])) continue;
       const Face face = face_of(positions, uvs, corner);
       if (face.degenerate) continue;
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = corner[k];
-        if (!mine(v)) continue;
-        const glm::vec3 nv = normal(v);
-        const glm::vec3 t = in_plane(face.along_u, nv);
-        // The corner's angle between its edges projected onto the normal's plane (a zero edge: pi / 2, as
-        // mikktspace.c's zero vectors give), from one square root instead of two normalisations.
-        const glm::vec3 p = positions[v];
-        const glm::vec3 a = positions[corner[(k + 2) % 3]] - p, b = positions[corner[(k + 1) % 3]] - p;
-        const glm::vec3 a_in = a - nv * glm::dot(nv, a), b_in = b - nv * glm::dot(nv, b);
-        const double lengths2 = double(glm::dot(a_in, a_in)) * double(glm::dot(b_in, b_in));
-        const double cosine = lengths2 > 0.0 && std::isfinite(lengths2) ? double(glm::dot(a_in, b_in)) / std::sqrt(lengths2) : 0.0;
-        const float angle = float(deterministic_acos(cosine));
-        if (face.preserving) {
-          glm::vec3 sum(tangents[same[v]]);
-          sum += angle * t;
-          tangents[same[v]] = glm::vec4(sum, 0.0f);
-        } else {
-          mirrored_sum[same[v]] += angle * t;
-        }
-        flags[same[v]] |= face.preserving ? 1 : 2;
-      }
+      if (!face.preserving) std::call_once(mirrored_made, [&] { mirrored_sum.assign(n, glm::vec3(0.0f)); });
+      batch.set(count, positions, normals, corner, face.along_u);
+      waiting[std::size_t(count)] = w;
+      waiting[std::size_t(count)].preserving = face.preserving;
+      if (++count == CornerBatch::kFaces) sum_batch();
     }
+    if (count > 0) sum_batch();
   });
+  const bool any_mirrored = !mirrored_sum.empty();
 
   const auto tangent = [&](std::uint32_t v, int side) {
     const glm::vec3 t = unit_or_zero(side == 0 ? glm::vec3(tangents[same[v]]) : mirrored_sum[same[v]]);
