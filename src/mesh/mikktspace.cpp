@@ -13,6 +13,7 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -138,69 +139,90 @@ struct CornerBatch {
     }
   }
 
-  void compute() {
-    for (int g = 0; g < kGroups; ++g) compute(4 * g);
-  }
+  // Each step over the three vectors before the next step, so that their divisions and square roots overlap.
+  struct V {  // (a template of a vector type drops its attributes)
+    __m128 v[kGroups];
+    __m128& operator[](std::size_t i) { return v[i]; }
+    const __m128& operator[](std::size_t i) const { return v[i]; }
+    static constexpr std::size_t size() { return kGroups; }
+  };
+  struct D {  // a V's lanes 0-1 and 2-3 in double
+    __m128d v[2 * kGroups];
+    __m128d& operator[](std::size_t i) { return v[i]; }
+    const __m128d& operator[](std::size_t i) const { return v[i]; }
+    static constexpr std::size_t size() { return 2 * kGroups; }
+  };
 
-private:
-  void compute(int l) {
-    const auto add = [](__m128 a, __m128 b) { return _mm_add_ps(a, b); };
-    const auto sub = [](__m128 a, __m128 b) { return _mm_sub_ps(a, b); };
-    const auto mul = [](__m128 a, __m128 b) { return _mm_mul_ps(a, b); };
-    const auto dot = [&](__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+  void compute() {
+    const auto each = [](auto f, const auto&... in) {
+      std::remove_cvref_t<decltype((in, ...))> out;
+      for (std::size_t g = 0; g < out.size(); ++g) out[g] = f(in[g]...);
+      return out;
+    };
+    const auto load = [](const float* from) {
+      V v;
+      for (int g = 0; g < kGroups; ++g) v[std::size_t(g)] = _mm_load_ps(from + 4 * g);
+      return v;
+    };
+    const auto add = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_add_ps(x, y); }, a, b); };
+    const auto sub = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_sub_ps(x, y); }, a, b); };
+    const auto mul = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_mul_ps(x, y); }, a, b); };
+    const auto dot = [&](const V& ax, const V& ay, const V& az, const V& bx, const V& by, const V& bz) {
       return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
     };
-    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
     // unit_or_zero, in place.
-    const auto unit = [&](__m128& x, __m128& y, __m128& z) {
-      const __m128 len = _mm_sqrt_ps(dot(x, y, z, x, y, z));
-      const __m128 a = _mm_and_ps(len, abs_mask);
-      const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(a, _mm_set1_ps(std::numeric_limits<float>::min())),
-                                   _mm_cmple_ps(a, _mm_set1_ps(std::numeric_limits<float>::max())));
-      x = _mm_and_ps(ok, _mm_div_ps(x, len));
-      y = _mm_and_ps(ok, _mm_div_ps(y, len));
-      z = _mm_and_ps(ok, _mm_div_ps(z, len));
+    const auto unit = [&](V& x, V& y, V& z) {
+      const V len = each([](__m128 d) { return _mm_sqrt_ps(d); }, dot(x, y, z, x, y, z));
+      const V ok = each([](__m128 l) {
+        const __m128 a = _mm_and_ps(l, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)));
+        return _mm_and_ps(_mm_cmpgt_ps(a, _mm_set1_ps(std::numeric_limits<float>::min())),
+                          _mm_cmple_ps(a, _mm_set1_ps(std::numeric_limits<float>::max())));
+      }, len);
+      const auto divide = [](__m128 v, __m128 l, __m128 o) { return _mm_and_ps(o, _mm_div_ps(v, l)); };
+      x = each(divide, x, len, ok);
+      y = each(divide, y, len, ok);
+      z = each(divide, z, len, ok);
     };
-    __m128 nx_ = _mm_load_ps(nx + l), ny_ = _mm_load_ps(ny + l), nz_ = _mm_load_ps(nz + l);
+    V nx_ = load(nx), ny_ = load(ny), nz_ = load(nz);
     unit(nx_, ny_, nz_);
     // in_plane: v - n dot(n, v), normalised; the edges' projections alike (not normalised).
-    const auto project = [&](__m128& x, __m128& y, __m128& z) {
-      const __m128 d = dot(nx_, ny_, nz_, x, y, z);
+    const auto project = [&](V& x, V& y, V& z) {
+      const V d = dot(nx_, ny_, nz_, x, y, z);
       x = sub(x, mul(nx_, d));
       y = sub(y, mul(ny_, d));
       z = sub(z, mul(nz_, d));
     };
-    __m128 tx = _mm_load_ps(ux + l), ty = _mm_load_ps(uy + l), tz = _mm_load_ps(uz + l);
+    V tx = load(ux), ty = load(uy), tz = load(uz);
     project(tx, ty, tz);
     unit(tx, ty, tz);
-    const __m128 px_ = _mm_load_ps(px + l), py_ = _mm_load_ps(py + l), pz_ = _mm_load_ps(pz + l);
-    __m128 ax_ = sub(_mm_load_ps(ax + l), px_), ay_ = sub(_mm_load_ps(ay + l), py_), az_ = sub(_mm_load_ps(az + l), pz_);
-    __m128 bx_ = sub(_mm_load_ps(bx + l), px_), by_ = sub(_mm_load_ps(by + l), py_), bz_ = sub(_mm_load_ps(bz + l), pz_);
+    const V px_ = load(px), py_ = load(py), pz_ = load(pz);
+    V ax_ = sub(load(ax), px_), ay_ = sub(load(ay), py_), az_ = sub(load(az), pz_);
+    V bx_ = sub(load(bx), px_), by_ = sub(load(by), py_), bz_ = sub(load(bz), pz_);
     project(ax_, ay_, az_);
     project(bx_, by_, bz_);
-    const __m128 aa = dot(ax_, ay_, az_, ax_, ay_, az_), bb = dot(bx_, by_, bz_, bx_, by_, bz_),
-                 ab = dot(ax_, ay_, az_, bx_, by_, bz_);
-    const __m128d low = angle(_mm_cvtps_pd(aa), _mm_cvtps_pd(bb), _mm_cvtps_pd(ab));
-    const __m128d high = angle(_mm_cvtps_pd(_mm_movehl_ps(aa, aa)), _mm_cvtps_pd(_mm_movehl_ps(bb, bb)),
-                               _mm_cvtps_pd(_mm_movehl_ps(ab, ab)));
-    const __m128 w = _mm_movelh_ps(_mm_cvtpd_ps(low), _mm_cvtpd_ps(high));
-    _mm_store_ps(wx + l, mul(w, tx));
-    _mm_store_ps(wy + l, mul(w, ty));
-    _mm_store_ps(wz + l, mul(w, tz));
-  }
-
-  // The corner's angle from its projected edges' dot products, in double, two lanes at a time: cosine
-  // ab / sqrt(aa bb) (0 when that is not positive and finite), then deterministic_acos.
-  static __m128d angle(__m128d aa, __m128d bb, __m128d ab) {
-    const __m128d lengths2 = _mm_mul_pd(aa, bb);
-    const __m128d ok = _mm_and_pd(_mm_cmpgt_pd(lengths2, _mm_setzero_pd()),
-                                  _mm_cmple_pd(lengths2, _mm_set1_pd(std::numeric_limits<double>::max())));
-    __m128d x = _mm_and_pd(ok, _mm_div_pd(ab, _mm_sqrt_pd(lengths2)));
-    // std::clamp (NaN passes), then both branches.
-    const __m128d one = _mm_set1_pd(1.0), minus_one = _mm_set1_pd(-1.0), half = _mm_set1_pd(0.5);
+    const auto wide = [](const V& v) {
+      D d;
+      for (std::size_t g = 0; g < v.size(); ++g) {
+        d[2 * g] = _mm_cvtps_pd(v[g]);
+        d[2 * g + 1] = _mm_cvtps_pd(_mm_movehl_ps(v[g], v[g]));
+      }
+      return d;
+    };
+    const D aa = wide(dot(ax_, ay_, az_, ax_, ay_, az_)), bb = wide(dot(bx_, by_, bz_, bx_, by_, bz_)),
+            ab = wide(dot(ax_, ay_, az_, bx_, by_, bz_));
+    // The corner's angle in double: cosine ab / sqrt(aa bb) (0 where aa bb is not positive and finite), then
+    // deterministic_acos (std::clamp, through which NaN passes, then both branches).
     const auto select = [](__m128d mask, __m128d a, __m128d b) { return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b)); };
-    const __m128d below = _mm_cmplt_pd(x, minus_one), above = _mm_cmplt_pd(one, x);
-    x = select(below, minus_one, select(above, one, x));
+    const D lengths2 = each([](__m128d a, __m128d b) { return _mm_mul_pd(a, b); }, aa, bb);
+    const D root = each([](__m128d l) { return _mm_sqrt_pd(l); }, lengths2);
+    const D x = each([&](__m128d l, __m128d r, __m128d d) {
+      const __m128d ok = _mm_and_pd(_mm_cmpgt_pd(l, _mm_setzero_pd()), _mm_cmple_pd(l, _mm_set1_pd(std::numeric_limits<double>::max())));
+      const __m128d c = _mm_and_pd(ok, _mm_div_pd(d, r));
+      const __m128d one = _mm_set1_pd(1.0), minus_one = _mm_set1_pd(-1.0);
+      return select(_mm_cmplt_pd(c, minus_one), minus_one, select(_mm_cmplt_pd(one, c), one, c));
+    }, lengths2, root, ab);
+    const D abs_x = each([](__m128d v) { return _mm_and_pd(v, _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffll))); }, x);
+    const D large_root = each([](__m128d a) { return _mm_sqrt_pd(_mm_mul_pd(_mm_sub_pd(_mm_set1_pd(1.0), a), _mm_set1_pd(0.5))); }, abs_x);
     const auto asin_small = [](__m128d a) {
       const __m128d z = _mm_mul_pd(a, a);
       __m128d p = _mm_add_pd(_mm_mul_pd(_mm_set1_pd(4.2163199048e-2), z), _mm_set1_pd(2.4181311049e-2));
@@ -209,12 +231,19 @@ private:
       p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(1.6666752422e-1));
       return _mm_add_pd(a, _mm_mul_pd(_mm_mul_pd(a, z), p));
     };
-    const __m128d half_pi = _mm_set1_pd(1.57079632679489661923);
-    const __m128d a = _mm_and_pd(x, _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffll)));
-    const __m128d large =
-        _mm_sub_pd(half_pi, _mm_mul_pd(_mm_set1_pd(2.0), asin_small(_mm_sqrt_pd(_mm_mul_pd(_mm_sub_pd(one, a), half)))));
-    const __m128d asin_a = select(_mm_cmple_pd(a, half), asin_small(a), large);
-    return select(_mm_cmplt_pd(x, _mm_setzero_pd()), _mm_add_pd(half_pi, asin_a), _mm_sub_pd(half_pi, asin_a));
+    const D angle = each([&](__m128d v, __m128d a, __m128d r) {
+      const __m128d half_pi = _mm_set1_pd(1.57079632679489661923);
+      const __m128d large = _mm_sub_pd(half_pi, _mm_mul_pd(_mm_set1_pd(2.0), asin_small(r)));
+      const __m128d asin_a = select(_mm_cmple_pd(a, _mm_set1_pd(0.5)), asin_small(a), large);
+      return select(_mm_cmplt_pd(v, _mm_setzero_pd()), _mm_add_pd(half_pi, asin_a), _mm_sub_pd(half_pi, asin_a));
+    }, x, abs_x, large_root);
+    for (int g = 0; g < kGroups; ++g) {
+      const auto i = std::size_t(g);
+      const __m128 w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * i]), _mm_cvtpd_ps(angle[2 * i + 1]));
+      _mm_store_ps(wx + 4 * g, _mm_mul_ps(w, tx[i]));
+      _mm_store_ps(wy + 4 * g, _mm_mul_ps(w, ty[i]));
+      _mm_store_ps(wz + 4 * g, _mm_mul_ps(w, tz[i]));
+    }
   }
 };
 
@@ -274,14 +303,16 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
     };
     for (std::size_t f = 0; f < faces; ++f) {
       const std::uint32_t* corner = &indices[3 * f];
-      const Waiting w{corner, {mine(corner[0]), mine(corner[1]), mine(corner[2])}, false};
-      if (!(w.own[0] || w.own[1] || w.own[2])) continue;
+      const bool own0 = mine(corner[0]), own1 = mine(corner[1]), own2 = mine(corner[2]);
+      if (!(own0 || own1 || own2)) continue;
       const Face face = face_of(positions, uvs, corner);
       if (face.degenerate) continue;
       if (!face.preserving) std::call_once(mirrored_made, [&] { mirrored_sum.assign(n, glm::vec3(0.0f)); });
       batch.set(count, positions, normals, corner, face.along_u);
-      waiting[std::size_t(count)] = w;
-      waiting[std::size_t(count)].preserving = face.preserving;
+      Waiting& w = waiting[std::size_t(count)];  // field by field (a whole struct stored then copied stalls)
+      w.corner = corner;
+      w.own[0] = own0, w.own[1] = own1, w.own[2] = own2;
+      w.preserving = face.preserving;
       if (++count == CornerBatch::kFaces) sum_batch();
     }
     if (count > 0) sum_batch();
