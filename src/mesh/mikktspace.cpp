@@ -4,7 +4,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include <emmintrin.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include <type_traits>
 
 #include <glm/geometric.hpp>
+#include <xsimd/xsimd.hpp>
 
 #include "mesh/builders.hpp"
 
@@ -140,18 +140,10 @@ struct CornerBatch {
   }
 
   // Each step over the three vectors before the next step, so that their divisions and square roots overlap.
-  struct V {  // (a template of a vector type drops its attributes)
-    __m128 v[kGroups];
-    __m128& operator[](std::size_t i) { return v[i]; }
-    const __m128& operator[](std::size_t i) const { return v[i]; }
-    static constexpr std::size_t size() { return kGroups; }
-  };
-  struct D {  // a V's lanes 0-1 and 2-3 in double
-    __m128d v[2 * kGroups];
-    __m128d& operator[](std::size_t i) { return v[i]; }
-    const __m128d& operator[](std::size_t i) const { return v[i]; }
-    static constexpr std::size_t size() { return 2 * kGroups; }
-  };
+  using Floats = xsimd::batch<float, xsimd::sse2>;
+  using Doubles = xsimd::batch<double, xsimd::sse2>;
+  using V = std::array<Floats, kGroups>;
+  using D = std::array<Doubles, 2 * kGroups>;  // a V's lanes 0-1 and 2-3 in double
 
   void compute() {
     const auto each = [](auto f, const auto&... in) {
@@ -161,27 +153,28 @@ struct CornerBatch {
     };
     const auto load = [](const float* from) {
       V v;
-      for (int g = 0; g < kGroups; ++g) v[std::size_t(g)] = _mm_load_ps(from + 4 * g);
+      for (int g = 0; g < kGroups; ++g) v[std::size_t(g)] = Floats::load_aligned(from + 4 * g);
       return v;
     };
-    const auto add = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_add_ps(x, y); }, a, b); };
-    const auto sub = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_sub_ps(x, y); }, a, b); };
-    const auto mul = [&](const V& a, const V& b) { return each([](__m128 x, __m128 y) { return _mm_mul_ps(x, y); }, a, b); };
+    const auto add = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x + y; }, a, b); };
+    const auto sub = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x - y; }, a, b); };
+    const auto mul = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x * y; }, a, b); };
     const auto dot = [&](const V& ax, const V& ay, const V& az, const V& bx, const V& by, const V& bz) {
       return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
     };
     // unit_or_zero, in place.
     const auto unit = [&](V& x, V& y, V& z) {
-      const V len = each([](__m128 d) { return _mm_sqrt_ps(d); }, dot(x, y, z, x, y, z));
-      const V ok = each([](__m128 l) {
-        const __m128 a = _mm_and_ps(l, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)));
-        return _mm_and_ps(_mm_cmpgt_ps(a, _mm_set1_ps(std::numeric_limits<float>::min())),
-                          _mm_cmple_ps(a, _mm_set1_ps(std::numeric_limits<float>::max())));
-      }, len);
-      const auto divide = [](__m128 v, __m128 l, __m128 o) { return _mm_and_ps(o, _mm_div_ps(v, l)); };
-      x = each(divide, x, len, ok);
-      y = each(divide, y, len, ok);
-      z = each(divide, z, len, ok);
+      const V len = each([](const Floats& d) { return xsimd::sqrt(d); }, dot(x, y, z, x, y, z));
+      std::array<xsimd::batch_bool<float, xsimd::sse2>, kGroups> ok;
+      for (std::size_t g = 0; g < ok.size(); ++g) {
+        const Floats a = xsimd::abs(len[g]);
+        ok[g] = (a > Floats(std::numeric_limits<float>::min())) & (a <= Floats(std::numeric_limits<float>::max()));
+      }
+      for (std::size_t g = 0; g < ok.size(); ++g) {
+        x[g] = xsimd::select(ok[g], x[g] / len[g], Floats(0.0f));
+        y[g] = xsimd::select(ok[g], y[g] / len[g], Floats(0.0f));
+        z[g] = xsimd::select(ok[g], z[g] / len[g], Floats(0.0f));
+      }
     };
     V nx_ = load(nx), ny_ = load(ny), nz_ = load(nz);
     unit(nx_, ny_, nz_);
@@ -200,6 +193,8 @@ struct CornerBatch {
     V bx_ = sub(load(bx), px_), by_ = sub(load(by), py_), bz_ = sub(load(bz), pz_);
     project(ax_, ay_, az_);
     project(bx_, by_, bz_);
+    // Float lanes to double lanes and back, two at a time, by intrinsics: xsimd converts only between batches of
+    // one lane count.
     const auto wide = [](const V& v) {
       D d;
       for (std::size_t g = 0; g < v.size(); ++g) {
@@ -212,37 +207,35 @@ struct CornerBatch {
             ab = wide(dot(ax_, ay_, az_, bx_, by_, bz_));
     // The corner's angle in double: cosine ab / sqrt(aa bb) (0 where aa bb is not positive and finite), then
     // deterministic_acos (std::clamp, through which NaN passes, then both branches).
-    const auto select = [](__m128d mask, __m128d a, __m128d b) { return _mm_or_pd(_mm_and_pd(mask, a), _mm_andnot_pd(mask, b)); };
-    const D lengths2 = each([](__m128d a, __m128d b) { return _mm_mul_pd(a, b); }, aa, bb);
-    const D root = each([](__m128d l) { return _mm_sqrt_pd(l); }, lengths2);
-    const D x = each([&](__m128d l, __m128d r, __m128d d) {
-      const __m128d ok = _mm_and_pd(_mm_cmpgt_pd(l, _mm_setzero_pd()), _mm_cmple_pd(l, _mm_set1_pd(std::numeric_limits<double>::max())));
-      const __m128d c = _mm_and_pd(ok, _mm_div_pd(d, r));
-      const __m128d one = _mm_set1_pd(1.0), minus_one = _mm_set1_pd(-1.0);
-      return select(_mm_cmplt_pd(c, minus_one), minus_one, select(_mm_cmplt_pd(one, c), one, c));
+    const D lengths2 = each([](const Doubles& a, const Doubles& b) { return a * b; }, aa, bb);
+    const D root = each([](const Doubles& l) { return xsimd::sqrt(l); }, lengths2);
+    const D x = each([](const Doubles& l, const Doubles& r, const Doubles& d) {
+      const auto ok = (l > Doubles(0.0)) & (l <= Doubles(std::numeric_limits<double>::max()));
+      const Doubles c = xsimd::select(ok, d / r, Doubles(0.0)), one(1.0), minus_one(-1.0);
+      return xsimd::select(c < minus_one, minus_one, xsimd::select(one < c, one, c));
     }, lengths2, root, ab);
-    const D abs_x = each([](__m128d v) { return _mm_and_pd(v, _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffll))); }, x);
-    const D large_root = each([](__m128d a) { return _mm_sqrt_pd(_mm_mul_pd(_mm_sub_pd(_mm_set1_pd(1.0), a), _mm_set1_pd(0.5))); }, abs_x);
-    const auto asin_small = [](__m128d a) {
-      const __m128d z = _mm_mul_pd(a, a);
-      __m128d p = _mm_add_pd(_mm_mul_pd(_mm_set1_pd(4.2163199048e-2), z), _mm_set1_pd(2.4181311049e-2));
-      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(4.5470025998e-2));
-      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(7.4953002686e-2));
-      p = _mm_add_pd(_mm_mul_pd(p, z), _mm_set1_pd(1.6666752422e-1));
-      return _mm_add_pd(a, _mm_mul_pd(_mm_mul_pd(a, z), p));
+    const D abs_x = each([](const Doubles& v) { return xsimd::abs(v); }, x);
+    const D large_root = each([](const Doubles& a) { return xsimd::sqrt((Doubles(1.0) - a) * Doubles(0.5)); }, abs_x);
+    const auto asin_small = [](const Doubles& a) {
+      const Doubles z = a * a;
+      Doubles p = Doubles(4.2163199048e-2) * z + Doubles(2.4181311049e-2);
+      p = p * z + Doubles(4.5470025998e-2);
+      p = p * z + Doubles(7.4953002686e-2);
+      p = p * z + Doubles(1.6666752422e-1);
+      return a + (a * z) * p;
     };
-    const D angle = each([&](__m128d v, __m128d a, __m128d r) {
-      const __m128d half_pi = _mm_set1_pd(1.57079632679489661923);
-      const __m128d large = _mm_sub_pd(half_pi, _mm_mul_pd(_mm_set1_pd(2.0), asin_small(r)));
-      const __m128d asin_a = select(_mm_cmple_pd(a, _mm_set1_pd(0.5)), asin_small(a), large);
-      return select(_mm_cmplt_pd(v, _mm_setzero_pd()), _mm_add_pd(half_pi, asin_a), _mm_sub_pd(half_pi, asin_a));
+    const D angle = each([&](const Doubles& v, const Doubles& a, const Doubles& r) {
+      const Doubles half_pi(1.57079632679489661923);
+      const Doubles large = half_pi - Doubles(2.0) * asin_small(r);
+      const Doubles asin_a = xsimd::select(a <= Doubles(0.5), asin_small(a), large);
+      return xsimd::select(v < Doubles(0.0), half_pi + asin_a, half_pi - asin_a);
     }, x, abs_x, large_root);
     for (int g = 0; g < kGroups; ++g) {
       const auto i = std::size_t(g);
-      const __m128 w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * i]), _mm_cvtpd_ps(angle[2 * i + 1]));
-      _mm_store_ps(wx + 4 * g, _mm_mul_ps(w, tx[i]));
-      _mm_store_ps(wy + 4 * g, _mm_mul_ps(w, ty[i]));
-      _mm_store_ps(wz + 4 * g, _mm_mul_ps(w, tz[i]));
+      const Floats w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * i]), _mm_cvtpd_ps(angle[2 * i + 1]));
+      (w * tx[i]).store_aligned(wx + 4 * g);
+      (w * ty[i]).store_aligned(wy + 4 * g);
+      (w * tz[i]).store_aligned(wz + 4 * g);
     }
   }
 };
