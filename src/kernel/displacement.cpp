@@ -55,7 +55,7 @@ DisplacementProgram::DisplacementProgram(const DisplacementInputs& inputs, const
       shade_(variant.shade), cones_(inputs.cones),
       reference_(inputs.reference), reference_scale_(inputs.reference_scale), reference_memo_(inputs.reference_memo),
       reference_id_(inputs.reference_id), surface_(inputs.surface), sampler_(SamplerState::from(key.sampler, params.sampler)),
-      lod_mode_(key.sampler.lod), key_(key), trace_(params.trace), lighting_(params.lighting),
+      key_(key), trace_(params.trace), lighting_(params.lighting),
       orm_params_(params.orm), blend_(params.blend), shadow_(params.shadow), ao_(params.ao), lights_(lights) {
   if (inputs.layers.empty() || inputs.layers.size() > std::size_t(BlendedSurface::kMaxLayers))
     throw Error("displacement program", "needs 1 to 4 layers");
@@ -700,7 +700,7 @@ DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) c
   const Float& u = in.varyings[kU];
   const Float& v = in.varyings[kV];
   Setup setup;
-  setup.d = UvDerivatives::from(u, v, lod_mode_);
+  setup.d = UvDerivatives::from(u, v, key_.sampler.lod);
   setup.frame = TangentFrame::from(in);
   setup.view = view_vector(in, lights_);
   setup.view_tangent = setup.frame.to_tangent(setup.view);

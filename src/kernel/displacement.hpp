@@ -147,7 +147,6 @@ private:
   std::uint64_t reference_id_;
   const HeightField* surface_;
   SamplerState sampler_;
-  LodMode lod_mode_;
   ProgramKey key_;
   TraceParams trace_;
   LightingParams lighting_;
