@@ -52,7 +52,7 @@ nlohmann::json RenderStats::to_json() const {
                  {"mesh_bytes", mesh_bytes}, {"peak_rss_bytes", peak_rss_bytes}};
   j["prepare"] = {{"items_built", items_built}, {"items_reused", items_reused}, {"steps", nlohmann::json::array()}};
   for (const PrepareStep& step : prepare_steps)
-    j["prepare"]["steps"].push_back({{"item", step.item}, {"what", step.what}, {"where", step.where}, {"ms", step.ms}});
+    j["prepare"]["steps"].push_back({{"item", step.item}, {"what", step.what}, {"where", step.where}, {"start_ms", step.start_ms}, {"ms", step.ms}});
   j["materials"] = nlohmann::json::array();
   for (const MaterialStat& m : materials) j["materials"].push_back({{"name", m.name}, {"variant", m.variant}});
   j["textures"] = nlohmann::json::array();

@@ -154,6 +154,7 @@ public:
         file_(plan.scene.file.string()) {}
 
   void run() {
+    begin_ = Clock::now();
     const std::vector<std::string> items = plan_.items();
     items_ = items.size();
     weight_maps();
@@ -181,6 +182,7 @@ private:
 
   // An item built: `order` is its place in plan_.items(), `step` what it was and when its build began.
   void record(const std::string& item, std::size_t order, PrepareStep step, Clock::time_point start) {
+    step.start_ms = std::chrono::duration<double, std::milli>(start - begin_).count();
     step.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     std::lock_guard lock(mutex_);
     built_.push_back(item);
@@ -448,6 +450,7 @@ private:
   const std::function<void(double)>& progress_;
   SpareTextures* spares_;
   std::string file_;
+  Clock::time_point begin_;
   std::size_t items_ = 0;
   std::mutex mutex_;
   std::vector<std::pair<std::size_t, PrepareStep>> steps_;

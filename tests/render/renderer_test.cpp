@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "cli/cli_test_util.hpp"
@@ -112,10 +113,19 @@ TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
     EXPECT_EQ(step.item, expected[i]);
     EXPECT_GE(step.ms, 0.0) << step.item;
     EXPECT_LE(step.ms, first.prepare_ms) << step.item;  // each step lies inside prepare
+    EXPECT_GE(step.start_ms, 0.0) << step.item;
+    EXPECT_LE(step.start_ms + step.ms, first.prepare_ms) << step.item;
     EXPECT_FALSE(step.what.empty()) << step.item;
     EXPECT_NE(step.where.find(scene.file.string()), std::string::npos) << step.item;
   }
   EXPECT_EQ(first.prepare_steps.back().what, "blend_ao_map");
+  // The AO map is baked from the combined surface: it begins once that has been built.
+  const auto built = [&](const std::string& what) {
+    return std::find_if(first.prepare_steps.begin(), first.prepare_steps.end(),
+                        [&](const PrepareStep& s) { return s.what == what; });
+  };
+  ASSERT_NE(built("combined_surface"), first.prepare_steps.end());
+  EXPECT_GE(built("blend_ao_map")->start_ms, built("combined_surface")->start_ms + built("combined_surface")->ms);
   // 0 first, then one call per item built with the fraction done, then 1 when prepare is over.
   ASSERT_EQ(fractions.size(), expected.size() + 2);
   EXPECT_EQ(fractions.front(), 0.0);

@@ -28,6 +28,7 @@ struct PrepareStep {
   std::string item;   // "mesh 0", "texture 3", "derived 7": the plan's numbering
   std::string what;   // the texture's purpose or the derived kind: "albedo", "combined_quadtree", "blend_ao_map"
   std::string where;  // the scene field it came from
+  double start_ms = 0;  // when its build began, from the start of the preparation (steps overlap where built side by side)
   double ms = 0;
 };
 
