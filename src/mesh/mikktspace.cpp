@@ -54,9 +54,11 @@ inline Face face_of(std::span<const glm::vec3> positions, std::span<const glm::v
 }
 
 // Vertices with equal attributes are one vertex (mikktspace.c welds them): same[v] is the first vertex of v's kind.
-// A hash table (+0 and -0 alike, as mikktspace.c's == sees them) filled in vertex order, so the first of a kind is
-// the one in the table. The table lives in `scratch` (the tangents, 16 bytes a vertex: 2 slots of 8 bytes, each the
-// hash's low half beside vertex + 1, so a probe compares a vertex's attributes only where the hashes agree).
+// A hash table (+0 and -0 alike, as mikktspace.c's == sees them) filled by threads, each a range of vertices: a
+// kind takes one slot (claimed by compare-and-swap) that ends up holding its smallest vertex (an atomic minimum),
+// whatever the threads' timing; a second pass reads every vertex's kind from its slot. The table lives in
+// `scratch` (the tangents, 16 bytes a vertex: 2 slots of 8 bytes, each the hash's low half above vertex + 1, so a
+// probe compares a vertex's attributes only where the hashes agree).
 using Slot = std::uint64_t __attribute__((may_alias));  // the scratch holds floats before and after
 
 std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
@@ -80,70 +82,84 @@ std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<
   // Linear probing at most 1/2 full; a hash's slot is the hash scaled to the capacity.
   const std::size_t capacity = 2 * n;
   Slot* table = reinterpret_cast<Slot*>(scratch.data());
-  std::memset(static_cast<void*>(scratch.data()), 0, capacity * sizeof(Slot));
+  constexpr std::size_t kGrain = 16384;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, capacity, 2 * kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::memset(static_cast<void*>(table + r.begin()), 0, r.size() * sizeof(Slot));
+  });
   std::vector<std::uint32_t> same(n);
-  // Batches: the slots of a batch are asked for before they are probed.
-  constexpr std::size_t kBatch = 32;
-  std::array<std::size_t, kBatch> slot{};
-  std::array<std::uint64_t, kBatch> tag{};
-  for (std::size_t first = 0; first < n; first += kBatch) {
-    const std::size_t count = std::min(kBatch, n - first);
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::uint64_t h = hash(key(std::uint32_t(first + k)));
-      slot[k] = std::size_t(((h >> 32) * capacity) >> 32);  // capacity < 2^32: 3 x kMaxTriangles vertices at most
-      tag[k] = h << 32;  // the low half
-      __builtin_prefetch(&table[slot[k]]);
-    }
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto v = std::uint32_t(first + k);
-      for (std::size_t at = slot[k];; at = at + 1 == capacity ? 0 : at + 1) {
-        const std::uint64_t entry = table[at];
-        if (entry == 0) {
-          table[at] = tag[k] | (std::uint64_t(v) + 1);
-          same[v] = v;
-          break;
-        }
-        if ((entry & ~0xffffffffull) == tag[k] && key(std::uint32_t(entry) - 1) == key(v)) {
-          same[v] = std::uint32_t(entry) - 1;
-          break;
+  // The kinds' slots, into same[]; a batch's slots are asked for before they are probed.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    constexpr std::size_t kBatch = 32;
+    std::array<std::size_t, kBatch> slot{};
+    std::array<std::uint64_t, kBatch> tag{};
+    for (std::size_t first = r.begin(); first < r.end(); first += kBatch) {
+      const std::size_t count = std::min(kBatch, r.end() - first);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::uint64_t h = hash(key(std::uint32_t(first + k)));
+        slot[k] = std::size_t(((h >> 32) * capacity) >> 32);  // capacity < 2^32: 3 x kMaxTriangles vertices at most
+        tag[k] = h << 32;  // the low half
+        __builtin_prefetch(&table[slot[k]]);
+      }
+      for (std::size_t k = 0; k < count; ++k) {
+        const auto v = std::uint32_t(first + k);
+        const std::uint64_t mine = tag[k] | (std::uint64_t(v) + 1);
+        for (std::size_t at = slot[k];;) {
+          std::uint64_t entry = __atomic_load_n(&table[at], __ATOMIC_RELAXED);
+          if (entry == 0 && __atomic_compare_exchange_n(&table[at], &entry, mine, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+            same[v] = std::uint32_t(at);
+            break;
+          }
+          // entry: the slot's (another thread may just have claimed it). Only its vertex can change, to a smaller
+          // one of its kind.
+          if ((entry & ~0xffffffffull) == tag[k] && key(std::uint32_t(entry) - 1) == key(v)) {
+            while (entry > mine &&
+                   !__atomic_compare_exchange_n(&table[at], &entry, mine, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+            }
+            same[v] = std::uint32_t(at);
+            break;
+          }
+          at = at + 1 == capacity ? 0 : at + 1;
         }
       }
     }
-  }
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v != r.end(); ++v) same[v] = std::uint32_t(__atomic_load_n(&table[same[v]], __ATOMIC_RELAXED)) - 1;
+  });
   return same;
 }
 
-// The corners of four faces at once, in three vectors of SSE2's four lanes (x86-64's baseline): each corner's
-// direction (its face's +u in the plane of the corner's normal, normalised) times its angle (between its edges
-// projected onto that plane). Every lane takes the scalar formulas' operations in their order (glm's dot is
-// (x x + y y) + z z, its length the square root of that, a vector over a scalar three divisions;
-// deterministic_acos's branches are both taken and one chosen), and SSE2 rounds as the scalar operations do: the
-// same bits. Three independent vectors keep the divisions and square roots busy.
+// Four faces at once in SSE2's four lanes (x86-64's baseline), a face a lane: its +u direction and UV orientation
+// (face_of), then for each corner k, one vector of four lanes each, the corner's direction (the face's +u in the
+// plane of the corner's normal, normalised) times its angle (between its edges projected onto that plane). Every
+// lane takes the scalar formulas' operations in their order (glm's dot is (x x + y y) + z z, its length the
+// square root of that, a vector over a scalar three divisions; deterministic_acos's argument chosen per lane, its
+// polynomial evaluated once), and SSE2 rounds as the scalar operations do: the same bits. The three corners' vectors are
+// independent: their divisions and square roots overlap.
 struct CornerBatch {
-  static constexpr int kFaces = 4, kGroups = 3, kLanes = 4 * kGroups;  // corner k of face i: lane 3 i + k
-  alignas(16) float px[kLanes]{}, py[kLanes]{}, pz[kLanes]{};  // the corner's position
-  alignas(16) float ax[kLanes]{}, ay[kLanes]{}, az[kLanes]{};  // corner k + 2's
-  alignas(16) float bx[kLanes]{}, by[kLanes]{}, bz[kLanes]{};  // corner k + 1's
-  alignas(16) float nx[kLanes]{}, ny[kLanes]{}, nz[kLanes]{};  // the corner's normal
-  alignas(16) float ux[kLanes]{}, uy[kLanes]{}, uz[kLanes]{};  // the face's +u
-  alignas(16) float wx[kLanes]{}, wy[kLanes]{}, wz[kLanes]{};  // the result
+  static constexpr int kFaces = 4;
+  // Input per face (lane i): its corners' positions, UVs and normals.
+  alignas(16) float px[3][kFaces]{}, py[3][kFaces]{}, pz[3][kFaces]{};
+  alignas(16) float u[3][kFaces]{}, v[3][kFaces]{};
+  alignas(16) float nx[3][kFaces]{}, ny[3][kFaces]{}, nz[3][kFaces]{};
+  // Output: corner k of face i at [k][i]; per face whether it is degenerate or preserves the UV orientation.
+  alignas(16) float wx[3][kFaces]{}, wy[3][kFaces]{}, wz[3][kFaces]{};
+  std::uint32_t degenerate = 0, preserving = 0;  // bit i: face i
 
   void set(int face, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-           const std::uint32_t* corner, const glm::vec3& along_u) {
+           std::span<const glm::vec2> uvs, const std::uint32_t* corner) {
     for (int k = 0; k < 3; ++k) {
-      const int l = 3 * face + k;
-      const glm::vec3 &p = positions[corner[k]], &a = positions[corner[(k + 2) % 3]], &b = positions[corner[(k + 1) % 3]];
-      const glm::vec3& n = normals[corner[k]];
-      px[l] = p.x, py[l] = p.y, pz[l] = p.z, ax[l] = a.x, ay[l] = a.y, az[l] = a.z, bx[l] = b.x, by[l] = b.y, bz[l] = b.z;
-      nx[l] = n.x, ny[l] = n.y, nz[l] = n.z, ux[l] = along_u.x, uy[l] = along_u.y, uz[l] = along_u.z;
+      const glm::vec3 &p = positions[corner[k]], &n = normals[corner[k]];
+      const glm::vec2& t = uvs[corner[k]];
+      px[k][face] = p.x, py[k][face] = p.y, pz[k][face] = p.z, u[k][face] = t.x, v[k][face] = t.y;
+      nx[k][face] = n.x, ny[k][face] = n.y, nz[k][face] = n.z;
     }
   }
 
-  // Each step over the three vectors before the next step, so that their divisions and square roots overlap.
   using Floats = xsimd::batch<float, xsimd::sse2>;
   using Doubles = xsimd::batch<double, xsimd::sse2>;
-  using V = std::array<Floats, kGroups>;
-  using D = std::array<Doubles, 2 * kGroups>;  // a V's lanes 0-1 and 2-3 in double
+  using V = std::array<Floats, 3>;              // one vector per corner
+  using D = std::array<Doubles, 2 * 3>;         // a V's lanes 0-1 and 2-3 in double
 
   void compute() {
     const auto each = [](auto f, const auto&... in) {
@@ -151,10 +167,10 @@ struct CornerBatch {
       for (std::size_t g = 0; g < out.size(); ++g) out[g] = f(in[g]...);
       return out;
     };
-    const auto load = [](const float* from) {
-      V v;
-      for (int g = 0; g < kGroups; ++g) v[std::size_t(g)] = Floats::load_aligned(from + 4 * g);
-      return v;
+    const auto load = [](const float (&from)[3][kFaces]) {
+      V r;
+      for (std::size_t k = 0; k < 3; ++k) r[k] = Floats::load_aligned(from[k]);
+      return r;
     };
     const auto add = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x + y; }, a, b); };
     const auto sub = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x - y; }, a, b); };
@@ -162,20 +178,38 @@ struct CornerBatch {
     const auto dot = [&](const V& ax, const V& ay, const V& az, const V& bx, const V& by, const V& bz) {
       return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
     };
+    // not_zero(a) and a finite, for a = |x|.
+    const auto usable = [](const Floats& x) {
+      const Floats a = xsimd::abs(x);
+      return (a > Floats(std::numeric_limits<float>::min())) & (a <= Floats(std::numeric_limits<float>::max()));
+    };
     // unit_or_zero, in place.
     const auto unit = [&](V& x, V& y, V& z) {
       const V len = each([](const Floats& d) { return xsimd::sqrt(d); }, dot(x, y, z, x, y, z));
-      std::array<xsimd::batch_bool<float, xsimd::sse2>, kGroups> ok;
-      for (std::size_t g = 0; g < ok.size(); ++g) {
-        const Floats a = xsimd::abs(len[g]);
-        ok[g] = (a > Floats(std::numeric_limits<float>::min())) & (a <= Floats(std::numeric_limits<float>::max()));
-      }
-      for (std::size_t g = 0; g < ok.size(); ++g) {
-        x[g] = xsimd::select(ok[g], x[g] / len[g], Floats(0.0f));
-        y[g] = xsimd::select(ok[g], y[g] / len[g], Floats(0.0f));
-        z[g] = xsimd::select(ok[g], z[g] / len[g], Floats(0.0f));
+      for (std::size_t g = 0; g < len.size(); ++g) {
+        const auto ok = usable(len[g]);
+        x[g] = xsimd::select(ok, x[g] / len[g], Floats(0.0f));
+        y[g] = xsimd::select(ok, y[g] / len[g], Floats(0.0f));
+        z[g] = xsimd::select(ok, z[g] / len[g], Floats(0.0f));
       }
     };
+    const V px_ = load(px), py_ = load(py), pz_ = load(pz);
+    // face_of: the UV area's sign and the +u direction, os * (+-1 / |os|), where both are usable.
+    const Floats d1x = px_[1] - px_[0], d1y = py_[1] - py_[0], d1z = pz_[1] - pz_[0];
+    const Floats d2x = px_[2] - px_[0], d2y = py_[2] - py_[0], d2z = pz_[2] - pz_[0];
+    const Floats u0 = Floats::load_aligned(u[0]), v0 = Floats::load_aligned(v[0]);
+    const Floats t21x = Floats::load_aligned(u[1]) - u0, t21y = Floats::load_aligned(v[1]) - v0;
+    const Floats t31x = Floats::load_aligned(u[2]) - u0, t31y = Floats::load_aligned(v[2]) - v0;
+    const Floats area = t21x * t31y - t21y * t31x;
+    const auto keeps = area > Floats(0.0f);
+    const Floats osx = t31y * d1x - t21y * d2x, osy = t31y * d1y - t21y * d2y, osz = t31y * d1z - t21y * d2z;
+    const Floats os_len = xsimd::sqrt((osx * osx + osy * osy) + osz * osz);
+    const Floats scale = xsimd::select(keeps, Floats(1.0f), Floats(-1.0f)) / os_len;
+    const auto ok = (xsimd::abs(area) > Floats(std::numeric_limits<float>::min())) & usable(os_len);
+    preserving = std::uint32_t(_mm_movemask_ps(keeps));  // intrinsics: xsimd 8 has no mask-to-bits
+    degenerate = ~std::uint32_t(_mm_movemask_ps(ok)) & 0xfu;
+    const Floats ux = osx * scale, uy = osy * scale, uz = osz * scale;
+
     V nx_ = load(nx), ny_ = load(ny), nz_ = load(nz);
     unit(nx_, ny_, nz_);
     // in_plane: v - n dot(n, v), normalised; the edges' projections alike (not normalised).
@@ -185,37 +219,40 @@ struct CornerBatch {
       y = sub(y, mul(ny_, d));
       z = sub(z, mul(nz_, d));
     };
-    V tx = load(ux), ty = load(uy), tz = load(uz);
+    V tx{ux, ux, ux}, ty{uy, uy, uy}, tz{uz, uz, uz};
     project(tx, ty, tz);
     unit(tx, ty, tz);
-    const V px_ = load(px), py_ = load(py), pz_ = load(pz);
-    V ax_ = sub(load(ax), px_), ay_ = sub(load(ay), py_), az_ = sub(load(az), pz_);
-    V bx_ = sub(load(bx), px_), by_ = sub(load(by), py_), bz_ = sub(load(bz), pz_);
-    project(ax_, ay_, az_);
-    project(bx_, by_, bz_);
+    // Corner k's edges: to corner k + 2 (a) and to corner k + 1 (b).
+    const V ax_ = {px_[2], px_[0], px_[1]}, ay_ = {py_[2], py_[0], py_[1]}, az_ = {pz_[2], pz_[0], pz_[1]};
+    const V bx_ = {px_[1], px_[2], px_[0]}, by_ = {py_[1], py_[2], py_[0]}, bz_ = {pz_[1], pz_[2], pz_[0]};
+    V ex = sub(ax_, px_), ey = sub(ay_, py_), ez = sub(az_, pz_);
+    V fx = sub(bx_, px_), fy = sub(by_, py_), fz = sub(bz_, pz_);
+    project(ex, ey, ez);
+    project(fx, fy, fz);
     // Float lanes to double lanes and back, two at a time, by intrinsics: xsimd converts only between batches of
     // one lane count.
-    const auto wide = [](const V& v) {
+    const auto wide = [](const V& x) {
       D d;
-      for (std::size_t g = 0; g < v.size(); ++g) {
-        d[2 * g] = _mm_cvtps_pd(v[g]);
-        d[2 * g + 1] = _mm_cvtps_pd(_mm_movehl_ps(v[g], v[g]));
+      for (std::size_t g = 0; g < x.size(); ++g) {
+        d[2 * g] = _mm_cvtps_pd(x[g]);
+        d[2 * g + 1] = _mm_cvtps_pd(_mm_movehl_ps(x[g], x[g]));
       }
       return d;
     };
-    const D aa = wide(dot(ax_, ay_, az_, ax_, ay_, az_)), bb = wide(dot(bx_, by_, bz_, bx_, by_, bz_)),
-            ab = wide(dot(ax_, ay_, az_, bx_, by_, bz_));
+    const D aa = wide(dot(ex, ey, ez, ex, ey, ez)), bb = wide(dot(fx, fy, fz, fx, fy, fz)),
+            ab = wide(dot(ex, ey, ez, fx, fy, fz));
     // The corner's angle in double: cosine ab / sqrt(aa bb) (0 where aa bb is not positive and finite), then
-    // deterministic_acos (std::clamp, through which NaN passes, then both branches).
+    // deterministic_acos (std::clamp, through which NaN passes, then its branch).
     const D lengths2 = each([](const Doubles& a, const Doubles& b) { return a * b; }, aa, bb);
     const D root = each([](const Doubles& l) { return xsimd::sqrt(l); }, lengths2);
     const D x = each([](const Doubles& l, const Doubles& r, const Doubles& d) {
-      const auto ok = (l > Doubles(0.0)) & (l <= Doubles(std::numeric_limits<double>::max()));
-      const Doubles c = xsimd::select(ok, d / r, Doubles(0.0)), one(1.0), minus_one(-1.0);
+      const auto fine = (l > Doubles(0.0)) & (l <= Doubles(std::numeric_limits<double>::max()));
+      const Doubles c = xsimd::select(fine, d / r, Doubles(0.0)), one(1.0), minus_one(-1.0);
       return xsimd::select(c < minus_one, minus_one, xsimd::select(one < c, one, c));
     }, lengths2, root, ab);
-    const D abs_x = each([](const Doubles& v) { return xsimd::abs(v); }, x);
-    const D large_root = each([](const Doubles& a) { return xsimd::sqrt((Doubles(1.0) - a) * Doubles(0.5)); }, abs_x);
+    const D abs_x = each([](const Doubles& a) { return xsimd::abs(a); }, x);
+    // asin_small of a (|x| <= 0.5) or of sqrt((1 - a) / 2) (above): the branch's argument chosen first, the
+    // polynomial evaluated once.
     const auto asin_small = [](const Doubles& a) {
       const Doubles z = a * a;
       Doubles p = Doubles(4.2163199048e-2) * z + Doubles(2.4181311049e-2);
@@ -224,18 +261,18 @@ struct CornerBatch {
       p = p * z + Doubles(1.6666752422e-1);
       return a + (a * z) * p;
     };
-    const D angle = each([&](const Doubles& v, const Doubles& a, const Doubles& r) {
+    const D angle = each([&](const Doubles& c, const Doubles& a) {
       const Doubles half_pi(1.57079632679489661923);
-      const Doubles large = half_pi - Doubles(2.0) * asin_small(r);
-      const Doubles asin_a = xsimd::select(a <= Doubles(0.5), asin_small(a), large);
-      return xsimd::select(v < Doubles(0.0), half_pi + asin_a, half_pi - asin_a);
-    }, x, abs_x, large_root);
-    for (int g = 0; g < kGroups; ++g) {
-      const auto i = std::size_t(g);
-      const Floats w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * i]), _mm_cvtpd_ps(angle[2 * i + 1]));
-      (w * tx[i]).store_aligned(wx + 4 * g);
-      (w * ty[i]).store_aligned(wy + 4 * g);
-      (w * tz[i]).store_aligned(wz + 4 * g);
+      const auto small = a <= Doubles(0.5);
+      const Doubles s = asin_small(xsimd::select(small, a, xsimd::sqrt((Doubles(1.0) - a) * Doubles(0.5))));
+      const Doubles asin_a = xsimd::select(small, s, half_pi - Doubles(2.0) * s);
+      return xsimd::select(c < Doubles(0.0), half_pi + asin_a, half_pi - asin_a);
+    }, x, abs_x);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Floats w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * k]), _mm_cvtpd_ps(angle[2 * k + 1]));
+      (w * tx[k]).store_aligned(wx[k]);
+      (w * ty[k]).store_aligned(wy[k]);
+      (w * tz[k]).store_aligned(wz[k]);
     }
   }
 };
@@ -254,7 +291,9 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
   // vertices split). Each thread takes a range of kinds and sums their corners in triangle order. flags: bit 0 / 1
   // the kind has a preserving / mirrored sum; bits 2-3 the orientation of the vertex's own entry (1 preserving, 2
   // mirrored, 0 unset).
-  std::fill(tangents.begin(), tangents.end(), glm::vec4(0.0f));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::fill(tangents.begin() + std::ptrdiff_t(r.begin()), tangents.begin() + std::ptrdiff_t(r.end()), glm::vec4(0.0f));
+  });
   std::vector<glm::vec3> mirrored_sum;
   std::once_flag mirrored_made;
   std::vector<std::uint8_t> flags(n, 0);
@@ -262,34 +301,35 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
   tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
     const std::uint32_t lo = std::uint32_t(n * part / parts), hi = std::uint32_t(n * (part + 1) / parts);
     const auto mine = [&](std::uint32_t v) { return same[v] >= lo && same[v] < hi; };
-    // Faces wait in a batch of four for their corners' directions, then are summed in order.
+    // Faces wait in a batch of four for their directions and their corners' weights, then are summed in order.
     CornerBatch batch;
     struct Waiting {
       const std::uint32_t* corner;
       bool own[3];
-      bool preserving;
     };
     std::array<Waiting, CornerBatch::kFaces> waiting{};
     int count = 0;
     const auto sum_batch = [&] {
       batch.compute();
       for (int i = 0; i < count; ++i) {
+        if (batch.degenerate >> i & 1) continue;
         const Waiting& face = waiting[std::size_t(i)];
+        const bool preserving = batch.preserving >> i & 1;
+        if (!preserving) std::call_once(mirrored_made, [&] { mirrored_sum.assign(n, glm::vec3(0.0f)); });
         for (int k = 0; k < 3; ++k) {
           if (!face.own[k]) continue;
-          const int l = 3 * i + k;
           const std::uint32_t kind = same[face.corner[k]];
           const auto add = [&](auto& sum) {
-            sum.x += batch.wx[l];
-            sum.y += batch.wy[l];
-            sum.z += batch.wz[l];
+            sum.x += batch.wx[k][i];
+            sum.y += batch.wy[k][i];
+            sum.z += batch.wz[k][i];
           };
-          if (face.preserving) {
+          if (preserving) {
             add(tangents[kind]);
           } else {
             add(mirrored_sum[kind]);
           }
-          flags[kind] |= face.preserving ? 1 : 2;
+          flags[kind] |= preserving ? 1 : 2;
         }
       }
       count = 0;
@@ -298,14 +338,10 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
       const std::uint32_t* corner = &indices[3 * f];
       const bool own0 = mine(corner[0]), own1 = mine(corner[1]), own2 = mine(corner[2]);
       if (!(own0 || own1 || own2)) continue;
-      const Face face = face_of(positions, uvs, corner);
-      if (face.degenerate) continue;
-      if (!face.preserving) std::call_once(mirrored_made, [&] { mirrored_sum.assign(n, glm::vec3(0.0f)); });
-      batch.set(count, positions, normals, corner, face.along_u);
+      batch.set(count, positions, normals, uvs, corner);
       Waiting& w = waiting[std::size_t(count)];  // field by field (a whole struct stored then copied stalls)
       w.corner = corner;
       w.own[0] = own0, w.own[1] = own1, w.own[2] = own2;
-      w.preserving = face.preserving;
       if (++count == CornerBatch::kFaces) sum_batch();
     }
     if (count > 0) sum_batch();

@@ -33,11 +33,11 @@ struct MikkTSpaceCopies {
 
 // positions and normals per vertex (normals need not be unit length), uvs one per vertex (qdmr's: v up),
 // `indices` 3 per triangle, rewritten where a corner moves to a copy of its vertex; `tangents` (one per vertex) is
-// written. The work over triangles runs on threads, each summing the corners of its own vertices in triangle
-// order (the corners' directions and angles four triangles at a time in SSE2 lanes, rounded as the scalar
-// formulas): the same bits for any thread count. Working memory beside the result: 4 bytes a vertex (its kind), 1
-// (flags); welding hashes in `tangents` before they are written; where UVs are mirrored 16 more (the mirrored sums,
-// the copies).
+// written. The weld and the work over triangles run on threads, each summing the corners of its own vertices in
+// triangle order (the triangles' directions and their corners' angles four triangles at a time in SSE2 lanes,
+// rounded as the scalar formulas): the same bits for any thread count. Working memory beside the result: 4 bytes
+// a vertex (its kind), 1 (flags); welding hashes in `tangents` before they are written; where UVs are mirrored 16
+// more (the mirrored sums, the copies).
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                                      std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
                                      std::span<glm::vec4> tangents);
