@@ -19,9 +19,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
@@ -280,6 +282,37 @@ public:
     });
   }
 
+  // The elements as floats into out[components i + c] (`components`: the accessor's, at most 4): floats stored one
+  // after the other are read straight into `out` and then checked (on threads; the first that is not finite is
+  // named, as floats() names it), any other layout through floats().
+  void float_array(const Elements& e, int index, float* out) const {
+    const auto components = std::size_t(std::min(e.components, 4));
+    if (e.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT || e.stride != e.bytes || e.bytes != 4 * components) {
+      floats(e, index, [&](std::size_t i, const float* v) { std::copy(v, v + components, out + components * i); });
+      return;
+    }
+    read(*e.source, e.first, e.count * e.bytes, reinterpret_cast<unsigned char*>(out));
+    const std::size_t bad = first_where(e.count, [&](std::size_t i) {
+      bool finite = true;
+      for (std::size_t c = 0; c < components; ++c) finite &= std::isfinite(out[components * i + c]);
+      return !finite;
+    });
+    if (bad < e.count) fail("/accessors/" + std::to_string(index), "element " + std::to_string(bad) + " is not finite");
+  }
+
+  // The smallest i < count for which bad(i), else count; on threads.
+  template <class Bad>
+  static std::size_t first_where(std::size_t count, Bad&& bad) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, count, kCheckGrain), count,
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t found) {
+          for (std::size_t i = r.begin(); i < r.end() && i < found; ++i)
+            if (bad(i)) return i;
+          return found;
+        },
+        [](std::size_t a, std::size_t b) { return std::min(a, b); });
+  }
+
   // The elements of a float attribute (of one type; `normalized_ok`: also normalised unsigned bytes or shorts).
   Elements float_elements(int index, const std::string& pointer, int type, bool normalized_ok) const {
     return normalized_ok ? elements(index, pointer, {type}, {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
@@ -295,6 +328,17 @@ public:
 
   // The indices, each checked against the vertex count, into out[0, e.count).
   void indices(const Elements& e, int index, std::size_t vertices, std::uint32_t* out) const {
+    const auto past = [&](std::size_t i, std::uint32_t v) {
+      fail("/accessors/" + std::to_string(index), "index " + std::to_string(i) + " is " + std::to_string(v) +
+                                                      ", past the primitive's " + std::to_string(vertices) + " vertices");
+    };
+    if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && e.stride == 4) {
+      // 32-bit indices one after the other: read straight into `out`, then checked on threads.
+      read(*e.source, e.first, 4 * e.count, reinterpret_cast<unsigned char*>(out));
+      const std::size_t bad = first_where(e.count, [&](std::size_t i) { return out[i] >= vertices; });
+      if (bad < e.count) past(bad, out[bad]);
+      return;
+    }
     for_each_element(e, [&](const unsigned char* p, std::size_t i) {
       std::uint32_t v = 0;
       if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
@@ -306,15 +350,14 @@ public:
       } else {
         std::memcpy(&v, p, 4);
       }
-      if (v >= vertices)
-        fail("/accessors/" + std::to_string(index), "index " + std::to_string(i) + " is " + std::to_string(v) +
-                                                        ", past the primitive's " + std::to_string(vertices) + " vertices");
+      if (v >= vertices) past(i, v);
       out[i] = v;
     });
   }
 
 private:
   static constexpr std::size_t kBlockBytes = std::size_t(64) << 10;
+  static constexpr std::size_t kCheckGrain = 16384;  // elements a task checks
   const tinygltf::Model& model_;
   const std::vector<BufferSource>& buffers_;
   std::string where_;
@@ -756,8 +799,10 @@ private:
       std::fill(out, out + in.positions.count, qdmr_uv(glm::dvec2(0.0), in.uv_choice, c, s));
       return;
     }
-    asset_.floats(in.uvs, in.uv_accessor,
-                  [&](std::size_t i, const float* v) { out[i] = qdmr_uv(glm::dvec2(v[0], v[1]), in.uv_choice, c, s); });
+    asset_.float_array(in.uvs, in.uv_accessor, glm::value_ptr(out[0]));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, in.positions.count, 16384), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) out[i] = qdmr_uv(glm::dvec2(out[i]), in.uv_choice, c, s);
+    });
   }
 
   // The primitive's triangles, 3 corners each (from its indices, else its vertices in order), into `out`.
@@ -793,17 +838,13 @@ private:
                   std::uint32_t material) {
     const std::size_t count = in.positions.count, base = mesh_.positions.size(), first = mesh_.indices.size();
     mesh_.positions.resize(base + count);
-    asset_.floats(in.positions, in.position_accessor,
-                  [&](std::size_t i, const float* v) { mesh_.positions[base + i] = glm::vec3(v[0], v[1], v[2]); });
+    asset_.float_array(in.positions, in.position_accessor, glm::value_ptr(mesh_.positions[base]));
     mesh_.normals.resize(base + count);
-    asset_.floats(in.normals, in.normal_accessor,
-                  [&](std::size_t i, const float* v) { mesh_.normals[base + i] = glm::vec3(v[0], v[1], v[2]); });
+    asset_.float_array(in.normals, in.normal_accessor, glm::value_ptr(mesh_.normals[base]));
     mesh_.uvs.resize(base + count);
     read_uvs(in, mesh_.uvs.data() + base);
     mesh_.tangents.resize(base + count);
-    if (in.tangent_accessor >= 0)
-      asset_.floats(in.tangents, in.tangent_accessor,
-                    [&](std::size_t i, const float* v) { mesh_.tangents[base + i] = glm::vec4(v[0], v[1], v[2], v[3]); });
+    if (in.tangent_accessor >= 0) asset_.float_array(in.tangents, in.tangent_accessor, glm::value_ptr(mesh_.tangents[base]));
     mesh_.indices.resize(first + 3 * in.triangles);
     read_triangles(in, mesh_.indices.data() + first);
     if (in.tangent_accessor < 0) {
@@ -851,8 +892,7 @@ private:
   void add_flat(const Primitive& in, const glm::dmat4& world, std::uint32_t material) {
     const std::size_t count = in.positions.count;
     std::vector<glm::vec3> positions(count);
-    asset_.floats(in.positions, in.position_accessor,
-                  [&](std::size_t i, const float* v) { positions[i] = glm::vec3(v[0], v[1], v[2]); });
+    asset_.float_array(in.positions, in.position_accessor, glm::value_ptr(positions[0]));
     std::vector<glm::vec2> uvs(count);
     read_uvs(in, uvs.data());
     std::vector<std::uint32_t> triangles(3 * in.triangles);
