@@ -1,6 +1,8 @@
 #pragma once
 // The shading program interface inside a draw kernel: one batch of lanes (whole 2x2 quads) in, colour and
 // AOVs out. Compiled once per ISA (simd::Float is the kernel's batch type).
+#include <cstddef>
+
 #include "core/simd.hpp"
 #include "program/program.hpp"
 
@@ -32,7 +34,31 @@ struct ShadeOutput {
   // itself, its longest lane's iterations times the lanes.
   int executed_lane_iterations = -1;
   simd::Float depth, view_depth;
+
+  // f(value) for each lane-wise output, value(out) being that Float of an output (ShadeOutput or const): every
+  // member but depth and view_depth (set from whole quads, after the lane-wise stages: batch_scheduler.hpp) and
+  // the two scalars. What a packed batch hands back to the batches its lanes came from.
+  template <class F>
+  static constexpr void lane_values(F&& f) {
+    for (int c = 0; c < 3; ++c) f([c](auto& o) -> auto& { return o.color[c]; });
+    for (int c = 0; c < 3; ++c) f([c](auto& o) -> auto& { return o.normal[c]; });
+    f([](auto& o) -> auto& { return o.iterations; });
+    f([](auto& o) -> auto& { return o.hit_u; });
+    f([](auto& o) -> auto& { return o.hit_v; });
+    f([](auto& o) -> auto& { return o.hit_depth; });
+    f([](auto& o) -> auto& { return o.error_texels; });
+    f([](auto& o) -> auto& { return o.missed; });
+    f([](auto& o) -> auto& { return o.shadow; });
+    f([](auto& o) -> auto& { return o.ao; });
+  }
 };
+// lane_values() lists every Float but depth and view_depth (the two scalars share one Float's room): a member added
+// without it fails here.
+static_assert(sizeof(ShadeOutput) == std::size_t([] {
+                int count = 0;
+                ShadeOutput::lane_values([&](auto) { ++count; });
+                return count + 3;
+              }()) * sizeof(simd::Float));
 
 // The most batches a program's group (ShadingProgram::shade) may hold.
 inline constexpr int kMaxGroupBatches = 8;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <type_traits>
 
-#include "kernel/lane_compaction.hpp"
+#include "kernel/batch_scheduler.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/reference/reference.hpp"
 #include "qdmr/reference/reference_memo.hpp"
@@ -195,6 +195,32 @@ struct DisplacementProgram::Setup {
   // Mip LOD of the (first) height map: relief and POM steps, blend heights, soft shadows; 0 without one. Set by
   // setup_for (no default: a group's array of setups is made per batch, in the hot path).
   Float height_lod;
+
+  // f(value) for each Float above, value(setup) being it in a Setup (or const): what a packed batch takes of its
+  // lanes' setups (batch_scheduler.hpp; `active` is its used lanes).
+  template <class F>
+  static constexpr void values(F&& f) {
+    f([](auto& s) -> auto& { return s.d.dudx; });
+    f([](auto& s) -> auto& { return s.d.dvdx; });
+    f([](auto& s) -> auto& { return s.d.dudy; });
+    f([](auto& s) -> auto& { return s.d.dvdy; });
+    const auto vec3 = [&](auto of) {
+      f([of](auto& s) -> auto& { return of(s).x; });
+      f([of](auto& s) -> auto& { return of(s).y; });
+      f([of](auto& s) -> auto& { return of(s).z; });
+    };
+    vec3([](auto& s) -> auto& { return s.frame.t; });
+    vec3([](auto& s) -> auto& { return s.frame.b; });
+    vec3([](auto& s) -> auto& { return s.frame.n; });
+    vec3([](auto& s) -> auto& { return s.view; });
+    vec3([](auto& s) -> auto& { return s.view_tangent; });
+    f([](auto& s) -> auto& { return s.ds; });
+    f([](auto& s) -> auto& { return s.ray.u0; });
+    f([](auto& s) -> auto& { return s.ray.v0; });
+    f([](auto& s) -> auto& { return s.ray.du; });
+    f([](auto& s) -> auto& { return s.ray.dv; });
+    f([](auto& s) -> auto& { return s.height_lod; });
+  }
 };
 
 template <class V, class Surface>
@@ -318,15 +344,6 @@ struct DisplacementProgram::SurfaceAtHit {
   Float albedo[4], tangent_normal[3], specular = Float(0.0f), ao = Float(1.0f);
   Float roughness, occlusion;
 };
-
-template <class V, class Surface>
-void DisplacementProgram::shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
-                                    ShadeOutput& out) const {
-  SurfaceAtHit at;
-  surface_at_hit(setup, surface, hit, at);
-  light_hit<V>(in, setup, surface, at, out);
-  if (trace_.write_depth) displaced_depth(in, setup.d, setup.frame, setup.ray, at.hit.s, out);
-}
 
 template <class Surface>
 void DisplacementProgram::surface_at_hit(const Setup& setup, const Surface& surface, const Hit& traced,
@@ -485,7 +502,7 @@ void DisplacementProgram::shade(const Fragments* const* in, ShadeOutput* const* 
   (this->*shade_)(in, out, n);
 }
 
-// A blend's sparse batches are packed into fewer (shade_compacted): up to eight at once, with at most four
+// A blend's sparse batches are packed into fewer (shade_in_stages): up to eight at once, with at most four
 // batches' worth of covered lanes (replayed on the terrain's batches, larger groups of eight left hardly fewer
 // packed batches: docs/performance-history.md).
 static_assert(simd::LaneCompaction::kMaxBatches <= kMaxGroupBatches);
@@ -494,61 +511,6 @@ BatchGrouping DisplacementProgram::grouping() const {
   if (!pairs_technique(key_.trace.technique)) return {};
   if (layers_.size() > 1) return {simd::LaneCompaction::kMaxBatches, 4 * simd::kLanes};
   return {2, 2 * simd::kLanes};
-}
-
-// The one way batches are shaded, in stages: every batch of the group set up (derivatives, frame, the ray and its
-// depth range), then traced, then each one's surface at the hit, its lighting and its displaced depth. A group of
-// one batch is the usual case. Paired single-layer batches (QDM, relief, POM) run each stage side by side: QDM's
-// two walks step in one loop, and each batch's chains of dependent operations overlap the other's. A blend's
-// batches whose covered lanes fit fewer run packed (shade_compacted); otherwise each is traced over its own blended
-// surface, two at a time.
-template <class V>
-void DisplacementProgram::shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  Setup setups[kMaxGroupBatches];
-  for (int k = 0; k < n; ++k) setups[k] = setup_for(*in[k]);
-  if (layers_.size() > 1) {
-    if (n > 1) {
-      std::uint32_t covered[kMaxGroupBatches];
-      for (int k = 0; k < n; ++k) covered[k] = simd::to_bits(in[k]->covered);
-      const simd::LaneCompaction lanes(covered, n);
-      if (lanes.packed_batches() < n) {
-        shade_compacted<V>(in, setups, out, lanes);
-        return;
-      }
-    }
-    trace_blended<V>(in, setups, n, [&](int k, const BlendedSurface& surface, const Hit& hit) {
-      shade_hit<V>(*in[k], setups[k], surface, hit, *out[k]);
-    });
-    return;
-  }
-  const SingleLayerSurface surface = layer_surface(0);
-  for (int k = 0; k < n; k += 2) {
-    if (k + 1 == n) {
-      shade_hit<V>(*in[k], setups[k], surface, trace<V>(surface, setups[k]), *out[k]);
-      return;
-    }
-    const Setup& setup_a = setups[k];
-    const Setup& setup_b = setups[k + 1];
-    Hit hit_a, hit_b;
-    if constexpr (V::technique == TechniqueKind::Qdm) {
-      walk_pair<V>(surface, setup_a, hit_a, surface, setup_b, hit_b);
-      refine_qdm_hits(surface, setup_a, hit_a, setup_b, hit_b);
-    } else if constexpr (V::technique == TechniqueKind::Relief) {  // the binary searches side by side
-      if (fetch_recorder_listens()) {
-        hit_a = trace<V>(surface, setup_a);
-        hit_b = trace<V>(surface, setup_b);
-      } else {
-        trace::relief_pair(surface, trace_, setup_a.ray, setup_a.ds, setup_a.height_lod, setup_a.active, hit_a,
-                           setup_b.ray, setup_b.ds, setup_b.height_lod, setup_b.active, hit_b);
-        hit_a.box_s = hit_a.s;
-        hit_b.box_s = hit_b.s;
-      }
-    } else {  // POM: its loop runs at the core's throughput already; one after the other
-      hit_a = trace<V>(surface, setup_a);
-      hit_b = trace<V>(surface, setup_b);
-    }
-    shade_hits<V>(*in[k], setup_a, hit_a, *out[k], *in[k + 1], setup_b, hit_b, *out[k + 1]);
-  }
 }
 
 // Two batches' QDM walks to their ends, a step of each per round: their hits on the box surface.
@@ -564,137 +526,118 @@ void DisplacementProgram::walk_pair(const Surface& surface_a, const Setup& setup
   hit_b = walk_b.hit();
 }
 
-// Traces batches 0 .. n - 1 over their blended surfaces, two at a time (QDM's walks interleaved, relief and POM
-// one after the other), and calls shade(k, surface, hit) for each.
-template <class V, class Shade>
-void DisplacementProgram::trace_blended(const Fragments* const* in, const Setup* setups, int n,
-                                        const Shade& shade) const {
-  const LayerSurfaces layers = layer_surfaces();
-  for (int k = 0; k < n; k += 2) {
-    const BlendedSurface surface_a = blended_surface(layers, *in[k], setups[k]);
-    if (k + 1 == n) {
-      shade(k, surface_a, trace<V>(surface_a, setups[k]));
-      return;
-    }
-    const BlendedSurface surface_b = blended_surface(layers, *in[k + 1], setups[k + 1]);
-    Hit hit_a, hit_b;
+// A batch's stages over one surface type (SingleLayerSurface, or BlendedSurface for a blend), as shade_in_stages
+// calls them (batch_scheduler.hpp says in which order, paired or packed).
+template <class V, class Surface>
+class DisplacementProgram::Stages {
+public:
+  static constexpr bool kBlend = std::is_same_v<Surface, BlendedSurface>;
+  // A blend's sparse groups are packed (its setup has made everything that reads whole quads).
+  static constexpr PackLanes kPackLanes = kBlend ? PackLanes::Groups : PackLanes::Never;
+  using Setup = DisplacementProgram::Setup;
+  using Hit = DisplacementProgram::Hit;
+  using AtHit = SurfaceAtHit;
+
+  explicit Stages(const DisplacementProgram& program) : p_(program), layers_(layers(program)) {}
+
+  Setup setup(const Fragments& in) const { return p_.setup_for(in); }
+
+  // One layer's surface is every batch's; a blend's is bounded per batch (its weights over the ray's UV box).
+  std::conditional_t<kBlend, BlendedSurface, const SingleLayerSurface&> surface(const Fragments& in,
+                                                                                const Setup& setup) const {
+    if constexpr (kBlend)
+      return p_.blended_surface(layers_, in, setup);
+    else
+      return layers_;
+  }
+
+  Hit trace(const Surface& surface, const Setup& setup) const { return p_.trace<V>(surface, setup); }
+
+  // Two batches' traces: QDM's walks step in one loop, a single layer's relief runs its binary searches side by
+  // side, the rest (POM's loop runs at the core's throughput already) one after the other.
+  void trace_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
+                  const Setup& setup_b, Hit& hit_b) const {
     if constexpr (V::technique == TechniqueKind::Qdm) {
-      walk_pair<V>(surface_a, setups[k], hit_a, surface_b, setups[k + 1], hit_b);
-      hit_a = refine_qdm_hit(surface_a, setups[k], hit_a);
-      hit_b = refine_qdm_hit(surface_b, setups[k + 1], hit_b);
+      p_.walk_pair<V>(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
+      if constexpr (kBlend) {
+        hit_a = p_.refine_qdm_hit(surface_a, setup_a, hit_a);
+        hit_b = p_.refine_qdm_hit(surface_b, setup_b, hit_b);
+      } else {
+        p_.refine_qdm_hits(surface_a, setup_a, hit_a, setup_b, hit_b);
+      }
+    } else if constexpr (V::technique == TechniqueKind::Relief && !kBlend) {
+      if (fetch_recorder_listens()) {
+        hit_a = trace(surface_a, setup_a);
+        hit_b = trace(surface_b, setup_b);
+      } else {
+        trace::relief_pair(surface_a, p_.trace_, setup_a.ray, setup_a.ds, setup_a.height_lod, setup_a.active, hit_a,
+                           setup_b.ray, setup_b.ds, setup_b.height_lod, setup_b.active, hit_b);
+        hit_a.box_s = hit_a.s;
+        hit_b.box_s = hit_b.s;
+      }
     } else {
-      hit_a = trace<V>(surface_a, setups[k]);
-      hit_b = trace<V>(surface_b, setups[k + 1]);
+      hit_a = trace(surface_a, setup_a);
+      hit_b = trace(surface_b, setup_b);
     }
-    shade(k, surface_a, hit_a);
-    shade(k + 1, surface_b, hit_b);
   }
-}
 
-// Past the setup (whose derivatives read whole quads) a blended batch's work is lane by lane: the covered lanes of
-// n batches are packed into as few batches as hold them (simd::LaneCompaction), traced (QDM's walks two at a time)
-// and shaded, and each batch gets its own lanes back. The displaced depth reads quads again (the world position's
-// derivatives): each batch's, from its own lanes' hits.
+  AtHit surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit) const {
+    AtHit at;
+    p_.surface_at_hit(setup, surface, hit, at);
+    return at;
+  }
+
+  void light(const Fragments& in, const Setup& setup, const Surface& surface, const AtHit& at,
+             ShadeOutput& out) const {
+    p_.light_hit<V>(in, setup, surface, at, out);
+  }
+
+  // The displaced depth, from the batch's own quads (the world position's derivatives) and its hits.
+  void finish(const Fragments& in, const Setup& setup, ShadeOutput& out) const {
+    if (p_.trace_.write_depth) p_.displaced_depth(in, setup.d, setup.frame, setup.ray, out.hit_depth, out);
+  }
+
+  // Of the inputs, what the stages after the setup read: the pixel (frame AO's noise) and the vertex weights (the
+  // blended surface).
+  template <class F>
+  void lane_inputs(F&& f) const {
+    f([](auto& in) -> auto& { return in.pixel_x; });
+    f([](auto& in) -> auto& { return in.pixel_y; });
+    for (int j = kWeight0; j < p_.varying_count(); ++j) f([j](auto& in) -> auto& { return in.varyings[j]; });
+  }
+  // What light_hit writes: every lane-wise output.
+  template <class F>
+  static void output_values(F&& f) {
+    ShadeOutput::lane_values(f);
+  }
+
+private:
+  static auto layers(const DisplacementProgram& program) {
+    if constexpr (kBlend)
+      return program.layer_surfaces();
+    else
+      return program.layer_surface(0);
+  }
+
+  const DisplacementProgram& p_;
+  std::conditional_t<kBlend, LayerSurfaces, SingleLayerSurface> layers_;
+};
+
+// Every group, one batch included, in stages (batch_scheduler.hpp): one layer's batches two at a time, a blend's
+// sparse batches packed.
 template <class V>
-void DisplacementProgram::shade_compacted(const Fragments* const* in, const Setup* setups, ShadeOutput* const* out,
-                                          const simd::LaneCompaction& lanes) const {
-  constexpr int kMax = simd::LaneCompaction::kMaxBatches;
-  const int packed = lanes.packed_batches();
-  Fragments packed_in[kMax];
-  Setup packed_setup[kMax];
-  for (int w = 0; w < packed; ++w) {
-    const auto pack = [&](auto field) { return lanes.pack(w, field); };
-    const auto pack3 = [&](auto vec) {
-      return Vec3{pack([&](int k) -> const Float& { return vec(k).x; }),
-                  pack([&](int k) -> const Float& { return vec(k).y; }),
-                  pack([&](int k) -> const Float& { return vec(k).z; })};
-    };
-    // Of the inputs, what reads them past the setup: the pixel (frame AO's noise), the vertex weights (the blended
-    // surface) and the covered lanes.
-    Fragments& f = packed_in[w];
-    f.pixel_x = pack([&](int k) -> const Float& { return in[k]->pixel_x; });
-    f.pixel_y = pack([&](int k) -> const Float& { return in[k]->pixel_y; });
-    for (int j = kWeight0; j < varying_count(); ++j)
-      f.varyings[j] = pack([&](int k) -> const Float& { return in[k]->varyings[j]; });
-    f.covered = lanes.used(w);
-    Setup& s = packed_setup[w];
-    s.d = {pack([&](int k) -> const Float& { return setups[k].d.dudx; }),
-           pack([&](int k) -> const Float& { return setups[k].d.dvdx; }),
-           pack([&](int k) -> const Float& { return setups[k].d.dudy; }),
-           pack([&](int k) -> const Float& { return setups[k].d.dvdy; })};
-    s.frame = {pack3([&](int k) -> const Vec3& { return setups[k].frame.t; }),
-               pack3([&](int k) -> const Vec3& { return setups[k].frame.b; }),
-               pack3([&](int k) -> const Vec3& { return setups[k].frame.n; })};
-    s.view = pack3([&](int k) -> const Vec3& { return setups[k].view; });
-    s.view_tangent = pack3([&](int k) -> const Vec3& { return setups[k].view_tangent; });
-    s.ds = pack([&](int k) -> const Float& { return setups[k].ds; });
-    s.ray = {pack([&](int k) -> const Float& { return setups[k].ray.u0; }),
-             pack([&](int k) -> const Float& { return setups[k].ray.v0; }),
-             pack([&](int k) -> const Float& { return setups[k].ray.du; }),
-             pack([&](int k) -> const Float& { return setups[k].ray.dv; })};
-    s.active = f.covered;
-    s.height_lod = pack([&](int k) -> const Float& { return setups[k].height_lod; });
-  }
-  const Fragments* packed_of[kMax];
-  for (int w = 0; w < packed; ++w) packed_of[w] = &packed_in[w];
-  ShadeOutput lit[kMax];
-  Float hit_s[kMax];
-  trace_blended<V>(packed_of, packed_setup, packed,
-                   [&](int w, const BlendedSurface& surface, const Hit& hit) {
-                     SurfaceAtHit at;
-                     surface_at_hit(packed_setup[w], surface, hit, at);
-                     light_hit<V>(packed_in[w], packed_setup[w], surface, at, lit[w]);
-                     hit_s[w] = at.hit.s;
-                   });
-  // What the packed batches' loops executed: each one's longest lane times the lanes, counted with the batch its
-  // first lane came from.
-  int executed[kMax] = {};
-  for (int w = 0; w < packed; ++w) {
-    alignas(64) float iterations[simd::kLanes];
-    xsimd::select(lanes.used(w), lit[w].iterations, Float(0.0f)).store_aligned(iterations);
-    executed[lanes.first_source(w)] += int(*std::max_element(iterations, iterations + simd::kLanes)) * simd::kLanes;
-  }
-  for (int k = 0; k < lanes.batches(); ++k) {
-    const auto unpack = [&](Float ShadeOutput::*field) {
-      return lanes.unpack(k, [&](int w) -> const Float& { return lit[w].*field; });
-    };
-    ShadeOutput& o = *out[k];
-    o = lit[0];
-    for (int c = 0; c < 3; ++c) {
-      o.color[c] = lanes.unpack(k, [&](int w) -> const Float& { return lit[w].color[c]; });
-      o.normal[c] = lanes.unpack(k, [&](int w) -> const Float& { return lit[w].normal[c]; });
-    }
-    for (Float ShadeOutput::*f : {&ShadeOutput::hit_u, &ShadeOutput::hit_v, &ShadeOutput::hit_depth,
-                                  &ShadeOutput::error_texels, &ShadeOutput::missed, &ShadeOutput::shadow,
-                                  &ShadeOutput::ao})
-      o.*f = unpack(f);
-    // Uncovered lanes ran no iteration (unpack() leaves them undefined): the batch's useful iterations are its
-    // covered lanes'.
-    o.iterations = xsimd::select(in[k]->covered, unpack(&ShadeOutput::iterations), Float(0.0f));
-    o.executed_lane_iterations = executed[k];
-    if (trace_.write_depth)
-      displaced_depth(*in[k], setups[k].d, setups[k].frame, setups[k].ray,
-                      lanes.unpack(k, [&](int w) -> const Float& { return hit_s[w]; }), o);
-  }
+void DisplacementProgram::shade_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const {
+  // values() lists every member but `active` (a Mask, in a Float's room): a member added without it fails here.
+  static_assert(sizeof(Setup) == std::size_t([] {
+                  int count = 0;
+                  Setup::values([&](auto) { ++count; });
+                  return count + 1;
+                }()) * sizeof(Float));
+  if (layers_.size() > 1)
+    shade_in_stages(Stages<V, BlendedSurface>(*this), in, out, n);
+  else
+    shade_in_stages(Stages<V, SingleLayerSurface>(*this), in, out, n);
 }
-
-// shade_hit() of two single-layer batches, stage by stage: the surface at each hit, then the lighting of each.
-template <class V>
-void DisplacementProgram::shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, ShadeOutput& out_a,
-                                     const Fragments& b, const Setup& setup_b, const Hit& hit_b,
-                                     ShadeOutput& out_b) const {
-  const SingleLayerSurface surface = layer_surface(0);
-  SurfaceAtHit at_a, at_b;
-  surface_at_hit(setup_a, surface, hit_a, at_a);
-  surface_at_hit(setup_b, surface, hit_b, at_b);
-  light_hit<V>(a, setup_a, surface, at_a, out_a);
-  light_hit<V>(b, setup_b, surface, at_b, out_b);
-  if (trace_.write_depth) {
-    displaced_depth(a, setup_a.d, setup_a.frame, setup_a.ray, at_a.hit.s, out_a);
-    displaced_depth(b, setup_b.d, setup_b.frame, setup_b.ray, at_b.hit.s, out_b);
-  }
-}
-
 
 DisplacementProgram::Setup DisplacementProgram::setup_for(const Fragments& in) const {
   const Float& u = in.varyings[kU];
@@ -755,7 +698,7 @@ BlendedSurface DisplacementProgram::blended_surface(const LayerSurfaces& layers,
 
 template <class V>
 DisplacementProgram::Variant DisplacementProgram::variant() {
-  return {&DisplacementProgram::shade_group_variant<V>, V::options()};
+  return {&DisplacementProgram::shade_variant<V>, V::options()};
 }
 
 // Every combination of the trace options is instantiated (TraceOptions, qdmr/program/program_key.hpp): 5 techniques, and for qdm

@@ -7,7 +7,6 @@
 #include <optional>
 #include <vector>
 
-#include "kernel/lane_compaction.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "kernel/blended_surface.hpp"
@@ -56,7 +55,7 @@ private:
   };
   // What shade() computes before the surface is known: the frame, the ray and its depth range (the only one).
   struct Setup;
-  // The instantiation of shade_group_variant for a material's trace options, and the options of the type it runs.
+  // The instantiation of shade_variant for a material's trace options, and the options of the type it runs.
   using ShadeFn = void (DisplacementProgram::*)(const Fragments* const*, ShadeOutput* const*, int) const;
   struct Variant {
     ShadeFn shade;
@@ -83,28 +82,18 @@ private:
   static constexpr bool pairs_technique(TechniqueKind k) {
     return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
   }
-  // Everything after the trace: the surface's colour and normal at the hit, lighting and AOVs (light_hit), then the
-  // displaced depth; in stages (a pair of batches runs each stage for both side by side).
-  struct SurfaceAtHit;
+  // The stages of a batch (batch_scheduler.hpp) over one layer's surface or a blend's: setup_for, the trace (and
+  // trace_pair), surface_at_hit, light_hit, the displaced depth; run by shade_in_stages for the instantiation V.
   template <class V, class Surface>
-  void shade_hit(const Fragments& in, const Setup& setup, const Surface& surface, const Hit& hit,
-                 ShadeOutput& out) const;
+  class Stages;
+  struct SurfaceAtHit;
+  template <class V>
+  void shade_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const;
   template <class Surface>
   void surface_at_hit(const Setup& setup, const Surface& surface, const Hit& hit, SurfaceAtHit& at) const;
   template <class V, class Surface>
   void walk_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
                  const Setup& setup_b, Hit& hit_b) const;
-  // The batch scheduler: setup, trace, surface at the hit, lighting (displacement.cpp says how groups run).
-  template <class V>
-  void shade_group_variant(const Fragments* const* in, ShadeOutput* const* out, int n) const;
-  template <class V, class Shade>
-  void trace_blended(const Fragments* const* in, const Setup* setups, int n, const Shade& shade) const;
-  template <class V>
-  void shade_compacted(const Fragments* const* in, const Setup* setups, ShadeOutput* const* out,
-                       const simd::LaneCompaction& lanes) const;
-  template <class V>
-  void shade_hits(const Fragments& a, const Setup& setup_a, const Hit& hit_a, ShadeOutput& out_a,
-                  const Fragments& b, const Setup& setup_b, const Hit& hit_b, ShadeOutput& out_b) const;
   template <class V, class Surface>
   void light_hit(const Fragments& in, const Setup& setup, const Surface& surface, const SurfaceAtHit& at,
                  ShadeOutput& out) const;

@@ -1,5 +1,6 @@
 #include "kernel/normal_mapping.hpp"
 
+#include "kernel/batch_scheduler.hpp"
 #include "kernel/lighting_models.hpp"
 #include "kernel/shading_math.hpp"
 
@@ -67,15 +68,6 @@ Float NormalMappingProgram::orm_lod(const UvDerivatives& d, const Float& albedo_
   return orm_->lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
-template <bool Orm>
-void NormalMappingProgram::sample(const Fragments& in, const UvDerivatives& d, const Float& albedo_lod,
-                                  Samples& out) const {
-  const UvAhead ahead = d.quad_below();
-  textures_.sample(in.varyings[kU], in.varyings[kV], albedo_lod, normal_lod(d, albedo_lod), out.albedo,
-                   out.tangent_normal, &ahead);
-  if constexpr (Orm) orm_->sample(in.varyings[kU], in.varyings[kV], orm_lod(d, albedo_lod), out.orm);
-}
-
 namespace {
 
 // The tangent-space normal (an RGB sample in [0, 1]) to world space, unit length.
@@ -87,8 +79,8 @@ Vec3 shading_normal_of(const TangentFrame& frame, const Float* tangent_normal) {
 }  // namespace
 
 template <bool Orm>
-void NormalMappingProgram::light(const Fragments& in, const Samples& s, const TangentFrame& frame,
-                                 const Vec3& shading_normal, const Vec3& view, ShadeOutput& out) const {
+void NormalMappingProgram::light(const Samples& s, const TangentFrame& frame, const Vec3& shading_normal,
+                                 const Vec3& view, ShadeOutput& out) const {
   const Float specular = specular_from_albedo(s.albedo, specular_, lighting_.specular);
   if constexpr (Orm) {
     const OrmSurface orm = apply_orm(s.orm, orm_params_, lighting_.roughness, s.albedo, specular);
@@ -105,91 +97,113 @@ void NormalMappingProgram::light(const Fragments& in, const Samples& s, const Ta
   out.normal[2] = shading_normal.z;
   out.iterations = out.hit_depth = out.error_texels = out.missed = Float(0.0f);
   out.shadow = Float(1.0f);  // no self-shadowing
-  out.hit_u = in.varyings[kU];
-  out.hit_v = in.varyings[kV];
 }
+
+// Normal mapping's stages, as shade_in_stages calls them (batch_scheduler.hpp): the surface is the polygon's, so
+// there is nothing to trace. A pair's LODs are evaluated together (setup_pair), and a pair whose covered lanes fit
+// in one batch samples and lights once (small triangles: a 1 M-triangle grid averages 5.6 covered lanes of 16).
+template <bool Orm>
+class NormalMappingProgram::Stages {
+public:
+  static constexpr PackLanes kPackLanes = PackLanes::Pairs;
+  // What reads whole quads: the LODs (the ORM texture's with Orm) and the samples' prefetch hint.
+  struct Setup {
+    Float lod, normal_lod, orm_lod;
+    UvAhead ahead;
+
+    template <class F>
+    static constexpr void values(F&& f) {
+      f([](auto& s) -> auto& { return s.lod; });
+      f([](auto& s) -> auto& { return s.normal_lod; });
+      if constexpr (Orm) f([](auto& s) -> auto& { return s.orm_lod; });
+      f([](auto& s) -> auto& { return s.ahead.du; });
+      f([](auto& s) -> auto& { return s.ahead.dv; });
+    }
+  };
+  // The polygon at the batch's lanes: its frame, the view vector and the UVs.
+  struct Surface {
+    TangentFrame frame;
+    Vec3 view;
+    Float u, v;
+  };
+  struct Hit {};
+  using AtHit = Samples;
+
+  explicit Stages(const NormalMappingProgram& program) : p_(program) {}
+
+  Setup setup(const Fragments& in) const {
+    const UvDerivatives d = p_.derivatives(in);
+    Setup setup;
+    fill(d, p_.albedo_lod(d), setup);
+    return setup;
+  }
+  // Per quad, a quad's derivatives are the same in its four lanes: one LOD evaluation serves both batches
+  // (albedo_lods).
+  void setup_pair(const Fragments& a, const Fragments& b, Setup& setup_a, Setup& setup_b) const {
+    const UvDerivatives da = p_.derivatives(a), db = p_.derivatives(b);
+    Float lod_a, lod_b;
+    p_.albedo_lods(da, db, lod_a, lod_b);
+    fill(da, lod_a, setup_a);
+    fill(db, lod_b, setup_b);
+  }
+
+  // The frame is a chain of three normalisations (a square root, then a division, each) that needs no sample: a
+  // pair's two side by side, while the LODs' chains (a logarithm after a division) are under way.
+  Surface surface(const Fragments& in, const Setup&) const {
+    return {TangentFrame::from(in), view_vector(in, p_.lights_), in.varyings[kU], in.varyings[kV]};
+  }
+  Hit trace(const Surface&, const Setup&) const { return {}; }
+  void trace_pair(const Surface&, const Setup&, Hit&, const Surface&, const Setup&, Hit&) const {}
+
+  Samples surface_at_hit(const Setup& setup, const Surface& surface, const Hit&) const {
+    Samples s;
+    p_.textures_.sample(surface.u, surface.v, setup.lod, setup.normal_lod, s.albedo, s.tangent_normal, &setup.ahead);
+    if constexpr (Orm) p_.orm_->sample(surface.u, surface.v, setup.orm_lod, s.orm);
+    return s;
+  }
+
+  void light(const Fragments&, const Setup&, const Surface& surface, const Samples& s, ShadeOutput& out) const {
+    p_.light<Orm>(s, surface.frame, shading_normal_of(surface.frame, s.tangent_normal), surface.view, out);
+  }
+
+  // The hit is the polygon's own UV.
+  void finish(const Fragments& in, const Setup&, ShadeOutput& out) const {
+    out.hit_u = in.varyings[kU];
+    out.hit_v = in.varyings[kV];
+  }
+
+  // Of the inputs, what the surface reads: every varying but the blend weights (none here).
+  template <class F>
+  void lane_inputs(F&& f) const {
+    for (int j = 0; j < kBaseVaryingCount; ++j) f([j](auto& in) -> auto& { return in.varyings[j]; });
+  }
+  // What light writes that differs between lanes (the rest is the same in every lane).
+  template <class F>
+  static void output_values(F&& f) {
+    for (int c = 0; c < 3; ++c) f([c](auto& o) -> auto& { return o.color[c]; });
+    for (int c = 0; c < 3; ++c) f([c](auto& o) -> auto& { return o.normal[c]; });
+    if constexpr (Orm) f([](auto& o) -> auto& { return o.ao; });
+  }
+
+private:
+  // Member by member: a whole Setup returned and assigned was copied through general registers.
+  void fill(const UvDerivatives& d, const Float& lod, Setup& setup) const {
+    setup.lod = lod;
+    setup.normal_lod = p_.normal_lod(d, lod);
+    if constexpr (Orm) setup.orm_lod = p_.orm_lod(d, lod);
+    const UvAhead ahead = d.quad_below();
+    setup.ahead.du = ahead.du;
+    setup.ahead.dv = ahead.dv;
+  }
+
+  const NormalMappingProgram& p_;
+};
 
 void NormalMappingProgram::shade(const Fragments* const* in, ShadeOutput* const* out, int n) const {
   if (orm_)
-    shade_batches<true>(in, out, n);
+    shade_in_stages(Stages<true>(*this), in, out, n);
   else
-    shade_batches<false>(in, out, n);
-}
-
-template <bool Orm>
-void NormalMappingProgram::shade_batches(const Fragments* const* in, ShadeOutput* const* out, int n) const {
-  int k = 0;
-  for (; k + 1 < n; k += 2) shade_pair<Orm>(*in[k], *out[k], *in[k + 1], *out[k + 1]);
-  if (k < n) shade_batch<Orm>(*in[k], *out[k]);
-}
-
-template <bool Orm>
-void NormalMappingProgram::shade_batch(const Fragments& in, ShadeOutput& out) const {
-  Samples s;
-  const UvDerivatives d = derivatives(in);
-  sample<Orm>(in, d, albedo_lod(d), s);
-  const TangentFrame frame = TangentFrame::from(in);
-  light<Orm>(in, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(in, lights_), out);
-}
-
-// Stage by stage, a's and b's work side by side: each stage of one batch is a chain of dependent operations
-// (derivatives, LOD, the sample's addresses, its loads, the filter), and the other batch's same stage next to it
-// gives the core independent work to overlap with it. Sparse batches whose covered lanes fit in one run packed
-// (shade_packed).
-template <bool Orm>
-void NormalMappingProgram::shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b,
-                                      ShadeOutput& out_b) const {
-  const UvDerivatives da = derivatives(a), db = derivatives(b);
-  Float lod_a, lod_b;
-  albedo_lods(da, db, lod_a, lod_b);
-  const std::uint32_t covered_a = simd::to_bits(a.covered), covered_b = simd::to_bits(b.covered);
-  if (simd::LanePacking::fits(covered_a, covered_b)) {
-    shade_packed<Orm>(a, da, lod_a, out_a, b, db, lod_b, out_b, simd::LanePacking(covered_a, covered_b));
-    return;
-  }
-  Samples sa, sb;
-  // Each frame is a chain of three normalisations (a square root, then a division, each), and the shading normal
-  // one more: a's and b's side by side, so one chain's arithmetic fills the other's waits. The frames and view
-  // vectors need no sample: made while the LOD's chain (a logarithm after a division) is under way.
-  const TangentFrame frame_a = TangentFrame::from(a), frame_b = TangentFrame::from(b);
-  const Vec3 view_a = view_vector(a, lights_), view_b = view_vector(b, lights_);
-  sample<Orm>(a, da, lod_a, sa);
-  sample<Orm>(b, db, lod_b, sb);
-  const Vec3 normal_a = shading_normal_of(frame_a, sa.tangent_normal), normal_b = shading_normal_of(frame_b, sb.tangent_normal);
-  light<Orm>(a, sa, frame_a, normal_a, view_a, out_a);
-  light<Orm>(b, sb, frame_b, normal_b, view_b, out_b);
-}
-
-// Past the LODs (which read whole quads) everything is lane by lane: the covered lanes of both batches run as one
-// batch, and each batch's outputs are its own lanes back (the others are never written).
-template <bool Orm>
-void NormalMappingProgram::shade_packed(const Fragments& a, const UvDerivatives& da, const Float& lod_a,
-                                        ShadeOutput& out_a, const Fragments& b, const UvDerivatives& db,
-                                        const Float& lod_b, ShadeOutput& out_b, const simd::LanePacking& packing) const {
-  Fragments packed;
-  for (int k = 0; k < kBaseVaryingCount; ++k) packed.varyings[k] = packing.pack(a.varyings[k], b.varyings[k]);
-  const UvAhead ahead_a = da.quad_below(), ahead_b = db.quad_below();
-  const UvAhead ahead{packing.pack(ahead_a.du, ahead_b.du), packing.pack(ahead_a.dv, ahead_b.dv)};
-  Samples s;
-  textures_.sample(packed.varyings[kU], packed.varyings[kV], packing.pack(lod_a, lod_b),
-                   packing.pack(normal_lod(da, lod_a), normal_lod(db, lod_b)), s.albedo, s.tangent_normal, &ahead);
-  if constexpr (Orm)
-    orm_->sample(packed.varyings[kU], packed.varyings[kV], packing.pack(orm_lod(da, lod_a), orm_lod(db, lod_b)), s.orm);
-  const TangentFrame frame = TangentFrame::from(packed);
-  ShadeOutput lit;
-  light<Orm>(packed, s, frame, shading_normal_of(frame, s.tangent_normal), view_vector(packed, lights_), lit);
-  const auto unpack = [&](const Fragments& in, ShadeOutput& out, auto lanes) {
-    out = lit;
-    for (int c = 0; c < 3; ++c) {
-      out.color[c] = lanes(lit.color[c]);
-      out.normal[c] = lanes(lit.normal[c]);
-    }
-    if constexpr (Orm) out.ao = lanes(lit.ao);
-    out.hit_u = in.varyings[kU];
-    out.hit_v = in.varyings[kV];
-  };
-  unpack(a, out_a, [&](const Float& v) { return packing.first(v); });
-  unpack(b, out_b, [&](const Float& v) { return packing.second(v); });
+    shade_in_stages(Stages<false>(*this), in, out, n);
 }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -3,7 +3,6 @@
 // (lighting_models.hpp) from directional lights plus ambient.
 #include <optional>
 
-#include "kernel/lane_packing.hpp"
 #include "program/light_rig.hpp"
 #include "kernel/batch.hpp"
 #include "qdmr/program/program_params.hpp"
@@ -32,14 +31,10 @@ public:
   void shade(const Fragments* const* in, ShadeOutput* const* out, int n) const override;
 
 private:
-  // Orm: the ORM texture is sampled and applied (orm_ is set); both instantiations are made, shade() picks one.
+  // The stages of a batch (batch_scheduler.hpp): the LODs, the polygon's frame, the samples, the lighting; no trace.
+  // Orm: the ORM texture is sampled and applied (orm_ is set); both are instantiated, shade() picks one.
   template <bool Orm>
-  void shade_batches(const Fragments* const* in, ShadeOutput* const* out, int n) const;
-  template <bool Orm>
-  void shade_batch(const Fragments& in, ShadeOutput& out) const;
-  // Two batches, stage by stage side by side (the same results as shade_batch of each).
-  template <bool Orm>
-  void shade_pair(const Fragments& a, ShadeOutput& out_a, const Fragments& b, ShadeOutput& out_b) const;
+  class Stages;
   struct Samples;
   shading::UvDerivatives derivatives(const Fragments& in) const;
   bool magnified(const shading::UvDerivatives& d) const;
@@ -48,19 +43,10 @@ private:
                    simd::Float& lod_b) const;
   simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
   simd::Float orm_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  // Lights a batch whose frame, shading normal and view vector are computed.
   template <bool Orm>
-  void sample(const Fragments& in, const shading::UvDerivatives& d, const simd::Float& albedo_lod,
-              Samples& out) const;
-  // Lights a batch whose frame, shading normal and view vector are computed (shade_pair computes two batches'
-  // side by side).
-  template <bool Orm>
-  void light(const Fragments& in, const Samples& samples, const shading::TangentFrame& frame,
-             const shading::Vec3& shading_normal, const shading::Vec3& view, ShadeOutput& out) const;
-  // shade_pair() of two batches whose covered lanes fit in one (small triangles).
-  template <bool Orm>
-  void shade_packed(const Fragments& a, const shading::UvDerivatives& da, const simd::Float& lod_a, ShadeOutput& out_a,
-                    const Fragments& b, const shading::UvDerivatives& db, const simd::Float& lod_b, ShadeOutput& out_b,
-                    const simd::LanePacking& packing) const;
+  void light(const Samples& samples, const shading::TangentFrame& frame, const shading::Vec3& shading_normal,
+             const shading::Vec3& view, ShadeOutput& out) const;
 
   TwinSampler textures_;  // albedo first, normal map second
   LodMode lod_mode_;

@@ -286,56 +286,38 @@ private:
     slots_[packing_].pass = 0;
   }
 
-  // A batch ready to shade: now, or held back for a group (a pair, or more: ShadingProgram::grouping) when the
-  // program shades batches together.
+  // A batch ready to shade: held back for a group (ShadingProgram::grouping: a pair, or more), and the group
+  // shaded once it is full. A program that shades one batch at a time, and every program while the texture-cache
+  // recorder listens (it attributes fetches to the batch in flight), has groups of one: shaded at once.
   void ready(int slot) {
     PendingBatch& p = slots_[slot];
-    if (recorder_ == nullptr && p.program != grouping_of_) {  // asked once per program, not per batch
+    if (p.program != grouping_of_) {  // asked once per program, not per batch
       grouping_of_ = p.program;
-      grouping_ = p.program->grouping();
+      grouping_ = recorder_ == nullptr ? p.program->grouping() : BatchGrouping{};
       grouping_.batches = std::min(grouping_.batches, kMaxGroupBatches);
     }
-    if (recorder_ == nullptr && grouping_.batches > 1) {
-      // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one
-      // of its pixels is tested), so a later one's early depth test may run before an earlier one's write.
-      const int lanes = std::popcount(p.pass);
-      if (held_count_ > 0 && (slots_[held_[0]].program != p.program || held_lanes_ + lanes > grouping_.lanes))
-        shade_held();
-      held_[held_count_++] = slot;
-      held_slots_ |= 1u << slot;
-      held_lanes_ += lanes;
-      if (held_count_ >= grouping_.batches) shade_held();
-      return;
-    }
-    ShadeOutput out;
-    if (recorder_ != nullptr) {
-      // The texture cache sees the quads a GPU would run: every lane of a quad with a pixel to write.
-      std::uint32_t issuing = 0;
-      for (int q = 0; q < simd::kQuadsPerBatch; ++q)
-        if ((p.pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
-      int lane_x[kLanes], lane_y[kLanes];
-      for (int l = 0; l < kLanes; ++l) {
-        lane_x[l] = p.lane_pixel_x(l);
-        lane_y[l] = p.lane_pixel_y(l);
-      }
-      recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
-      p.program->shade_one(p.in, out);
-      recorder_->end_batch();
-    } else {
-      p.program->shade_one(p.in, out);
-    }
-    finish(p, out);
+    // Batches held back write no pixel in common (prepare() writes a held-back batch before a batch with one of
+    // its pixels is tested), so a later one's early depth test may run before an earlier one's write.
+    const int lanes = std::popcount(p.pass);
+    if (held_count_ > 0 && (slots_[held_[0]].program != p.program || held_lanes_ + lanes > grouping_.lanes))
+      shade_held();
+    held_[held_count_++] = slot;
+    held_slots_ |= 1u << slot;
+    held_lanes_ += lanes;
+    if (held_count_ >= grouping_.batches) shade_held();
   }
 
-  // Shades the batches held back, as one group (one batch alone, two as a pair: the usual cases, without the
-  // group's arrays).
+  // Shades the batches held back, as one group: one batch (under the recorder's eyes when it listens) or a pair,
+  // the usual cases, here; more in shade_held_group (its arrays would make every pair's frame bigger).
   void shade_held() {
     const ShadingProgram& program = *slots_[held_[0]].program;
     if (held_count_ <= 2) {
       ShadeOutput out[2];
       PendingBatch& first = slots_[held_[0]];
       if (held_count_ == 1) {
+        if (recorder_ != nullptr) begin_recorded_batch(first);
         program.shade_one(first.in, out[0]);
+        if (recorder_ != nullptr) recorder_->end_batch();
       } else {
         const Fragments* const in[2] = {&first.in, &slots_[held_[1]].in};
         ShadeOutput* const out_of[2] = {&out[0], &out[1]};
@@ -349,6 +331,19 @@ private:
     held_count_ = 0;
     held_lanes_ = 0;
     held_slots_ = 0;
+  }
+
+  // The texture cache sees the quads a GPU would run: every lane of a quad with a pixel to write.
+  void begin_recorded_batch(const PendingBatch& p) {
+    std::uint32_t issuing = 0;
+    for (int q = 0; q < simd::kQuadsPerBatch; ++q)
+      if ((p.pass >> (4 * q)) & 0xFu) issuing |= 0xFu << (4 * q);
+    int lane_x[kLanes], lane_y[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      lane_x[l] = p.lane_pixel_x(l);
+      lane_y[l] = p.lane_pixel_y(l);
+    }
+    recorder_->begin_batch(kLanes, lane_x, lane_y, issuing);
   }
 
   // shade_held() of more than two batches (a function of its own: its arrays would make every pair's frame bigger).
