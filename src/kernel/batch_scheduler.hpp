@@ -65,9 +65,11 @@ concept BatchStages = requires(const S& s, const Fragments& in, const typename S
 
 namespace stages_detail {
 
-// The lane-wise stages of batches 0 .. n - 1, two at a time, each stage of a pair side by side.
+// The lane-wise stages of batches 0 .. n - 1, two at a time, each stage of a pair side by side. Inlined into the
+// scheduler: a call between them sent every pair's setups through the stack and back (normal mapping's pairs cost
+// more instructions than its own pair function had).
 template <class S>
-void shade_lanes(const S& s, const Fragments* const* in, const typename S::Setup* setups, ShadeOutput* const* out,
+[[gnu::always_inline]] inline void shade_lanes(const S& s, const Fragments* const* in, const typename S::Setup* setups, ShadeOutput* const* out,
                  int n) {
   for (int k = 0; k < n; k += 2) {
     if (k + 1 == n) {
