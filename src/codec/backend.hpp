@@ -2,7 +2,7 @@
 // Image files go through one narrow interface to OpenImageIO, so that the `qdmr` command can load OpenImageIO
 // (and the ~260 shared libraries it pulls in, about 0.3 s of dynamic linking) only when a job reads or writes an
 // image that qdmr does not handle itself: PNG, JPEG, OpenEXR, PBM/PGM/PPM and most TIFF are read in process
-// (codec/native_reader.hpp), PNG written so too (codec/png_writer.hpp). The library and the tests link the backend
+// (codec/native_reader.hpp), PNG and float OpenEXR written so too (codec/png_writer.hpp, codec/exr_writer.hpp). The library and the tests link the backend
 // directly (codec/direct.cpp); the command loads it from libqdmr_imageio.so on first use (codec/lazy.cpp).
 // Both run the same code (codec/oiio_backend.cpp).
 #include <cstddef>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "codec/exr_writer.hpp"
 #include "codec/png_writer.hpp"
 #include "file/atomic_file.hpp"
 
@@ -22,6 +23,13 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
     write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
       std::string error;
       return write_png(temporary.string(), stamped, data, error) ? "" : error;
+    });
+    return;
+  }
+  if (extension == ".exr" && exr_writes(stamped)) {  // float EXR: OpenEXR directly, the same bytes
+    write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
+      std::string error;
+      return write_exr(temporary.string(), stamped, data, error) ? "" : error;
     });
     return;
   }

@@ -1,6 +1,6 @@
 #pragma once
-// An image file written whole or not at all (file/atomic_file.hpp): PNG by qdmr's own writer, every other format
-// through the image backend.
+// An image file written whole or not at all (file/atomic_file.hpp): PNG and float OpenEXR by qdmr's own writers
+// (codec/png_writer.hpp, codec/exr_writer.hpp), every other file through the image backend.
 #include <filesystem>
 #include <string>
 

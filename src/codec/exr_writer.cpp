@@ -1,0 +1,135 @@
+#include "codec/exr_writer.hpp"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <ImfThreading.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace qdmr {
+namespace {
+
+// OpenEXR's bytes straight into the file, every write checked (as the OpenImageIO backend's CheckedFileOutput):
+// unbuffered pwrite() at the stream's position, the first OS error kept. OpenEXR writes the line offsets last, from
+// ~OutputFile, which swallows exceptions: the caller asks failure() after the file object is gone.
+class CheckedStream final : public Imf::OStream {
+public:
+  explicit CheckedStream(const std::string& path)
+      : Imf::OStream(path.c_str()), fd_(::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC)) {
+    if (fd_ < 0) failure_ = errno;
+  }
+  ~CheckedStream() override { close(); }
+  CheckedStream(const CheckedStream&) = delete;
+  CheckedStream& operator=(const CheckedStream&) = delete;
+
+  void write(const char c[], int n) override {
+    std::size_t done = 0;
+    while (fd_ >= 0 && failure_ == 0 && done < std::size_t(n)) {
+      const ssize_t w = ::pwrite(fd_, c + done, std::size_t(n) - done, off_t(position_ + done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) failure_ = w < 0 ? errno : ENOSPC;  // a write of 0 bytes: no room
+      if (w > 0) done += std::size_t(w);
+    }
+    position_ += done;
+    if (failure_ != 0) throw std::runtime_error(std::strerror(failure_));
+  }
+  std::uint64_t tellp() override { return position_; }
+  void seekp(std::uint64_t position) override { position_ = position; }
+
+  void close() {
+    if (fd_ >= 0 && ::close(fd_) != 0 && failure_ == 0) failure_ = errno;
+    fd_ = -1;
+  }
+  int failure() const { return failure_; }  // the first OS error (errno), 0 for none
+
+private:
+  int fd_;
+  int failure_ = 0;
+  std::uint64_t position_ = 0;
+};
+
+std::vector<std::string> channel_names(const imageio::WriteSpec& spec) {
+  if (!spec.channel_names.empty()) return spec.channel_names;
+  if (spec.channels == 1) return {"Y"};  // OpenImageIO's ImageSpec::default_channel_names
+  static const char* const kNames[] = {"R", "G", "B", "A"};
+  return {kNames, kNames + spec.channels};
+}
+
+// OpenEXR compresses a file's chunks on its global thread pool, which the OpenImageIO backend sized to the cores
+// (pvt::set_exr_threads): the same here, once, unless the process has set a pool size of its own.
+void size_exr_threads() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (Imf::globalThreadCount() == 0) Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+  });
+}
+
+}  // namespace
+
+bool exr_writes(const imageio::WriteSpec& spec) {
+  if (spec.type != imageio::PixelType::Float || spec.width < 1 || spec.height < 1 || spec.channels < 1 ||
+      spec.channels > 4 || !spec.ints.empty())
+    return false;
+  if (!spec.channel_names.empty()) {
+    if (spec.channel_names.size() != std::size_t(spec.channels)) return false;
+    std::vector<std::string> names = spec.channel_names;
+    std::sort(names.begin(), names.end());
+    if (std::adjacent_find(names.begin(), names.end()) != names.end() ||
+        std::any_of(names.begin(), names.end(), [](const std::string& n) { return n.empty(); }))
+      return false;
+  }
+  // Without a DateTime, OpenImageIO stamps the file with the current time (write_image_file always sets one).
+  return std::any_of(spec.strings.begin(), spec.strings.end(), [](const auto& s) { return s.first == "DateTime"; }) &&
+         std::all_of(spec.strings.begin(), spec.strings.end(), [](const auto& s) {
+           return s.first == "DateTime" || s.first == "Software" || s.first == "qdmr:bits_version";
+         });
+}
+
+bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const void* data, std::string& error) {
+  size_exr_threads();
+  CheckedStream stream(path);
+  if (stream.failure() != 0) {
+    error = std::strerror(stream.failure());
+    return false;
+  }
+  const std::vector<std::string> names = channel_names(spec);
+  try {
+    Imf::Header header(spec.width, spec.height);
+    for (const std::string& name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    for (const auto& [name, value] : spec.strings)
+      header.insert(name == "DateTime" ? "capDate" : name, Imf::StringAttribute(value));  // a later one replaces
+    const std::size_t pixel = sizeof(float) * std::size_t(spec.channels);
+    Imf::FrameBuffer frame;
+    char* base = static_cast<char*>(const_cast<void*>(data));
+    for (std::size_t c = 0; c < names.size(); ++c)
+      frame.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), pixel, pixel * std::size_t(spec.width)));
+    Imf::OutputFile file(stream, header);
+    file.setFrameBuffer(frame);
+    file.writePixels(spec.height);
+  } catch (const std::exception& e) {
+    error = stream.failure() != 0 ? std::strerror(stream.failure()) : e.what();
+    return false;
+  }
+  stream.close();
+  if (stream.failure() != 0) {  // the line offsets, written as the file object went
+    error = std::strerror(stream.failure());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace qdmr
