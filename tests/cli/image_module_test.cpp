@@ -51,13 +51,19 @@ TEST(ImageModule, OnlyJobsWithImagesLoadIt) {
                                              "--height", "18"});
   EXPECT_EQ(png.exit_code, 0) << png.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "p.png"));
+  // Float OpenEXR too, a float AOV with it (codec/exr_writer.hpp).
+  const CommandResult exr = run(cli(), {"render", plane, "-o", (dir / "p.exr").string(), "--width", "32", "--height",
+                                        "18", "--aov", "depth=" + (dir / "d.exr").string()});
+  EXPECT_EQ(exr.exit_code, 0) << exr.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "p.exr"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "d.exr"));
   // Any other format goes through the module.
-  const CommandResult render = run(cli(), {"render", plane, "-o", (dir / "p.exr").string(), "--width", "32",
+  const CommandResult render = run(cli(), {"render", plane, "-o", (dir / "p.tif").string(), "--width", "32",
                                                 "--height", "18"});
   EXPECT_EQ(render.exit_code, 2) << render.output;
   EXPECT_NE(render.output.find("image I/O: cannot load libqdmr_imageio.so"), std::string::npos) << render.output;
   EXPECT_NE(render.output.find("QDMR_IMAGEIO_MODULE"), std::string::npos) << render.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "p.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.tif"));
   // PNG, JPEG, OpenEXR, PGM, PFM and TIFF (of the layouts OpenImageIO passes through) textures are read in process
   // (codec/native_reader.hpp): planned and rendered without the module. A TIFF that OpenImageIO converts needs
   // it, and says so.

@@ -1,8 +1,8 @@
 // codec/exr_writer.cpp: float OpenEXR files written by the OpenEXR library directly must be the bytes the
 // OpenImageIO backend writes for the same spec (the files qdmr wrote before, and what the backend still writes for
 // specs the writer leaves to it), on sizes of one and several ZIP chunks (16 rows each), 1 to 4 channels, named or
-// not, with the metadata qdmr writes, and every kind of float (NaN, infinities, -0, subnormals). A render to EXR
-// then needs no image module; a full disk is reported with the OS's reason.
+// not, with the metadata qdmr writes, and every kind of float (NaN, infinities, -0, subnormals).
+// A full disk is reported with the OS's reason (the command without the module: cli/image_module_test.cpp).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -109,19 +109,6 @@ TEST(ExrWriter, AFullDiskIsReportedWithTheOSReason) {
   std::string error;
   EXPECT_FALSE(write_exr("/dev/full", spec, values.data(), error));
   EXPECT_EQ(error, "No space left on device");
-}
-
-// A render to EXR, with a float AOV, runs without the image module (QDMR_IMAGEIO_MODULE naming no file).
-TEST(ExrWriter, ARenderToExrNeedsNoImageModule) {
-  TempDir dir;
-  const std::string plane = (source_dir() / "scenes" / "plane.json").string();
-  const std::string no_module = "QDMR_IMAGEIO_MODULE=" + (dir / "no-such-module.so").string();
-  const CommandResult render =
-      run("/usr/bin/env", {no_module, cli().string(), "render", plane, "-o", (dir / "p.exr").string(), "--width",
-                           "32", "--height", "18", "--aov", "depth=" + (dir / "d.exr").string()});
-  EXPECT_EQ(render.exit_code, 0) << render.output;
-  EXPECT_TRUE(fs::is_regular_file(dir / "p.exr"));
-  EXPECT_TRUE(fs::is_regular_file(dir / "d.exr"));
 }
 
 }  // namespace
