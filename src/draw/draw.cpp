@@ -157,7 +157,8 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       inputs.combined = c->texture.get();
       inputs.layer_heights = c->layer_heights.get();
       inputs.box_values = c->box_values ? c->box_values->data() : nullptr;
-      const HeightField& combined = *assets.derived[std::size_t(m.combined_surface)].field;
+      // The tree's own field where it was made from the box values, else the fp64 surface it was made from.
+      const HeightField& combined = c->field ? *c->field : *assets.derived[std::size_t(m.combined_surface)].field;
       inputs.combined_period_u = combined.width;
       inputs.combined_period_v = combined.height;
     }

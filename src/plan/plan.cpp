@@ -416,20 +416,29 @@ public:
                                                           " texels (the layers' size times scale squared), more than 2^26");
         Key op;
         op("op").v(int(desc.blend.op))("width").v(desc.blend.width);
-        m.combined_surface = add(DerivedKind::CombinedSurface, "combined|" + heights + wkey + "|" + op.str(),
-                                 where + "/blend", {m.weights}, index, texels * sizeof(double), -1, 0, -1,
-                                 heights_dynamic);
-        const std::string& combined_key = plan_.derived[std::size_t(m.combined_surface)].key;
+        const std::string surface_key = "combined|" + heights + wkey + "|" + op.str();
+        // Where the walk keeps its fp32 level 0 (blend_box_values), the tree and the AO map are made from those
+        // values: the surface the walk intersects. The fp64 surface is then made for the exact reference only.
+        const bool from_box_values = c.combined_quadtree && c.box_values;
+        if (m.reference || !from_box_values)
+          m.combined_surface = add(DerivedKind::CombinedSurface, surface_key, where + "/blend", {m.weights}, index,
+                                   texels * sizeof(double), -1, 0, -1, heights_dynamic);
+        const std::string source_key =
+            from_box_values ? "box|" + surface_key : plan_.derived[std::size_t(m.combined_surface)].key;
         if (c.combined_quadtree)
-          m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + combined_key, where + "/blend/quadtree",
-                                    {m.combined_surface, m.weights}, index, c.combined_bytes);
+          m.combined_quadtree =
+              from_box_values
+                  ? add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree", {m.weights},
+                        index, c.combined_bytes + texels * sizeof(double), -1, 0, -1, heights_dynamic)
+                  : add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree",
+                        {m.combined_surface, m.weights}, index, c.combined_bytes);
         if (c.blend_ao) {
           AoDesc ao = desc.ao;
           ao.resolution = c.ao_side;
           const int field_w = h.width * m.weights_scale, field_h = h.height * m.weights_scale;
           const AoMapSize side = ao_map_size(field_w, field_h, ao);
-          m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + combined_key + "|" + ao_key(ao, desc.technique.depth_scale),
-                           where + "/ao", {m.combined_surface}, index,
+          m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + source_key + "|" + ao_key(ao, desc.technique.depth_scale),
+                           where + "/ao", {from_box_values ? m.combined_quadtree : m.combined_surface}, index,
                            mip_chain_bytes(side.width, side.height, TexelFormat::R16), -1, side.width);
           plan_.derived[std::size_t(m.blend_ao)].working_bytes = ao_bake_bytes(field_w, field_h, ao);
           keep_ao_rows(plan_.derived[std::size_t(m.blend_ao)], ao, side);
@@ -497,6 +506,7 @@ private:
   // What plan_material decided that derived() turns into items.
   struct Choices {
     bool combined_quadtree = false, blend_ao = false;
+    bool box_values = false;  // with the combined quadtree: the walk's fp32 level 0 (blend_box_values)
     std::uint64_t combined_bytes = 0;
     int ao_side = 0;
   };
@@ -603,8 +613,9 @@ MaterialPlan Planner::plan_material(const MaterialDesc& material, const std::str
         std::vector<TexelFormat> formats;
         for (const LayerPlan& l : plan.layers) formats.push_back(textures[std::size_t(l.height_max)].format);
         const std::uint64_t heights = layer_heights_bytes(h.width, h.height, formats);
-        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16) + heights +
-                                 blend_box_values_bytes(h.width, h.height, int(scale), heights);
+        const std::uint64_t box_values = blend_box_values_bytes(h.width, h.height, int(scale), heights);
+        choices.box_values = box_values > 0;
+        choices.combined_bytes = mip_chain_bytes(int(side_x), int(side_y), TexelFormat::R16) + heights + box_values;
       }
     }
   }

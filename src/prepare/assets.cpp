@@ -390,12 +390,13 @@ private:
         break;
       }
       case DerivedKind::CombinedQuadtree: {
-        out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field, kernel_.mip_extremum()));
+        // Inputs: the weight texture last, the fp64 surface first where the tree is made from it (no box values).
+        const Texture& weights = *input(d.inputs.size() - 1).texture;
         std::vector<const Texture*> chains;
         for (const LayerPlan& l : m.layers) chains.push_back(assets_.textures[std::size_t(l.height_max)].get());
         if (LayerHeights heights = interleave_layer_heights(chains); heights.width > 0) {
           out.layer_heights = std::make_shared<const LayerHeights>(std::move(heights));
-          const BlendBoxSource source{input(1).texture.get(), m.weights_scale, out.layer_heights.get(), desc.blend.op,
+          const BlendBoxSource source{&weights, m.weights_scale, out.layer_heights.get(), desc.blend.op,
                                       int(m.layers.size())};
           if (const std::size_t count = blend_box_value_count(source); count > 0) {
             ZeroedBuffer<float> values(count);  // zero pages, committed by the rows' threads
@@ -403,6 +404,14 @@ private:
             out.box_values = std::make_shared<const ZeroedBuffer<float>>(std::move(values));
           }
         }
+        if (d.inputs.size() == 1) {
+          // The tree and the blend's AO map of the values the walk reads (the plan made no fp64 surface for them).
+          if (!out.box_values) throw Error(d.where, "internal: the plan expected the blend's box values");
+          const int period = out.layer_heights->width * m.weights_scale;
+          out.field = std::make_shared<const HeightField>(box_value_field(*out.box_values, period));
+        }
+        out.texture = std::make_shared<const Texture>(
+            combined_quadtree(out.field ? *out.field : *input(0).field, kernel_.mip_extremum()));
         break;
       }
       case DerivedKind::BlendAoMap: {

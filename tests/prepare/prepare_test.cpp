@@ -32,6 +32,7 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
   const SceneDesc scene = load_shipped(shipped);
   // With the error AOVs the displacement materials also need their exact references (height fields, combined
   // surfaces): both plans must hold.
+  std::set<std::string> shading_items[2];  // [with no AOVs]: the blends' trees and AO maps
   for (const std::vector<Aov>& aovs : {std::vector<Aov>{}, std::vector<Aov>{Aov::ErrorTexels}}) {
     const FramePlan plan = plan_frame(scene, PlanOptions{aovs});
     const std::vector<std::string> items = plan.items();
@@ -55,14 +56,28 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
         EXPECT_EQ(plan.derived[i].bytes, d.twin_texels->size() * sizeof(float)) << plan.derived[i].key;
       }
       if (plan.derived[i].kind == DerivedKind::CombinedQuadtree) {
-        // What the plan counts for it: the tree, the layers' level-0 heights side by side and the blended
+        // What the plan counts for it: the tree, the layers' level-0 heights side by side, the blended
         // level-0 values of the period (every shipped blend's layers keep decoded copies and are square, so it
-        // has both).
+        // has both) and, made from those values, the fp64 field of the tree and the AO map (no separate fp64
+        // combined surface: no shipped blend asks for error AOVs).
         ASSERT_TRUE(d.layer_heights) << plan.derived[i].key;
         ASSERT_TRUE(d.box_values) << plan.derived[i].key;
+        ASSERT_TRUE(d.field) << plan.derived[i].key;
+        EXPECT_EQ(plan.derived[i].inputs.size(), 1u) << plan.derived[i].key;  // the weights only
         EXPECT_EQ(plan.derived[i].bytes, d.texture->bytes() + d.layer_heights->texels.size() * sizeof(float) +
-                                             d.box_values->size() * sizeof(float));
+                                             d.box_values->size() * sizeof(float) + d.field->h.size() * sizeof(double));
+        const auto differs = [&](std::size_t k) { return d.field->h[k] != double((*d.box_values)[k]); };
+        std::size_t k = 0;
+        while (k < d.box_values->size() && !differs(k)) ++k;
+        EXPECT_EQ(k, d.box_values->size()) << plan.derived[i].key << ": the field differs from the box values there";
       }
+      // The fp64 combined surface only for the exact reference; the tree and the AO map are the same items
+      // either way, so error AOVs leave the colour's bits alone.
+      if (aovs.empty()) {
+        EXPECT_NE(plan.derived[i].kind, DerivedKind::CombinedSurface) << plan.derived[i].key;
+      }
+      if (plan.derived[i].kind == DerivedKind::CombinedQuadtree || plan.derived[i].kind == DerivedKind::BlendAoMap)
+        shading_items[aovs.empty()].insert(plan.derived[i].key);
     }
     // Prepared again with the first assets as the previous ones: nothing is built, everything shared.
     const Assets again = prepare(plan, kernel_for(resolve_isa(Isa::Auto)), &assets, &plan);
@@ -70,6 +85,7 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
     EXPECT_EQ(again.reused, items);
     for (std::size_t i = 0; i < assets.textures.size(); ++i) EXPECT_EQ(again.textures[i], assets.textures[i]);
   }
+  EXPECT_EQ(shading_items[0], shading_items[1]) << shipped.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(, PreparePlan, testing::ValuesIn(shipped_scenes()), scene_name);

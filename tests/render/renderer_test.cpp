@@ -119,13 +119,13 @@ TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
     EXPECT_NE(step.where.find(scene.file.string()), std::string::npos) << step.item;
   }
   EXPECT_EQ(first.prepare_steps.back().what, "blend_ao_map");
-  // The AO map is baked from the combined surface: it begins once that has been built.
+  // The AO map is baked from the combined quadtree's field: it begins once that has been built.
   const auto built = [&](const std::string& what) {
     return std::find_if(first.prepare_steps.begin(), first.prepare_steps.end(),
                         [&](const PrepareStep& s) { return s.what == what; });
   };
-  ASSERT_NE(built("combined_surface"), first.prepare_steps.end());
-  EXPECT_GE(built("blend_ao_map")->start_ms, built("combined_surface")->start_ms + built("combined_surface")->ms);
+  ASSERT_NE(built("combined_quadtree"), first.prepare_steps.end());
+  EXPECT_GE(built("blend_ao_map")->start_ms, built("combined_quadtree")->start_ms + built("combined_quadtree")->ms);
   // 0 first, then one call per item built with the fraction done, then 1 when prepare is over.
   ASSERT_EQ(fractions.size(), expected.size() + 2);
   EXPECT_EQ(fractions.front(), 0.0);

@@ -8,7 +8,7 @@
 // differences. See docs/checks.md.
 namespace qdmr {
 
-inline constexpr int kBitsVersion = 6;
+inline constexpr int kBitsVersion = 7;
 
 const char* version();  // "0.1.0", the project version of CMakeLists.txt
 
