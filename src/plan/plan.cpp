@@ -425,13 +425,15 @@ public:
                                    texels * sizeof(double), -1, 0, -1, heights_dynamic);
         const std::string source_key =
             from_box_values ? "box|" + surface_key : plan_.derived[std::size_t(m.combined_surface)].key;
-        if (c.combined_quadtree)
-          m.combined_quadtree =
-              from_box_values
-                  ? add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree", {m.weights},
-                        index, c.combined_bytes + texels * sizeof(double), -1, 0, -1, heights_dynamic)
-                  : add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree",
-                        {m.combined_surface, m.weights}, index, c.combined_bytes);
+        if (c.combined_quadtree) {
+          // From the box values: the weights are its only input, and it keeps their fp64 field.
+          std::vector<int> inputs{m.weights};
+          if (!from_box_values) inputs.insert(inputs.begin(), m.combined_surface);
+          m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree",
+                                    std::move(inputs), index,
+                                    c.combined_bytes + (from_box_values ? texels * sizeof(double) : 0), -1, 0, -1,
+                                    heights_dynamic);
+        }
         if (c.blend_ao) {
           AoDesc ao = desc.ao;
           ao.resolution = c.ao_side;
