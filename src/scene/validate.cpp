@@ -843,8 +843,12 @@ void read_gltf_override(const Value& value, MaterialDesc& material) {
   if (auto v = object.find("layers")) {
     v->expect_type(json::value_t::array, "an array of one layer (a glTF material has one)");
     layers = v->array();
+    // Not a blend: a blend's layers carry no ORM texture (read_material), and the glTF material's base colour,
+    // normal, metallic-roughness and occlusion make one layer.
     v->require(layers.size() == 1, "a glTF material has one layer: 'layers' takes one element, not " +
-                                       std::to_string(layers.size()));
+                                       std::to_string(layers.size()) +
+                                       " (it cannot become a blend; a blend is a scene material named by the object's "
+                                       "'material')");
     for (const std::string_view key : layer_key_names)
       if (auto flat = object.find(key))
         flat->fail("give '" + std::string(key) + "' in 'layers'[0] or beside 'technique', not both");

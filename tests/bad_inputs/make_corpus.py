@@ -563,7 +563,7 @@ case("gltf_displaced_without_height", render("--set", '/objects/0={"mesh": {"typ
 case("gltf_override_both_forms", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"height": "gltf/quad.glb", "layers": [{}]}}}'),
      "/objects/0/materials/checker/height: give 'height' in 'layers'[0] or beside 'technique', not both")
 case("gltf_override_two_layers", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb"}, "materials": {"checker": {"layers": [{}, {}]}}}'),
-     "/objects/0/materials/checker/layers: a glTF material has one layer: 'layers' takes one element, not 2")
+     "/objects/0/materials/checker/layers: a glTF material has one layer: 'layers' takes one element, not 2 (it cannot become a blend; a blend is a scene material named by the object's 'material')")
 case("gltf_unknown_node", render("--set", '/objects/0={"mesh": {"type": "gltf", "file": "gltf/quad.glb", "node": "qaud"}}'),
      "the asset has no node named 'qaud'; did you mean 'quad'?")
 case("gltf_plan_points", ["plan", "{in}/gltf/points.gltf"], "points cannot be drawn")

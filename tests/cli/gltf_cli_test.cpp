@@ -4,6 +4,7 @@
 // mesh, materials and the warnings of what is ignored.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -97,7 +98,9 @@ TEST(CliGltf, TheOverridesLayerIsSetAndItsMistakesAreNamed) {
   const std::vector<std::pair<std::string, std::string>> mistakes = {
       {"/objects/0/materials/bricks/height=assets/wall_height.png",
        at + "/height: give 'height' in 'layers'[0] or beside 'technique', not both"},
-      {"/objects/0/materials/bricks/layers/-={}", at + "/layers: a glTF material has one layer: 'layers' takes one element, not 2"},
+      {"/objects/0/materials/bricks/layers/-={}",
+       at + "/layers: a glTF material has one layer: 'layers' takes one element, not 2 (it cannot become a blend; a "
+            "blend is a scene material named by the object's 'material')"},
       {"/objects/0/materials/bricks/layers/0/albedo=a.png", at + "/layers/0: unknown key 'albedo'"},
   };
   for (const auto& [set, error] : mistakes) {
@@ -106,6 +109,47 @@ TEST(CliGltf, TheOverridesLayerIsSetAndItsMistakesAreNamed) {
     EXPECT_NE(r.output.find(error), std::string::npos) << set << "\n" << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "c.png")) << set;
   }
+}
+
+// A glTF material with a metallic-roughness and an occlusion texture (quad_orm.gltf: its `orm` and `occlusion`)
+// overridden into 2, 3 or 4 layers is refused, not drawn with its ORM dropped: one line naming the scene and the
+// field, exit 2, nothing written. A blend is a scene material, whose layers cannot carry an `orm` either (the
+// blend programs sample each layer's albedo, normal and height, no ORM): the same promise, its own line.
+TEST(CliGltf, AnOrmMaterialIsNotBlended) {
+  TempDir dir;
+  const std::string scene = (gltf_dir() / "displaced_orm.json").string();
+  const auto render = [&](const std::string& set) {
+    return qdmr({"render", scene, "-o", (dir / "c.png").string(), "--set", set});
+  };
+  ASSERT_EQ(qdmr({"render", scene, "-o", (dir / "one.png").string()}).exit_code, 0);  // one layer: drawn
+  for (int count = 2; count <= 4; ++count) {
+    nlohmann::json layers = nlohmann::json::array();
+    for (int i = 0; i < count; ++i) layers.push_back({{"height", "assets/wall_height.png"}});
+    const nlohmann::json material = {{"layers", layers}, {"technique", {{"name", "qdm"}, {"depth_scale", 0.08}}}};
+    const CommandResult r = render("/objects/0/materials/checker=" + material.dump());
+    EXPECT_EQ(r.exit_code, 2) << count;
+    EXPECT_NE(r.output.find(scene + ": /objects/0/materials/checker/layers: a glTF material has one layer: 'layers' "
+                                    "takes one element, not " + std::to_string(count) + " (it cannot become a blend"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;  // one line
+    EXPECT_FALSE(std::filesystem::exists(dir / "c.png")) << count;
+  }
+  // The scene material way: a blend whose layer names the asset's ORM texture.
+  const nlohmann::json blend = {
+      {"layers", {{{"albedo", "assets/checker.png"}, {"height", "assets/wall_height.png"}, {"orm", "assets/orm.png"}},
+                  {{"albedo", "assets/white.png"}, {"height", "assets/wall_height.png"}}}},
+      {"technique", {{"name", "qdm"}, {"depth_scale", 0.08}}}};
+  const nlohmann::json object = {
+      {"name", "quad"}, {"mesh", {{"type", "gltf"}, {"file", "assets/quad_orm.gltf"}}}, {"material", "blend"}};
+  const CommandResult r = qdmr({"render", scene, "-o", (dir / "c.png").string(), "--set", "/materials/blend=" + blend.dump(),
+                                "--set", "/objects/0=" + object.dump()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find(scene + ": /materials/blend/layers/0/orm: an orm texture is read on a material of one layer, "
+                                  "not on a blend"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "c.png"));
 }
 
 // --max-memory reaches the glTF reader: 5000 nodes drawing the quad (1.07 MiB of drawn copies) are refused under
