@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
               "and by each kernel this CPU runs (the same bits)\n\n",
               size, double(ds), reps);
   std::printf("| rows | mode | radius (texels) | threads | seconds | ns / texel |\n|---|---|---|---|---|---|\n");
-  std::vector<std::pair<std::string, qdmr::AoMapRow>> bakes = {{"scalar", nullptr}};
+  std::vector<std::pair<std::string, qdmr::AoMapRow>> bakes = {{"scalar", qdmr::AoMapRow{}}};
   for (qdmr::Isa isa : qdmr::usable_isas()) bakes.emplace_back(qdmr::isa_name(isa), qdmr::kernel_for(isa).ao_map_row());
   for (bool coarse : {true, false})
     for (const auto& [name, row] : bakes)

@@ -26,31 +26,33 @@ namespace {
 constexpr std::uint32_t kAoFormatVersion = 2;
 constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
 
-AoMapSize map_size(const HeightField& field, const AoDesc& desc) { return ao_map_size(field.width, field.height, desc); }
+template <class T>
+AoMapSize map_size(const HeightView<T>& field, const AoDesc& desc) { return ao_map_size(field.width, field.height, desc); }
 
 }  // namespace
 
-ao::MaxPyramid::MaxPyramid(const HeightField& field) {
+template <class T>
+ao::MaxPyramid<T>::MaxPyramid(const HeightView<T>& field) {
   width.push_back(field.width);
   height.push_back(field.height);
   int levels = 1;
   for (int w = field.width, h = field.height; w > 1 || h > 1; w = std::max(1, w / 2), h = std::max(1, h / 2)) ++levels;
   parents.reserve(std::size_t(levels - 1));  // level's pointers stay valid
-  level.push_back(field.h.data());
+  level.push_back(field.h);
   while (width.back() > 1 || height.back() > 1) {
     const int w = width.back(), h = height.back();
     const int pw = std::max(1, w / 2), ph = std::max(1, h / 2);
     // Zero pages, first touched by the rows' own threads; a parent starts at 0, below every height.
-    ZeroedBuffer<double> parent(std::size_t(pw) * std::size_t(ph));
-    const double* child = level.back();
+    ZeroedBuffer<T> parent(std::size_t(pw) * std::size_t(ph));
+    const T* child = level.back();
     tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& rows) {
       for (int py = rows.begin(); py < rows.end(); ++py) {
-        double* out = parent.data() + std::size_t(py) * std::size_t(pw);
+        T* out = parent.data() + std::size_t(py) * std::size_t(pw);
         const int y_end = py == ph - 1 ? h : std::min(h, 2 * py + 2);  // the last row takes the leftover
         for (int y = 2 * py; y < y_end; ++y) {
-          const double* in = child + std::size_t(y) * std::size_t(w);
+          const T* in = child + std::size_t(y) * std::size_t(w);
           for (int x = 0; x < w; ++x) {
-            double& p = out[std::min(x / 2, pw - 1)];
+            T& p = out[std::min(x / 2, pw - 1)];
             p = std::max(p, in[x]);
           }
         }
@@ -63,9 +65,10 @@ ao::MaxPyramid::MaxPyramid(const HeightField& field) {
   }
 }
 
-ao::UniformColumns::UniformColumns(const Bake& b) : taps(b.taps.count) {
-  const HeightField& f = *b.field;
-  const MaxPyramid& p = *b.pyramid;
+template <class T>
+ao::UniformColumns::UniformColumns(const Bake<T>& b) : taps(b.taps.count) {
+  const HeightView<T>& f = b.field;
+  const MaxPyramid<T>& p = *b.pyramid;
   const int n = direction_count(b.pattern), w = b.map_width;
   cell.resize(std::size_t(n) * std::size_t(taps) * std::size_t(w));
   left.resize(std::size_t(w));
@@ -100,13 +103,13 @@ AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc) {
   return {desc.resolution, int(std::max<std::int64_t>(1, h))};
 }
 
-std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc) {
+std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc, int height_bytes) {
   const AoMapSize size = ao_map_size(field_width, field_height, desc);
   std::uint64_t bytes = std::uint64_t(size.width) * std::uint64_t(size.height) * sizeof(float);
   if (desc.coarse) {
     for (int w = field_width, h = field_height; w > 1 || h > 1;) {
       w = std::max(1, w / 2), h = std::max(1, h / 2);
-      bytes += std::uint64_t(w) * std::uint64_t(h) * sizeof(double);
+      bytes += std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(height_bytes);
     }
     if (!desc.jitter)
       bytes += ao::UniformColumns::bytes(size.width, ao::direction_count(pattern_of(desc)),
@@ -115,7 +118,8 @@ std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& des
   return bytes;
 }
 
-Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row) {
+template <class T>
+Image bake_ao_map(const HeightView<T>& field, double depth_scale, const AoDesc& desc, AoMapRow row) {
   if (field.width <= 0 || field.height <= 0) throw Error("ao map", "empty or inconsistent height field");
   const AoMapSize size = map_size(field, desc);
   Image map(size.width, size.height, 1);
@@ -123,15 +127,17 @@ Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& de
   return map;
 }
 
-void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
-                  AoMapRow row) {
-  if (field.width <= 0 || field.height <= 0 || field.h.size() != std::size_t(field.width) * std::size_t(field.height))
-    throw Error("ao map", "empty or inconsistent height field");
+template <class T>
+void bake_ao_rows(const HeightView<T>& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
+                  AoMapRow row_of) {
+  if (field.width <= 0 || field.height <= 0 || !field.h) throw Error("ao map", "empty or inconsistent height field");
+  const AoRowOf<T> row = row_of.template of<T>();
   const AoMapSize size = map_size(field, desc);
   if (map.width != size.width || map.height != size.height || map.channels != 1 || step < 1 || first < 0)
     throw Error("ao map", "bake_ao_rows: the map or the rows do not fit the bake");
-  const std::optional<ao::MaxPyramid> pyramid = desc.coarse ? std::optional<ao::MaxPyramid>(field) : std::nullopt;
-  ao::Bake bake{&field, pyramid ? &*pyramid : nullptr, depth_scale, pattern_of(desc),
+  const std::optional<ao::MaxPyramid<T>> pyramid =
+      desc.coarse ? std::optional<ao::MaxPyramid<T>>(field) : std::nullopt;
+  ao::Bake<T> bake{field, pyramid ? &*pyramid : nullptr, depth_scale, pattern_of(desc),
                 ao::make_taps(pattern_of(desc), field.width, field.height),
                 size.width, size.height};
   // The kernels' rows of a coarse bake without jitter read the columns every row shares.
@@ -155,14 +161,25 @@ void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& de
   });
 }
 
-std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {
+template <class T>
+std::uint64_t ao_map_key(const HeightView<T>& field, double depth_scale, const AoDesc& desc) {
   const AoMapSize size = map_size(field, desc);
   ContentHash f;
   f.value(kAoFormatVersion);
   f.value(std::int32_t(field.width));
   f.value(std::int32_t(field.height));
   f.value(std::int32_t(field.address));
-  f.bytes(field.h.data(), field.h.size() * sizeof(double));
+  const std::size_t count = std::size_t(field.width) * std::size_t(field.height);
+  if constexpr (std::is_same_v<T, double>) {
+    f.bytes(field.h, count * sizeof(double));
+  } else {  // the doubles they convert to, a block at a time
+    std::array<double, 4096> block;
+    for (std::size_t i = 0; i < count; i += block.size()) {
+      const std::size_t n = std::min(block.size(), count - i);
+      std::copy_n(field.h + i, n, block.begin());
+      f.bytes(block.data(), n * sizeof(double));
+    }
+  }
   f.value(depth_scale);
   f.value(std::int32_t(ao::direction_count(pattern_of(desc))));
   f.value(desc.radius);
@@ -174,7 +191,8 @@ std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoD
   return f.digest();
 }
 
-Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
+template <class T>
+Image load_or_bake_ao_map(const HeightView<T>& field, double depth_scale, const AoDesc& desc,
                           const std::filesystem::path& cache_dir, AoMapRow row) {
   if (field.width <= 0 || field.height <= 0) return bake_ao_map(field, depth_scale, desc, row);  // throws
   const std::uint64_t key = ao_map_key(field, depth_scale, desc);
@@ -186,5 +204,17 @@ Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const Ao
   write_float_cache(file, id, map.texels);
   return map;
 }
+
+#define QDMR_AO_BAKE(T)                                                                                            \
+  template struct ao::MaxPyramid<T>;                                                                              \
+  template ao::UniformColumns::UniformColumns(const ao::Bake<T>&);                                                \
+  template Image bake_ao_map(const HeightView<T>&, double, const AoDesc&, AoMapRow);                              \
+  template void bake_ao_rows(const HeightView<T>&, double, const AoDesc&, Image&, int, int, AoMapRow);            \
+  template std::uint64_t ao_map_key(const HeightView<T>&, double, const AoDesc&);                                \
+  template Image load_or_bake_ao_map(const HeightView<T>&, double, const AoDesc&, const std::filesystem::path&,  \
+                                     AoMapRow);
+QDMR_AO_BAKE(double)
+QDMR_AO_BAKE(float)
+#undef QDMR_AO_BAKE
 
 }  // namespace qdmr

@@ -16,8 +16,10 @@
 // it needs no rebake). depth_scale is the material's technique depth scale (depth in UV units).
 #include <cstdint>
 #include <filesystem>
+#include <type_traits>
 
 #include "bake/ao_pattern.hpp"
+#include "bake/ao_texel.hpp"
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "qdmr/texture/image.hpp"
@@ -30,22 +32,35 @@ inline ao::Pattern pattern_of(const AoDesc& desc) {
           .coarse = desc.coarse};
 }
 
-namespace ao {
-struct Bake;  // what one texel reads (bake/ao_texel.hpp)
-}
 // Row j of a map (map width floats into row) by a kernel's vectors (Kernel::ao_map_row, which preparation passes
-// so that `--isa` holds there too). Every row function gives the definition's bits.
-using AoMapRow = void (*)(const ao::Bake& bake, int j, float* row);
+// so that `--isa` holds there too), one function per stored height type. Every row function gives the definition's
+// bits; a null one (the default) bakes by the definition texel by texel (scalar, baseline x86-64).
+template <class T>
+using AoRowOf = void (*)(const ao::Bake<T>& bake, int j, float* row);
+struct AoMapRow {
+  AoRowOf<double> f64 = nullptr;
+  AoRowOf<float> f32 = nullptr;
 
-// A one-channel fp32 image, row 0 at v = 0. Parallel over rows with oneTBB; the same bits for any thread count.
-// Rows run `row`; null: the definition texel by texel (scalar, baseline x86-64). Throws qdmr::Error on an empty
-// field.
-Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row = nullptr);
+  template <class T>
+  AoRowOf<T> of() const {
+    if constexpr (std::is_same_v<T, float>) return f32;
+    else return f64;
+  }
+};
+
+// A one-channel fp32 image, row 0 at v = 0. Parallel over rows with oneTBB; the same bits for any thread count,
+// and for float heights the same as for a HeightField of the same values. Throws qdmr::Error on an empty field.
+template <class T>
+Image bake_ao_map(const HeightView<T>& field, double depth_scale, const AoDesc& desc, AoMapRow row = {});
+inline Image bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc, AoMapRow row = {}) {
+  return bake_ao_map(height_view(field), depth_scale, desc, row);
+}
 
 // Rows first, first + step, ... of `map` (sized as bake_ao_map makes it) baked as bake_ao_map bakes them; the other
 // rows are left as they are (an amortized map's rows of earlier frames: AoDesc::amortize_frames).
-void bake_ao_rows(const HeightField& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
-                  AoMapRow row = nullptr);
+template <class T>
+void bake_ao_rows(const HeightView<T>& field, double depth_scale, const AoDesc& desc, Image& map, int first, int step,
+                  AoMapRow row = {});
 
 struct AoMapSize {
   int width, height;
@@ -54,20 +69,30 @@ struct AoMapSize {
 AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc);
 
 // What a bake (or a cache read) holds besides the field and the stored map: the map in floats and, for coarse
-// taps, the max pyramid of the heights above level 0 (fp64) and, without jitter, the tap columns every row shares
+// taps, the max pyramid of the heights above level 0 (height_bytes per cell: as the heights are stored) and, without jitter, the tap columns every row shares
 // (bake/ao_texel.hpp's UniformColumns). For memory plans; nothing is baked.
-std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc);
+std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc, int height_bytes = sizeof(double));
 
-// XXH3-64 of the format version, W, H, address mode, heights (as doubles), depth scale, direction count
-// (clamped to 4..16), radius, coarse, jitter, the seed (when jittered) and the map's size. Not strength or mode.
-std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc);
+// XXH3-64 of the format version, W, H, address mode, heights (as doubles, whatever they are stored as: float
+// heights have the key of their fp64 copy), depth scale, direction count (clamped to 4..16), radius, coarse,
+// jitter, the seed (when jittered) and the map's size. Not strength or mode.
+template <class T>
+std::uint64_t ao_map_key(const HeightView<T>& field, double depth_scale, const AoDesc& desc);
+inline std::uint64_t ao_map_key(const HeightField& field, double depth_scale, const AoDesc& desc) {
+  return ao_map_key(height_view(field), depth_scale, desc);
+}
 
 // The cached map of (field, depth_scale, desc) from cache_dir (e.g. default_cache_dir() of cone_map.hpp), or
 // the bake, stored there through a temporary file and a rename. A cached file is used only if its header
 // (magic, version, key, size) and payload checksum match and every value lies in [0, 1]; anything else is
 // rebuilt and overwritten. A cache that cannot be written is not an error: a
 // warning (qdmr/core/warning.hpp) names the entry and the OS reason.
-Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
-                          const std::filesystem::path& cache_dir, AoMapRow row = nullptr);
+template <class T>
+Image load_or_bake_ao_map(const HeightView<T>& field, double depth_scale, const AoDesc& desc,
+                          const std::filesystem::path& cache_dir, AoMapRow row = {});
+inline Image load_or_bake_ao_map(const HeightField& field, double depth_scale, const AoDesc& desc,
+                                 const std::filesystem::path& cache_dir, AoMapRow row = {}) {
+  return load_or_bake_ao_map(height_view(field), depth_scale, desc, cache_dir, row);
+}
 
 }  // namespace qdmr

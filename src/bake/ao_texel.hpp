@@ -1,7 +1,9 @@
 #pragma once
 // One texel of a baked AO map (bake/ao_map.hpp's definition), scalar and in double: the baseline bake and the
 // per-ISA bakes (kernel/ao_rows.cpp) share it, the latter for lanes their vectors do not cover. Inline: compiled
-// with each ISA's flags it rounds alike everywhere (only IEEE operations, -ffp-contract=off).
+// with each ISA's flags it rounds alike everywhere (only IEEE operations, -ffp-contract=off). Templates on the
+// stored height type: double (a HeightField) or float (a blend's box values, texture/blend_box_values.hpp, read as
+// the doubles they convert to exactly: the same bits as their fp64 copy, without making it).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,18 +12,20 @@
 #include "bake/ao_pattern.hpp"
 #include "qdmr/core/zeroed_buffer.hpp"
 #include "qdmr/texture/heightfield.hpp"
+#include "texture/height_view.hpp"
 
 namespace qdmr::ao {
 
 // The max pyramid of the heights, shaped like the max-quadtree: level k+1 has max(1, floor(n/2)) cells per axis,
 // the last one also covering the leftover row/column, so texel x of level 0 lies in cell min(x >> k, n_k - 1).
-// Level 0 is the field's own heights (not copied).
+// Level 0 is the field's own heights (not copied); the levels above hold T too (a maximum is one of its inputs).
+template <class T>
 struct MaxPyramid {
   std::vector<int> width, height;
-  std::vector<const double*> level;
-  std::vector<ZeroedBuffer<double>> parents;  // levels 1..
+  std::vector<const T*> level;
+  std::vector<ZeroedBuffer<T>> parents;  // levels 1..
 
-  explicit MaxPyramid(const HeightField& field);
+  explicit MaxPyramid(const HeightView<T>& field);
 
   int top() const { return int(level.size()) - 1; }
 
@@ -30,7 +34,7 @@ struct MaxPyramid {
   std::int64_t cell_y(int k, std::int64_t y) const { return std::min<std::int64_t>(y >> k, height[std::size_t(k)] - 1); }
 
   double cell_max(int k, std::int64_t x, std::int64_t y) const {
-    return level[std::size_t(k)][std::size_t(cell_y(k, y) * width[std::size_t(k)] + cell_x(k, x))];
+    return double(level[std::size_t(k)][std::size_t(cell_y(k, y) * width[std::size_t(k)] + cell_x(k, x))]);
   }
 };
 
@@ -43,9 +47,10 @@ inline std::int64_t tap_texel(double t, int n, AddressMode address) {
 }
 
 // Everything one texel of a bake reads. pyramid is null for fine taps.
+template <class T>
 struct Bake {
-  const HeightField* field;
-  const MaxPyramid* pyramid;
+  HeightView<T> field;
+  const MaxPyramid<T>* pyramid;
   double depth_scale;
   Pattern pattern;
   Taps taps;
@@ -63,7 +68,8 @@ struct UniformColumns {
   std::vector<std::int32_t> left, right; // texel i's bilinear footprint: its level-0 columns (address applied)
   std::vector<double> fraction;          // and the fraction between them
 
-  explicit UniformColumns(const Bake& b);
+  template <class T>
+  explicit UniformColumns(const Bake<T>& b);
   // What they hold for a map `map_width` wide with `directions` x `taps` taps.
   static std::uint64_t bytes(int map_width, int directions, int taps);
 };
@@ -77,8 +83,9 @@ struct UniformColumns {
 // [0, 1]) the slope is found tap by tap. Returns 0 when no tap rises.
 inline constexpr double kSmallestScaledRise = 0x1p-990;
 
-inline double coarse_tap_rise(const Bake& b, int k, double s, double u, double v, double dx, double dy) {
-  const HeightField& field = *b.field;
+template <class T>
+double coarse_tap_rise(const Bake<T>& b, int k, double s, double u, double v, double dx, double dy) {
+  const HeightView<T>& field = b.field;
   const Tap& tap = b.taps.tap[std::size_t(k)];
   const double tu = u + dx * double(tap.distance), tv = v + dy * double(tap.distance);
   const std::int64_t x = tap_texel(tu, field.width, field.address), y = tap_texel(tv, field.height, field.address);
@@ -86,14 +93,16 @@ inline double coarse_tap_rise(const Bake& b, int k, double s, double u, double v
 }
 
 // The slope tap by tap, for a largest scaled rise below kSmallestScaledRise.
-inline double coarse_slope_by_tap(const Bake& b, double s, double u, double v, double dx, double dy) {
+template <class T>
+double coarse_slope_by_tap(const Bake<T>& b, double s, double u, double v, double dx, double dy) {
   double slope = 0.0;
   for (int k = 0; k < b.taps.count; ++k)
     slope = std::max(slope, coarse_tap_rise(b, k, s, u, v, dx, dy) / double(b.taps.tap[std::size_t(k)].distance));
   return slope;
 }
 
-inline double coarse_slope(const Bake& b, double s, double u, double v, double dx, double dy) {
+template <class T>
+double coarse_slope(const Bake<T>& b, double s, double u, double v, double dx, double dy) {
   double rise = 0.0, scale = 1.0;  // scale = 2^-k; no branch per tap: a rise's sign is a coin toss on rough ground
   for (int k = 0; k < b.taps.count; ++k, scale *= 0.5) rise = std::max(rise, coarse_tap_rise(b, k, s, u, v, dx, dy) * scale);
   if (rise == 0.0 || rise >= kSmallestScaledRise) return rise / double(b.taps.tap[0].distance);
@@ -101,27 +110,31 @@ inline double coarse_slope(const Bake& b, double s, double u, double v, double d
 }
 
 // The fine taps' horizon slope along (dx, dy): the largest (s - depth) / distance over taps on the bilinear surface.
-inline double fine_slope(const Bake& b, double s, double u, double v, double dx, double dy) {
+template <class T>
+double fine_slope(const Bake<T>& b, double s, double u, double v, double dx, double dy) {
   double slope = 0.0;
   for (int k = 0; k < b.taps.count; ++k) {
     const Tap& tap = b.taps.tap[std::size_t(k)];
     const double depth =
-        bilinear_surface_depth(*b.field, b.depth_scale, u + dx * double(tap.distance), v + dy * double(tap.distance));
+        bilinear_surface_depth(b.field, b.depth_scale, u + dx * double(tap.distance), v + dy * double(tap.distance));
     slope = std::max(slope, (s - depth) / double(tap.distance));
   }
   return slope;
 }
 
 // The map's UV of texel (i, j).
-inline double texel_u(const Bake& b, int i) { return (i + 0.5) / b.map_width; }
-inline double texel_v(const Bake& b, int j) { return (j + 0.5) / b.map_height; }
+template <class T>
+double texel_u(const Bake<T>& b, int i) { return (i + 0.5) / b.map_width; }
+template <class T>
+double texel_v(const Bake<T>& b, int j) { return (j + 0.5) / b.map_height; }
 
 // The raw AO of texel (i, j) of the map.
-inline double texel_ao(const Bake& b, int i, int j) {
+template <class T>
+double texel_ao(const Bake<T>& b, int i, int j) {
   const int n = direction_count(b.pattern);
   const int r = b.pattern.jitter ? rotation(std::uint32_t(i), std::uint32_t(j), b.pattern.seed) : 0;
   const double u = texel_u(b, i), v = texel_v(b, j);
-  const double s = bilinear_surface_depth(*b.field, b.depth_scale, u, v);
+  const double s = bilinear_surface_depth(b.field, b.depth_scale, u, v);
   double visible = 0.0;
   for (int d = 0; d < n; ++d) {
     const int index = direction_index(n, d, r);

@@ -157,10 +157,14 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       inputs.combined = c->texture.get();
       inputs.layer_heights = c->layer_heights.get();
       inputs.box_values = c->box_values ? c->box_values->data() : nullptr;
-      // The tree's own field where it was made from the box values, else the fp64 surface it was made from.
-      const HeightField& combined = c->field ? *c->field : *assets.derived[std::size_t(m.combined_surface)].field;
-      inputs.combined_period_u = combined.width;
-      inputs.combined_period_v = combined.height;
+      // The period of its box values where it has them, else of the fp64 surface it was made from.
+      if (c->box_values) {
+        inputs.combined_period_u = inputs.combined_period_v = c->layer_heights->width * m.weights_scale;
+      } else {
+        const HeightField& combined = *assets.derived[std::size_t(m.combined_surface)].field;
+        inputs.combined_period_u = combined.width;
+        inputs.combined_period_v = combined.height;
+      }
     }
     if (const DerivedAsset* a = derived(m.blend_ao)) {
       inputs.blend_ao = a->texture.get();

@@ -4,7 +4,7 @@
 // (ao::UniformColumns, found by the definition's code) in loops over chunks of the row; otherwise a batch falls
 // back to the scalar definition, lane by lane, where the vector form would differ: a tap texel index beyond
 // +-2^31 (the definition converts to int64). Either way a largest scaled rise below ao::kSmallestScaledRise is
-// compared tap by tap, as the definition does.
+// compared tap by tap, as the definition does. Heights stored as float are read as the doubles they convert to.
 #include "kernel/ao_rows.hpp"
 
 #include <algorithm>
@@ -67,8 +67,9 @@ struct Lanes {
 };
 
 // bilinear_surface_depth on lanes; ok turns false when an index leaves the vector form's range.
-Double bilinear_depth(const ao::Bake& b, const Double& u, const Double& v, bool& ok) {
-  const HeightField& f = *b.field;
+template <class T>
+Double bilinear_depth(const ao::Bake<T>& b, const Double& u, const Double& v, bool& ok) {
+  const HeightView<T>& f = b.field;
   const Double x = u * Double(double(f.width)) - Double(0.5), y = v * Double(double(f.height)) - Double(0.5);
   const Double fi = xsimd::floor(x), fj = xsimd::floor(y);
   const Double fx = x - fi, fy = y - fj;
@@ -77,7 +78,7 @@ Double bilinear_depth(const ao::Bake& b, const Double& u, const Double& v, bool&
   const double w = f.width, h = f.height;
   const Double i0 = texel_index(fi, w, f.address), i1 = texel_index(fi + Double(1.0), w, f.address);
   const Double r0 = texel_index(fj, h, f.address) * Double(w), r1 = texel_index(fj + Double(1.0), h, f.address) * Double(w);
-  const double* texels = f.h.data();
+  const T* texels = f.h;
   const Double h00 = Double::gather(texels, to_index(r0 + i0)), h10 = Double::gather(texels, to_index(r0 + i1));
   const Double h01 = Double::gather(texels, to_index(r1 + i0)), h11 = Double::gather(texels, to_index(r1 + i1));
   const Double height = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
@@ -87,10 +88,11 @@ Double bilinear_depth(const ao::Bake& b, const Double& u, const Double& v, bool&
 // The largest scaled rise of the coarse taps along (dx, dy) per lane (coarse_slope before its division). Without
 // jitter every lane of a row looks along the same direction from the same v: the taps' rows are found once
 // (dy_uniform), in scalar, by the definition's own code.
-Double coarse_rise(const ao::Bake& b, const Lanes& l, const Double& dx, const Double& dy, double v, const double* dy_uniform,
+template <class T>
+Double coarse_rise(const ao::Bake<T>& b, const Lanes& l, const Double& dx, const Double& dy, double v, const double* dy_uniform,
                    bool& ok) {
-  const HeightField& f = *b.field;
-  const ao::MaxPyramid& p = *b.pyramid;
+  const HeightView<T>& f = b.field;
+  const ao::MaxPyramid<T>& p = *b.pyramid;
   Double rise(0.0);
   double scale = 1.0;
   for (int k = 0; k < b.taps.count; ++k, scale *= 0.5) {
@@ -126,7 +128,8 @@ Double coarse_rise(const ao::Bake& b, const Lanes& l, const Double& dx, const Do
   return rise;
 }
 
-Double fine_slope(const ao::Bake& b, const Lanes& l, const Double& dx, const Double& dy, bool& ok) {
+template <class T>
+Double fine_slope(const ao::Bake<T>& b, const Lanes& l, const Double& dx, const Double& dy, bool& ok) {
   Double slope(0.0);
   for (int k = 0; k < b.taps.count && ok; ++k) {
     const ao::Tap& tap = b.taps.tap[std::size_t(k)];
@@ -138,7 +141,8 @@ Double fine_slope(const ao::Bake& b, const Lanes& l, const Double& dx, const Dou
 }
 
 // The raw AO of kWidth texels from i0 on row j; false where the vector form does not hold (nothing written).
-bool batch_ao(const ao::Bake& b, int i0, int j, std::array<double, kWidth>& out) {
+template <class T>
+bool batch_ao(const ao::Bake<T>& b, int i0, int j, std::array<double, kWidth>& out) {
   const int n = ao::direction_count(b.pattern);
   std::array<double, kWidth> u{};
   std::array<int, kWidth> rotation{};
@@ -193,19 +197,20 @@ static_assert(kChunk % kWidth == 0);
 // A row of a coarse bake without jitter, from the columns every row shares (ao::UniformColumns): per chunk of
 // texels, loops over the chunk that this ISA's vectors run, each texel's operations the definition's in its order.
 // A direction's taps read one pyramid row each, found once per row by the definition's own code.
-void uniform_row(const ao::Bake& b, int j, float* row) {
-  const HeightField& f = *b.field;
-  const ao::MaxPyramid& p = *b.pyramid;
+template <class T>
+void uniform_row(const ao::Bake<T>& b, int j, float* row) {
+  const HeightView<T>& f = b.field;
+  const ao::MaxPyramid<T>& p = *b.pyramid;
   const ao::UniformColumns& c = *b.columns;
   const int n = ao::direction_count(b.pattern), taps = c.taps;
   const double v = ao::texel_v(b, j), ds = b.depth_scale, first = double(b.taps.tap[0].distance);
   // bilinear_surface_depth's rows.
   const double y = v * f.height - 0.5, fj = std::floor(y), fy = y - fj;
   const auto r = std::int64_t(fj);
-  const double* row0 = f.h.data() + std::size_t(HeightField::texel_index(r, f.height, f.address) * f.width);
-  const double* row1 = f.h.data() + std::size_t(HeightField::texel_index(r + 1, f.height, f.address) * f.width);
+  const T* row0 = f.h + std::size_t(HeightField::texel_index(r, f.height, f.address) * f.width);
+  const T* row1 = f.h + std::size_t(HeightField::texel_index(r + 1, f.height, f.address) * f.width);
   // Each tap's pyramid row: [d * taps + k].
-  std::array<const double*, std::size_t(ao::kMaxDirections) * ao::kMaxTaps> tap_rows{};
+  std::array<const T*, std::size_t(ao::kMaxDirections) * ao::kMaxTaps> tap_rows{};
   std::array<double, ao::kMaxDirections> dxs{}, dys{};
   for (int d = 0; d < n; ++d) {
     const int index = ao::direction_index(n, d, 0);
@@ -226,7 +231,8 @@ void uniform_row(const ao::Bake& b, int j, float* row) {
     const double* fraction = c.fraction.data() + i0;
     for (int i = 0; i < m; ++i) {
       const double fx = fraction[i];
-      const double h00 = row0[left[i]], h10 = row0[right[i]], h01 = row1[left[i]], h11 = row1[right[i]];
+      const double h00 = double(row0[left[i]]), h10 = double(row0[right[i]]);
+      const double h01 = double(row1[left[i]]), h11 = double(row1[right[i]]);
       const double h = h00 + (h10 - h00) * fx + (h01 - h00) * fy + (h00 - h10 - h01 + h11) * fx * fy;
       s[std::size_t(i)] = ds * (1.0 - h);
       visible[std::size_t(i)] = 0.0;
@@ -235,10 +241,10 @@ void uniform_row(const ao::Bake& b, int j, float* row) {
       std::fill_n(rise.begin(), m, 0.0);
       double scale = 1.0;
       for (int k = 0; k < taps; ++k, scale *= 0.5) {
-        const double* cells = tap_rows[std::size_t(d * taps + k)];
+        const T* cells = tap_rows[std::size_t(d * taps + k)];
         const std::int32_t* column = c.cell.data() + (std::size_t(d) * std::size_t(taps) + std::size_t(k)) * std::size_t(b.map_width) + std::size_t(i0);
         for (int i = 0; i < m; ++i) {
-          const double t = (s[std::size_t(i)] - ds * (1.0 - cells[column[i]])) * scale;
+          const double t = (s[std::size_t(i)] - ds * (1.0 - double(cells[column[i]]))) * scale;
           rise[std::size_t(i)] = rise[std::size_t(i)] < t ? t : rise[std::size_t(i)];  // std::max
         }
       }
@@ -263,9 +269,8 @@ void uniform_row(const ao::Bake& b, int j, float* row) {
   }
 }
 
-}  // namespace
-
-void ao_map_row(const ao::Bake& bake, int j, float* row) {
+template <class T>
+void row_of(const ao::Bake<T>& bake, int j, float* row) {
   kernel_calls.ao_rows.fetch_add(1, std::memory_order_relaxed);
   if (bake.columns) return uniform_row(bake, j, row);
   int i = 0;
@@ -278,5 +283,10 @@ void ao_map_row(const ao::Bake& bake, int j, float* row) {
   }
   for (; i < bake.map_width; ++i) row[i] = float(ao::texel_ao(bake, i, j));
 }
+
+}  // namespace
+
+void ao_map_row(const ao::Bake<double>& bake, int j, float* row) { row_of(bake, j, row); }
+void ao_map_row(const ao::Bake<float>& bake, int j, float* row) { row_of(bake, j, row); }
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -6,7 +6,8 @@
 
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
-// Texels 0 .. bake.map_width - 1 of row j into row.
-void ao_map_row(const ao::Bake& bake, int j, float* row);
+// Texels 0 .. bake.map_width - 1 of row j into row, from heights stored as double or as float.
+void ao_map_row(const ao::Bake<double>& bake, int j, float* row);
+void ao_map_row(const ao::Bake<float>& bake, int j, float* row);
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -44,7 +44,9 @@ public:
 
   MipExtremum mip_extremum() const override { return &qdmr::QDMR_ISA::mip_extremum; }
 
-  AoMapRow ao_map_row() const override { return &qdmr::QDMR_ISA::ao_map_row; }
+  AoMapRow ao_map_row() const override {
+    return {.f64 = &qdmr::QDMR_ISA::ao_map_row, .f32 = &qdmr::QDMR_ISA::ao_map_row};
+  }
 
   const HeightRows& height_rows() const override { return qdmr::QDMR_ISA::height_rows(); }
 

@@ -426,13 +426,11 @@ public:
         const std::string source_key =
             from_box_values ? "box|" + surface_key : plan_.derived[std::size_t(m.combined_surface)].key;
         if (c.combined_quadtree) {
-          // From the box values: the weights are its only input, and it keeps their fp64 field.
+          // From the box values: the weights are its only input (the tree and the AO map read the values as floats).
           std::vector<int> inputs{m.weights};
           if (!from_box_values) inputs.insert(inputs.begin(), m.combined_surface);
           m.combined_quadtree = add(DerivedKind::CombinedQuadtree, "quadtree|" + source_key, where + "/blend/quadtree",
-                                    std::move(inputs), index,
-                                    c.combined_bytes + (from_box_values ? texels * sizeof(double) : 0), -1, 0, -1,
-                                    heights_dynamic);
+                                    std::move(inputs), index, c.combined_bytes, -1, 0, -1, heights_dynamic);
         }
         if (c.blend_ao) {
           AoDesc ao = desc.ao;
@@ -442,7 +440,8 @@ public:
           m.blend_ao = add(DerivedKind::BlendAoMap, "ao|" + source_key + "|" + ao_key(ao, desc.technique.depth_scale),
                            where + "/ao", {from_box_values ? m.combined_quadtree : m.combined_surface}, index,
                            mip_chain_bytes(side.width, side.height, TexelFormat::R16), -1, side.width);
-          plan_.derived[std::size_t(m.blend_ao)].working_bytes = ao_bake_bytes(field_w, field_h, ao);
+          plan_.derived[std::size_t(m.blend_ao)].working_bytes =
+              ao_bake_bytes(field_w, field_h, ao, from_box_values ? int(sizeof(float)) : int(sizeof(double)));
           keep_ao_rows(plan_.derived[std::size_t(m.blend_ao)], ao, side);
         }
       }

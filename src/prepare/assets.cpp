@@ -103,7 +103,8 @@ HeightField height_field(const Texture& h, AddressMode address) {
 
 // An AO map from the bake cache, or baked every frame (and not kept) for a dynamic surface: amortized over K
 // frames, the rows j % K == frame % K of the previous frame's map (`last`, when it is that frame's), else all.
-Image ao_map(const HeightField& field, double depth_scale, const AoDesc& ao, bool dynamic, AoMapRow row, int frame,
+template <class T>
+Image ao_map(const HeightView<T>& field, double depth_scale, const AoDesc& ao, bool dynamic, AoMapRow row, int frame,
              const AoHistory* last, std::shared_ptr<const AoHistory>& history) {
   if (!dynamic) return load_or_bake_ao_map(field, depth_scale, ao, default_cache_dir(), row);
   if (ao.amortize_frames <= 1) return bake_ao_map(field, depth_scale, ao, row);
@@ -405,22 +406,28 @@ private:
           }
         }
         if (d.inputs.size() == 1) {
-          // The tree and the blend's AO map of the values the walk reads (the plan made no fp64 surface for them).
+          // The tree (and the blend's AO map) of the values the walk reads: the plan made no fp64 surface for them.
           if (!out.box_values) throw Error(d.where, "internal: the plan expected the blend's box values");
-          const int period = out.layer_heights->width * m.weights_scale;
-          out.field = std::make_shared<const HeightField>(box_value_field(*out.box_values, period));
+          out.texture = std::make_shared<const Texture>(combined_quadtree(
+              box_value_view(*out.box_values, out.layer_heights->width * m.weights_scale), kernel_.mip_extremum()));
+        } else {
+          out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field, kernel_.mip_extremum()));
         }
-        out.texture = std::make_shared<const Texture>(
-            combined_quadtree(out.field ? *out.field : *input(0).field, kernel_.mip_extremum()));
         break;
       }
       case DerivedKind::BlendAoMap: {
         AoDesc ao = desc.ao;
         ao.radius /= float(m.weights_scale);  // the field's UV spans `scale` repeats
         ao.resolution = d.side;
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, ao, d.dynamic, kernel_.ao_map_row(),
-                                 plan_.scene.frame, previous_.ao_history(index, d), out.ao_history),
-                          TexelFormat::R16, MipReduce::Box);
+        const DerivedAsset& surface = input(0);  // the combined quadtree with its box values, or the fp64 surface
+        const auto bake = [&](const auto& field) {
+          return mip(ao_map(field, desc.technique.depth_scale, ao, d.dynamic, kernel_.ao_map_row(), plan_.scene.frame,
+                            previous_.ao_history(index, d), out.ao_history),
+                     TexelFormat::R16, MipReduce::Box);
+        };
+        out.texture = surface.field ? bake(height_view(*surface.field))
+                                    : bake(box_value_view(*surface.box_values,
+                                                          surface.layer_heights->width * m.weights_scale));
         break;
       }
       case DerivedKind::TwinTexels:
@@ -433,7 +440,7 @@ private:
         break;
       case DerivedKind::LayerAoMap:
         // Each layer's AO baked from its stored heights (cached by content); blended like the colours when shading.
-        out.texture = mip(ao_map(*input(0).field, desc.technique.depth_scale, desc.ao, d.dynamic, kernel_.ao_map_row(),
+        out.texture = mip(ao_map(height_view(*input(0).field), desc.technique.depth_scale, desc.ao, d.dynamic, kernel_.ao_map_row(),
                                  plan_.scene.frame, previous_.ao_history(index, d), out.ao_history),
                           TexelFormat::R16, MipReduce::Box);
         break;

@@ -1,6 +1,6 @@
 #include "texture/blend_box_values.hpp"
 
-#include <tbb/parallel_for.h>
+#include <string>
 
 #include "qdmr/core/error.hpp"
 
@@ -19,17 +19,10 @@ std::size_t blend_box_value_count(const BlendBoxSource& source) {
                      sizeof(float));
 }
 
-HeightField box_value_field(const ZeroedBuffer<float>& values, int period) {
+HeightView<float> box_value_view(const ZeroedBuffer<float>& values, int period) {
   if (period <= 0 || values.size() != std::size_t(period) * std::size_t(period))
     throw Error("box values", "the values do not fill a period of " + std::to_string(period) + " squared");
-  HeightField field;
-  field.width = field.height = period;
-  field.h = ZeroedBuffer<double>(values.size());  // zero pages, committed by the rows' threads
-  tbb::parallel_for(0, period, [&](int y) {
-    const std::size_t row = std::size_t(y) * std::size_t(period);
-    for (std::size_t x = row; x < row + std::size_t(period); ++x) field.h[x] = values[x];
-  });
-  return field;
+  return {period, period, AddressMode::Wrap, values.data()};
 }
 
 }  // namespace qdmr

@@ -10,7 +10,7 @@
 
 #include "qdmr/core/zeroed_buffer.hpp"
 #include "qdmr/scene/scene.hpp"
-#include "qdmr/texture/heightfield.hpp"
+#include "texture/height_view.hpp"
 #include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"
 
@@ -33,8 +33,9 @@ struct BlendBoxSource {
 // or 0 where blend_box_values_bytes() is 0. A draw kernel computes them (Kernel::blend_box_values, src/kernel/).
 std::size_t blend_box_value_count(const BlendBoxSource& source);
 
-// The values of a period x period blend (blend_box_value_count's layout) as an fp64 height field that wraps: the
-// surface the walk intersects, from which the combined quadtree and the blend's baked AO map are made.
-HeightField box_value_field(const ZeroedBuffer<float>& values, int period);
+// The values of a period x period blend (blend_box_value_count's layout) as a height field that wraps: the surface
+// the walk intersects, from which the combined quadtree and the blend's baked AO map are made. Throws when the
+// values do not fill the period.
+HeightView<float> box_value_view(const ZeroedBuffer<float>& values, int period);
 
 }  // namespace qdmr

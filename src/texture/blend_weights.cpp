@@ -257,9 +257,12 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
   return field;
 }
 
-Texture combined_quadtree(const HeightField& surface, MipExtremum extremum) {
+template <class T>
+Texture combined_quadtree(const HeightView<T>& surface, MipExtremum extremum) {
   Image level1(surface.width / 2, surface.height / 2, 1);
-  const auto at = [&](int x, int y) { return surface.h[std::size_t(y) * std::size_t(surface.width) + std::size_t(x)]; };
+  const auto at = [&](int x, int y) {
+    return double(surface.h[std::size_t(y) * std::size_t(surface.width) + std::size_t(x)]);
+  };
   tbb::parallel_for(0, level1.height, [&](int y) {
     for (int x = 0; x < level1.width; ++x) {
       const double top = std::max(std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)),
@@ -271,5 +274,8 @@ Texture combined_quadtree(const HeightField& surface, MipExtremum extremum) {
   });
   return make_mip_texture(level1, TexelFormat::R16, false, MipReduce::Max, extremum);
 }
+
+template Texture combined_quadtree(const HeightView<double>&, MipExtremum);
+template Texture combined_quadtree(const HeightView<float>&, MipExtremum);
 
 }  // namespace qdmr

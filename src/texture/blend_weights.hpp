@@ -11,6 +11,7 @@
 #include "qdmr/texture/image.hpp"
 #include "qdmr/texture/heightfield.hpp"
 #include "qdmr/texture/mip_texture.hpp"
+#include "texture/height_view.hpp"
 
 namespace qdmr {
 
@@ -43,7 +44,12 @@ HeightField combined_surface(const std::vector<const Texture*>& heights, const T
 
 // The precomputed combined quadtree of such a surface (WeightTexture::combined): level k = the maxima over cells
 // of level k + 1, R16 rounded up (conservative for the fp32 box values the shader computes); levels 2.. reduced by
-// `extremum` (make_mip_texture).
-Texture combined_quadtree(const HeightField& surface, MipExtremum extremum = nullptr);
+// `extremum` (make_mip_texture). From an fp64 surface, or from the fp32 box values the walk reads (the same tree as
+// from their fp64 copy).
+template <class T>
+Texture combined_quadtree(const HeightView<T>& surface, MipExtremum extremum = nullptr);
+inline Texture combined_quadtree(const HeightField& surface, MipExtremum extremum = nullptr) {
+  return combined_quadtree(height_view(surface), extremum);
+}
 
 }  // namespace qdmr

@@ -416,6 +416,17 @@ TEST(HeightBlend, BoxValuesAreTheLevelZeroValuesAWalkComputes) {
       ASSERT_EQ(std::memcmp(again.data(), values.data(), values.size() * sizeof(float)), 0) << isa_name(isa);
     }
     const Texture tree = combined_quadtree(combined_surface(box_pointers, weights, repeats, op));
+    {
+      // Preparation makes a blend's tree from these values as floats (no fp64 copy): the same tree as from the copy.
+      HeightField copy;
+      copy.width = copy.height = period;
+      copy.h.assign(values.begin(), values.end());
+      const Texture from_copy = combined_quadtree(copy);
+      const Texture from_floats = combined_quadtree(HeightView<float>{period, period, AddressMode::Wrap, values.data()});
+      ASSERT_EQ(from_floats.level_count(), from_copy.level_count());
+      for (int k = 0; k < from_copy.level_count(); ++k)
+        ASSERT_EQ(from_floats.level_image(k).texels, from_copy.level_image(k).texels) << "level " << k;
+    }
     const TextureSampler tree_view(tree, sampler);
     const WeightTexture chains_only{&weight_view, float(repeats), &tree_view, period, period};
     const WeightTexture with_heights{&weight_view, float(repeats), &tree_view, period, period, &interleaved};

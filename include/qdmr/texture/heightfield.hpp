@@ -65,8 +65,10 @@ enum class ReferenceSurface {
 // - Bilinear: the bilinear interpolation of the four texel centres around (u, v).
 double surface_depth(const HeightField& field, double depth_scale, double u, double v, ReferenceSurface surface);
 
-// surface_depth(field, depth_scale, u, v, ReferenceSurface::Bilinear), inline for the bakes' inner loops.
-inline double bilinear_surface_depth(const HeightField& field, double depth_scale, double u, double v) {
+// surface_depth(field, depth_scale, u, v, ReferenceSurface::Bilinear), inline for the bakes' inner loops; for any
+// field with HeightField's width, height and at() (the AO bake's views of float heights too: the same operations).
+template <class Field>
+double bilinear_surface_depth(const Field& field, double depth_scale, double u, double v) {
   const double x = u * field.width - 0.5, y = v * field.height - 0.5;
   const double fi = std::floor(x), fj = std::floor(y);
   const double fx = x - fi, fy = y - fj;
