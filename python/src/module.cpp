@@ -455,9 +455,16 @@ py::array read_image_arg(py::handle path_value) {
   return py::array(py::dtype::of<float>(), {h, w, c}, {-w * c * f, c * f, f}, top, base);
 }
 
-void write_image_arg(py::handle image, py::handle path_value, py::handle srgb_value) {
+void write_image_arg(py::handle image, py::handle path_value, py::handle srgb_value, py::handle threads) {
   const char* fn = "write_image";
   const std::string path = path_arg(path_value, fn, "path");
+  WriteOptions write;
+  if (!threads.is_none()) {
+    write.threads = int_arg(threads, fn, "threads");
+    if (write.threads < 1 || write.threads > limits::kMaxThreads)
+      throw BadValue("write_image(): threads must be from 1 to " + std::to_string(limits::kMaxThreads) +
+                     " (or None for every core), got " + std::to_string(write.threads));
+  }
   using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
   if (!py::isinstance<py::array>(image) && !PyList_Check(image.ptr()))
     type_error(fn, "image", "a numpy array of shape (H, W) or (H, W, C)", image);
@@ -477,7 +484,7 @@ void write_image_arg(py::handle image, py::handle path_value, py::handle srgb_va
   const std::span<const float> values(pixels.data(), pixels.size());
   py::gil_scoped_release release;
   try {
-    write_image(path, width, height, channels, values, srgb);
+    write_image(path, width, height, channels, values, srgb, write);
   } catch (const Error& e) {
     throw InputFailure(e.what());
   }
@@ -601,10 +608,13 @@ PYBIND11_MODULE(_qdmr, m) {
         "read_image(path) -> numpy.ndarray\n\nAn image file as float32 (H, W) or (H, W, C), row 0 at the top; PNG and\n"
         "TIFF codes normalised to [0, 1], EXR floats as stored. Raises InputError naming the file.");
   m.def("write_image", &write_image_arg, py::arg("image"), py::arg("path"), py::kw_only(), py::arg("srgb") = py::none(),
-        "write_image(image, path, *, srgb=None)\n\nWrites float (H, W) or (H, W, C) pixels (C from 1 to 4, row 0 at the\n"
+        py::arg("threads") = py::none(),
+        "write_image(image, path, *, srgb=None, threads=None)\n\nWrites float (H, W) or (H, W, C) pixels (C from 1 to 4, row 0 at the\n"
         "top) with qdmr's writers, through a temporary file and a rename: EXR as 32-bit floats, PNG 8-bit and TIFF\n"
         "16-bit codes, sRGB-encoded when srgb (default: for 3 channels, as a frame's colour). A frame's colour\n"
-        "written to .exr gives the same bytes as `qdmr render -o x.exr`. Raises InputError naming the file.");
+        "written to .exr gives the same bytes as `qdmr render -o x.exr`. threads: at most that many threads\n"
+        "encode and compress (1: the calling thread alone), None for every core; the same bytes on any count.\n"
+        "Raises InputError naming the file.");
 
   bind_studies(m);
 }

@@ -9,6 +9,8 @@
 #include <tuple>
 
 #include <nlohmann/json.hpp>
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
 
 #include "check/diff_folder.hpp"
 #include "file/atomic_file.hpp"
@@ -307,8 +309,9 @@ CheckRun run_checks(const Manifest& manifest, const CheckOptions& options) {
   std::atomic<std::size_t> next{0};
   std::mutex done_mutex;
   std::size_t done = 0;
-  const auto work = [&] {
-    CheckJob job(manifest, options, jobs == 1 && options.threads == 0 ? 0 : threads);
+  const int job_threads = jobs == 1 && options.threads == 0 ? 0 : threads;
+  const auto checks = [&] {
+    CheckJob job(manifest, options, job_threads);
     for (std::size_t k; !stop_requested() && (k = next.fetch_add(1)) < total;) {
       const std::size_t index = order[k];
       std::map<std::string, std::string> hashes;
@@ -318,6 +321,11 @@ CheckRun run_checks(const Manifest& manifest, const CheckOptions& options) {
       run.results[index] = std::move(result);
       if (options.on_result) options.on_result(run.results[index], ++done, total);
     }
+  };
+  // A job's writes (goldens, diff folders) on its threads too: qdmr's writers use the arena they run in.
+  const auto work = [&] {
+    if (job_threads == 0) return checks();
+    tbb::task_arena(std::min(job_threads, tbb::info::default_concurrency())).execute(checks);
   };
   if (jobs == 1) {
     work();

@@ -127,7 +127,7 @@ int run_bench(const BenchArgs& args) {
   const double frames_wall_ms = ms_since(wall);
 
   start = Clock::now();
-  write_frame(renderer.frame(), image);
+  write_frame(renderer.frame(), image, {.threads = options.threads});
   const double write_ms = ms_since(start);
   if (args.image.empty()) std::filesystem::remove(image);
 

@@ -229,7 +229,8 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
     // Every output of the frame written to a temporary first, then all renamed: all of them or none.
     qdmr::OutputBatch batch;
     start = Clock::now();
-    const qdmr::WriteOptions write{.timestamp = render.timestamp, .smallest_png = render.smallest_png};
+    const qdmr::WriteOptions write{
+        .timestamp = render.timestamp, .smallest_png = render.smallest_png, .threads = options.threads};
     const int at = n;
     qdmr::write_frame(frame, outputs[0].at(at), write);
     for (std::size_t a = 0; a < aov_kinds.size(); ++a) qdmr::write_aov(frame, aov_kinds[a], outputs[1 + a].at(at), write);

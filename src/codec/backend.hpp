@@ -31,6 +31,7 @@ struct WriteSpec {
   std::vector<std::string> channel_names;  // empty: the defaults (R, G, B, A)
   std::vector<std::pair<std::string, std::string>> strings;  // metadata
   std::vector<std::pair<std::string, int>> ints;
+  int threads = 0;  // at most this many threads compress the file (0: the writer's default, one per core)
 };
 
 struct Reader;  // an open file (the backend's)

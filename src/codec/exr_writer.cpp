@@ -6,6 +6,7 @@
 #include <ImfIO.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <IlmThreadPool.h>
 #include <ImfThreading.h>
 #include <fcntl.h>
 #include <unistd.h>
@@ -15,6 +16,8 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -69,16 +72,61 @@ std::vector<std::string> channel_names(const imageio::WriteSpec& spec) {
   return {kNames, kNames + spec.channels};
 }
 
-// OpenEXR compresses a file's chunks on its global thread pool, which the OpenImageIO backend sized to the cores
-// (pvt::set_exr_threads): the same here, once, unless the process has set a pool size of its own.
-void size_exr_threads() {
+// OpenEXR compresses a file's chunks as tasks on its global thread pool. The provider below, installed on that pool
+// once, runs the tasks of a write that may use k threads (ExrWriteThreads, set around the write on the calling
+// thread) on a pool of its own with k threads, and k = 1 in the calling thread itself (an OpenEXR pool of no
+// threads); every other task (OpenImageIO's reads and writes outside such a scope) goes to a shared pool of the
+// size the process set, or of one thread per core as the OpenImageIO backend sets it (pvt::set_exr_threads).
+// OpenEXR forwards setGlobalThreadCount to the provider, which sizes the shared pool.
+thread_local int t_write_threads = 0;  // 0: no ExrWriteThreads scope on this thread
+
+class ExrPools final : public IlmThread::ThreadPoolProvider {
+public:
+  explicit ExrPools(int shared) : shared_(unsigned(shared)) {}
+  int numThreads() const override { return shared_.numThreads(); }
+  void setNumThreads(int count) override { shared_.setNumThreads(count); }
+  void addTask(IlmThread::Task* task) override {
+    const int k = t_write_threads;
+    if (k == 0) return shared_.addTask(task);
+    IlmThread::ThreadPool* pool = nullptr;
+    {
+      const std::lock_guard lock(mutex_);
+      std::unique_ptr<IlmThread::ThreadPool>& p = by_threads_[k];
+      if (!p) p = std::make_unique<IlmThread::ThreadPool>(unsigned(k == 1 ? 0 : k));
+      pool = p.get();
+    }
+    pool->addTask(task);
+  }
+  // Called as OpenEXR replaces or destroys the provider: each pool's destructor runs its queued tasks and joins.
+  void finish() override {
+    const std::lock_guard lock(mutex_);
+    by_threads_.clear();
+    shared_.setNumThreads(0);
+  }
+
+private:
+  IlmThread::ThreadPool shared_;
+  std::mutex mutex_;
+  std::map<int, std::unique_ptr<IlmThread::ThreadPool>> by_threads_;
+};
+
+void install_exr_pools() {
   static std::once_flag once;
   std::call_once(once, [] {
-    if (Imf::globalThreadCount() == 0) Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+    const int set = Imf::globalThreadCount();
+    IlmThread::ThreadPool::globalThreadPool().setThreadProvider(
+        new ExrPools(set > 0 ? set : int(std::max(1u, std::thread::hardware_concurrency()))));
   });
 }
 
 }  // namespace
+
+ExrWriteThreads::ExrWriteThreads(int threads) : previous_(t_write_threads) {
+  install_exr_pools();
+  t_write_threads = std::max(1, threads > 0 ? threads : int(std::thread::hardware_concurrency()));
+}
+
+ExrWriteThreads::~ExrWriteThreads() { t_write_threads = previous_; }
 
 bool exr_writes(const imageio::WriteSpec& spec) {
   if (spec.type != imageio::PixelType::Float || spec.width < 1 || spec.height < 1 || spec.channels < 1 ||
@@ -100,7 +148,7 @@ bool exr_writes(const imageio::WriteSpec& spec) {
 }
 
 bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const void* data, std::string& error) {
-  size_exr_threads();
+  const ExrWriteThreads threads(spec.threads);
   CheckedStream stream(path);
   if (stream.failure() != 0) {
     error = std::strerror(stream.failure());
@@ -117,7 +165,7 @@ bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const vo
     char* base = static_cast<char*>(const_cast<void*>(data));
     for (std::size_t c = 0; c < names.size(); ++c)
       frame.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), pixel, pixel * std::size_t(spec.width)));
-    Imf::OutputFile file(stream, header);
+    Imf::OutputFile file(stream, header, t_write_threads);  // 2 x that many chunks in flight
     file.setFrameBuffer(frame);
     file.writePixels(spec.height);
   } catch (const std::exception& e) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include <tbb/task_arena.h>
+
 #include "codec/exr_writer.hpp"
 #include "codec/png_writer.hpp"
 #include "file/atomic_file.hpp"
@@ -15,6 +17,8 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
   // when the spec has no DateTime; an empty DateTime is written as an empty string instead. A caller that wants a
   // time in the file sets DateTime itself (write_frame's WriteOptions::timestamp).
   imageio::WriteSpec stamped = spec;
+  // The caller's task arena gives the threads: PNG's bands run on it, OpenEXR and OpenImageIO get its size.
+  stamped.threads = tbb::this_task_arena::max_concurrency();
   if (std::none_of(spec.strings.begin(), spec.strings.end(), [](const auto& s) { return s.first == "DateTime"; }))
     stamped.strings.emplace_back("DateTime", "");
   std::string extension = file.extension().string();
@@ -35,6 +39,7 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
   }
   const imageio::Backend& backend = imageio::backend();  // loaded before the temporary exists
   write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
+    const ExrWriteThreads threads(stamped.threads);  // an EXR that write_exr leaves to OpenImageIO
     std::string error;
     return backend.write(temporary.string(), stamped, data, error) ? "" : error;
   });

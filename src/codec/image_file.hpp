@@ -9,7 +9,9 @@
 namespace qdmr {
 
 // Writes no wall-clock time unless `spec` carries a DateTime attribute (see image_file.cpp). `data` holds
-// spec.width x spec.height pixels of spec.channels values of spec.type, top row first.
+// spec.width x spec.height pixels of spec.channels values of spec.type, top row first. The write uses the threads
+// of the caller's task arena (tbb::this_task_arena::max_concurrency(); spec.threads is replaced by it): PNG's
+// bands run on the arena, OpenEXR and OpenImageIO compress on that many threads, 1 being the calling thread alone.
 void write_image_file(const std::filesystem::path& file, const imageio::WriteSpec& spec, const void* data,
                       const std::string& what);
 

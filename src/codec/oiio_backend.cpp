@@ -223,6 +223,7 @@ bool write(const std::string& path, const WriteSpec& spec, const void* data, std
     checked = std::make_unique<CheckedFileOutput>(path);
     if (!output->set_ioproxy(checked.get())) checked.reset();
   }
+  if (spec.threads > 0) output->threads(spec.threads);  // TIFF's strips compressed on OpenImageIO's threads
   const bool written = output->open(path, s) && output->write_image(type_desc(spec.type), data) && output->close();
   if (checked) checked->close();
   if (checked && checked->failure() != 0) {  // the OS's reason first: OpenEXR's own message does not say why

@@ -103,7 +103,7 @@ private:
 class Measurer {
 public:
   Measurer(const StudySpec& spec, const SceneSource& source, int threads)
-      : spec_(spec), source_(source), timing_(with_threads(threads)),
+      : spec_(spec), source_(source), write_{.threads = threads}, timing_(with_threads(threads)),
         measuring_(with_threads(threads, std::make_shared<ReferenceMemo>())), baseline_renderer_(with_threads(threads)) {}
 
   // The colour of the baseline configuration for `config`: its values with the spec's baseline values put in
@@ -169,7 +169,7 @@ public:
       det["diff_max"] = std::isfinite(c.max_abs) ? nlohmann::json(c.max_abs) : nlohmann::json("inf");
       det["diff_pixels"] = c.pixels_over;
     }
-    if (keeps("image")) write_frame(frame, images / (std::to_string(config.index) + ".png"));
+    if (keeps("image")) write_frame(frame, images / (std::to_string(config.index) + ".png"), write_);
     if (spec_.wants(StudyMetric::Time)) {
       std::vector<double> sorted = draws;
       std::sort(sorted.begin(), sorted.end());
@@ -200,7 +200,7 @@ private:
   void write_reference(const StudyConfig& config, SceneDesc scene, const std::filesystem::path& images) {
     for (MaterialDesc& material : scene.materials) material.technique.exact_hits = true;
     measuring_.set_scene(scene, {});
-    write_frame(measuring_.draw(), images / (std::to_string(config.index) + ".reference.png"));
+    write_frame(measuring_.draw(), images / (std::to_string(config.index) + ".reference.png"), write_);
   }
 
   // One untimed frame for what is not time: the error AOVs, the kept AOVs and the texture cache.
@@ -213,7 +213,8 @@ private:
     scene.texture_cache.enabled = cache;
     measuring_.set_scene(scene, aovs);
     const Frame& frame = measuring_.draw();
-    for (Aov a : keep_aovs()) write_aov(frame, a, images / (std::to_string(config.index) + "." + aov_name(a) + ".exr"));
+    for (Aov a : keep_aovs())
+      write_aov(frame, a, images / (std::to_string(config.index) + "." + aov_name(a) + ".exr"), write_);
     if (cache) {
       const TextureCacheStats& c = frame.stats.texture_cache;
       det["cache_accesses_per_pixel"] = c.accesses_per_pixel;
@@ -255,6 +256,7 @@ private:
 
   const StudySpec& spec_;
   const SceneSource& source_;
+  WriteOptions write_;  // the kept images written on the configuration's threads, as it is drawn
   Renderer timing_, measuring_, baseline_renderer_;
   std::size_t asset_builds_ = 0;
   std::map<std::string, Image> baselines_;

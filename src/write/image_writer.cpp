@@ -6,7 +6,9 @@
 #include <span>
 #include <vector>
 
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <nlohmann/json.hpp>
 
@@ -137,6 +139,15 @@ AovPixels aov_pixels(const Frame& frame, Aov aov, Container container, const std
 
 void write_image(const std::filesystem::path& file, int width, int height, int channels, std::span<const float> pixels,
                  bool srgb, const WriteOptions& write) {
+  if (write.threads > 0 && write.threads != tbb::this_task_arena::max_concurrency()) {
+    // The encoding and the writer (write_image_file) run in an arena of that many threads. More threads than cores
+    // gain nothing here; oneTBB would not give them to an arena anyway.
+    tbb::task_arena arena(std::min(write.threads, tbb::info::default_concurrency()));
+    WriteOptions inside = write;
+    inside.threads = 0;
+    arena.execute([&] { write_image(file, width, height, channels, pixels, srgb, inside); });
+    return;
+  }
   const Container container = container_of(file);
   const Encoded encoded = encode(container, pixels, srgb);
   imageio::WriteSpec spec{width, height, channels, encoded.format, {}, {}, {}};

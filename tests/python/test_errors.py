@@ -93,6 +93,7 @@ def test_argument_types_name_the_parameter(tmp_path):
         (lambda: qdmr.write_image("pixels", tmp_path / "x.exr"), "image"),
         (lambda: qdmr.write_image(numpy.zeros((2, 2), numpy.float32), 7), "path"),
         (lambda: qdmr.write_image(numpy.zeros((2, 2), numpy.float32), tmp_path / "x.exr", srgb=1), "srgb"),
+        (lambda: qdmr.write_image(numpy.zeros((2, 2), numpy.float32), tmp_path / "x.exr", threads="1"), "threads"),
         (lambda: qdmr.study.run(SPEC, 5), "out"),
         (lambda: qdmr.study.run(3, tmp_path / "s"), "spec"),
         (lambda: qdmr.study.run(SPEC, tmp_path / "s", resume="yes"), "resume"),
@@ -118,6 +119,8 @@ def test_bad_values():
         renderer.draw()
     with pytest.raises(ValueError, match="shape"):
         qdmr.write_image(numpy.zeros((2, 2, 7), numpy.float32), "x.exr")
+    with pytest.raises(ValueError, match="threads"):
+        qdmr.write_image(numpy.zeros((2, 2), numpy.float32), "x.exr", threads=0)
 
 
 def test_memory_limit_refuses_before_building():

@@ -37,6 +37,8 @@ def test_pixels_equal_the_commands_exr_bit_for_bit(cli, tmp_path):
     # qdmr's own writer: the same bytes as the command's file.
     qdmr.write_image(frame.color, tmp_path / "again.exr")
     assert (tmp_path / "again.exr").read_bytes() == color.read_bytes()
+    qdmr.write_image(frame.color, tmp_path / "one.exr", threads=1)  # on the calling thread alone: the same bytes
+    assert (tmp_path / "one.exr").read_bytes() == color.read_bytes()
     assert not [p for p in os.listdir(tmp_path) if ".tmp" in p]  # no temporary left behind
 
 

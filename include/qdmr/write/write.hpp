@@ -22,6 +22,10 @@ struct WriteOptions {
   // PNG pixel data compressed as small as libdeflate can (its level 12: 10-25 % smaller, seconds for a 1080p
   // frame) instead of as fast as ISA-L's igzip can (its level 1: about 15 ms). The same pixels either way.
   bool smallest_png = false;
+  // At most this many threads encode and compress the file (1: the calling thread alone), as RenderOptions::threads
+  // bounds a draw; 0: the caller's task arena (every core, or the renderer's threads inside its arena). The same
+  // bytes on any count.
+  int threads = 0;
 };
 
 // Writes the colour image (PNG: 8-bit sRGB, TIFF: 16-bit sRGB, EXR: 32-bit float linear), with the metadata
