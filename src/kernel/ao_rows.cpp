@@ -223,7 +223,9 @@ void uniform_row(const ao::Bake<T>& b, int j, float* row) {
       tap_rows[std::size_t(d * taps + k)] = p.level[std::size_t(level)] + std::size_t(cy * p.width[std::size_t(level)]);
     }
   }
-  alignas(64) std::array<double, kChunk> s{}, rise{}, slope{}, visible{};
+  // Past m: lanes of earlier chunks or zeros, computed and never stored.
+  alignas(64) std::array<double, kChunk> s{}, rise{}, slope{}, visible{}, cell{};
+  const Double depth_scale(ds), one(1.0);
   for (int i0 = 0; i0 < b.map_width; i0 += kChunk) {
     const int m = std::min(kChunk, b.map_width - i0);
     const std::int32_t* left = c.left.data() + i0;
@@ -243,25 +245,29 @@ void uniform_row(const ao::Bake<T>& b, int j, float* row) {
       for (int k = 0; k < taps; ++k, scale *= 0.5) {
         const T* cells = tap_rows[std::size_t(d * taps + k)];
         const std::int32_t* column = c.cell.data() + (std::size_t(d) * std::size_t(taps) + std::size_t(k)) * std::size_t(b.map_width) + std::size_t(i0);
-        for (int i = 0; i < m; ++i) {
-          const double t = (s[std::size_t(i)] - ds * (1.0 - double(cells[column[i]]))) * scale;
-          rise[std::size_t(i)] = rise[std::size_t(i)] < t ? t : rise[std::size_t(i)];  // std::max
+        for (int i = 0; i < m; ++i) cell[std::size_t(i)] = double(cells[column[i]]);  // the taps' cell maxima
+        const Double tap_scale(scale);
+        for (int i = 0; i < m; i += kWidth) {
+          const Double t = (Double::load_aligned(&s[std::size_t(i)]) -
+                            depth_scale * (one - Double::load_aligned(&cell[std::size_t(i)]))) * tap_scale;
+          std_max(Double::load_aligned(&rise[std::size_t(i)]), t).store_aligned(&rise[std::size_t(i)]);
         }
       }
       // coarse_slope: one division, or tap by tap where the largest scaled rise is tiny.
-      bool by_tap = false;
-      for (int i = 0; i < m; ++i) {
-        slope[std::size_t(i)] = rise[std::size_t(i)] / first;
-        by_tap |= !(rise[std::size_t(i)] == 0.0 || rise[std::size_t(i)] >= ao::kSmallestScaledRise);
+      DoubleMask tiny(false);
+      for (int i = 0; i < m; i += kWidth) {
+        const Double r = Double::load_aligned(&rise[std::size_t(i)]);
+        (r / Double(first)).store_aligned(&slope[std::size_t(i)]);
+        tiny = tiny | !((r == Double(0.0)) | (r >= Double(ao::kSmallestScaledRise)));
       }
-      if (by_tap)
+      if (xsimd::any(tiny))  // also for lanes past m: those are then looked at and left alone
         for (int i = 0; i < m; ++i)
           if (!(rise[std::size_t(i)] == 0.0 || rise[std::size_t(i)] >= ao::kSmallestScaledRise))
             slope[std::size_t(i)] = ao::coarse_slope_by_tap(b, s[std::size_t(i)], ao::texel_u(b, i0 + i), v,
                                                             dxs[std::size_t(d)], dys[std::size_t(d)]);
-      for (int i = 0; i < m; i += kWidth) {  // past m: lanes of earlier chunks or zeros, not stored
+      for (int i = 0; i < m; i += kWidth) {
         const Double sl = Double::load_aligned(&slope[std::size_t(i)]);
-        (Double::load_aligned(&visible[std::size_t(i)]) + (Double(1.0) - sl / xsimd::sqrt(Double(1.0) + sl * sl)))
+        (Double::load_aligned(&visible[std::size_t(i)]) + (one - sl / xsimd::sqrt(one + sl * sl)))
             .store_aligned(&visible[std::size_t(i)]);
       }
     }
