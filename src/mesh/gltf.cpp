@@ -33,6 +33,7 @@
 #include "mesh/builders.hpp"
 #include "mesh/gltf_files.hpp"
 #include "mesh/mikktspace.hpp"
+#include "mesh/to_frame.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "qdmr/bake/cone_map.hpp"
 #include "qdmr/core/error.hpp"
@@ -868,20 +869,9 @@ private:
       }
     }
     // Into qdmr's frame, each vertex alone (the same bits in any order).
-    const glm::dmat3 linear(world);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(base, mesh_.positions.size(), 16384), [&](const auto& range) {
-      for (std::size_t v = range.begin(); v != range.end(); ++v) {
-        mesh_.positions[v] = glm::vec3(world * glm::dvec4(glm::dvec3(mesh_.positions[v]), 1.0));
-        const glm::dvec3 n = normal_matrix * glm::dvec3(mesh_.normals[v]);
-        const double len = glm::length(n);
-        mesh_.normals[v] = len > 0.0 && std::isfinite(len) ? glm::vec3(n / len) : glm::vec3(0, 0, 1);
-        const glm::vec4 t = mesh_.tangents[v];
-        const glm::dvec3 tw = linear * glm::dvec3(t);
-        const double tl = glm::length(tw);
-        const float w = (t.w < 0.0f) != mirrored ? -1.0f : 1.0f;
-        mesh_.tangents[v] = glm::vec4(tl > 0.0 && std::isfinite(tl) ? glm::vec3(tw / tl) : any_orthogonal(mesh_.normals[v]), w);
-      }
-    });
+    const std::size_t moved = mesh_.positions.size() - base;
+    to_frame({mesh_.positions.data() + base, moved}, {mesh_.normals.data() + base, moved},
+             {mesh_.tangents.data() + base, moved}, world, normal_matrix, mirrored);
     if (base > 0)
       for (std::size_t i = first; i < mesh_.indices.size(); ++i) mesh_.indices[i] += std::uint32_t(base);
     mesh_.triangle_materials.resize(mesh_.triangle_materials.size() + in.triangles, material);

@@ -183,10 +183,12 @@ struct CornerBatch {
       const Floats a = xsimd::abs(x);
       return (a > Floats(std::numeric_limits<float>::min())) & (a <= Floats(std::numeric_limits<float>::max()));
     };
-    // unit_or_zero, in place.
+    // unit_or_zero, in place. Where every lane's length is exactly 1 (axis-aligned normals, and many that are
+    // already normalised) the divisions are skipped: x / 1 is x, every bit (-0, subnormals).
     const auto unit = [&](V& x, V& y, V& z) {
       const V len = each([](const Floats& d) { return xsimd::sqrt(d); }, dot(x, y, z, x, y, z));
       for (std::size_t g = 0; g < len.size(); ++g) {
+        if (xsimd::all(len[g] == Floats(1.0f))) continue;
         const auto ok = usable(len[g]);
         x[g] = xsimd::select(ok, x[g] / len[g], Floats(0.0f));
         y[g] = xsimd::select(ok, y[g] / len[g], Floats(0.0f));

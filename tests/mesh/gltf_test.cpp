@@ -6,14 +6,18 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <random>
 #include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <nlohmann/json.hpp>
 
 #include "mesh/builders.hpp"
 #include "qdmr/bake/bake_cache.hpp"
 #include "mesh/gltf_files.hpp"
+#include "mesh/to_frame.hpp"
 #include "qdmr/core/error.hpp"
 #include "support/test_support.hpp"
 
@@ -204,6 +208,18 @@ TEST(Gltf, TextureTransformSamplerAndFactors) {
   EXPECT_TRUE(has_note(metal, "emission not drawn"));
 }
 
+// Read but not drawn, each a plan warning: animations (drawn at rest) and an extension used but not required.
+TEST(Gltf, AnimationsAndUnusedExtensionsAreWarnings) {
+  using J = nlohmann::json;
+  const MeshData m = edited([](J& d) {
+    d["animations"] = J::array({{{"channels", J::array()}, {"samplers", J::array()}}});
+    d["extensionsUsed"] = {"EXT_lights_image_based"};
+  });
+  EXPECT_TRUE(has_note(m, "1 animation ignored (drawn at rest)"));
+  EXPECT_TRUE(has_note(m, "extension EXT_lights_image_based ignored"));
+  EXPECT_FALSE(has_note(edited([](J&) {}), "ignored"));  // the quad as it is: no such warning
+}
+
 // Over a base colour texture, baseColorFactor x (1 - metallic) multiplies the texture's linear colour (the
 // texture build applies it: TextureImage.AlbedoFactorMultipliesTheLinearColour), and nothing is left unapplied.
 TEST(Gltf, BaseColorFactorTintsTheTexture) {
@@ -361,6 +377,52 @@ TEST(Gltf, UrisStayInTheFolder) {
   for (const char* bad : {"../a.png", "a/../../b.png", "/abs.png", "http://x/y.png", "C:/x.png", "a\\b.png", "%00.png",
                           "%2", "", "ftp:x"})
     EXPECT_THROW(mesh_detail::relative_uri(bad, "w"), Error) << bad;
+}
+
+// The frame move of add_smooth in SSE2's double lanes (to_frame) has the bits of glm's scalar code (to_frame_one,
+// add_smooth's former loop) on every vertex: random matrices (rotations, mirrors, uneven scales, translations, the
+// quarter turn every asset takes), random vertices with zero, -0 and tiny normals and tangents (the fallbacks), odd
+// and even counts and offsets, and counts that split over threads.
+TEST(Gltf, TheFrameMoveHasTheBitsOfGlm) {
+  std::mt19937 random(55);
+  const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };
+  const auto component = [&]() -> float {
+    switch (random() % 8) {
+      case 0: return 0.0f;
+      case 1: return -0.0f;
+      case 2: return float(uniform(-1e-30, 1e-30));  // squares underflow in float, not in double
+      default: return float(uniform(-3.0, 3.0));
+    }
+  };
+  const glm::dmat4 quarter_turn(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);  // (x, y, z) -> (x, -z, y)
+  for (int round = 0; round < 60; ++round) {
+    glm::dmat4 world = quarter_turn;
+    if (round % 3 != 0) {
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 3; ++r) world[c][r] = uniform(-2.0, 2.0);
+      if (round % 5 == 0) world[0] *= -1.0;  // mirrored
+    }
+    const glm::dmat3 linear(world);
+    const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+    const bool mirrored = glm::determinant(linear) < 0.0;
+    const std::size_t count = round == 59 ? 70001 : random() % 40, offset = random() % 3;
+    std::vector<glm::vec3> positions(offset + count), normals(offset + count);
+    std::vector<glm::vec4> tangents(offset + count);
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      positions[v] = glm::vec3(float(uniform(-100.0, 100.0)), component(), float(uniform(-1.0, 1.0)));
+      normals[v] = glm::vec3(component(), component(), component());
+      tangents[v] = glm::vec4(component(), component(), component(), random() % 2 ? 1.0f : -1.0f);
+    }
+    std::vector<glm::vec3> want_p = positions, want_n = normals;
+    std::vector<glm::vec4> want_t = tangents;
+    for (std::size_t v = offset; v < positions.size(); ++v)
+      mesh_detail::to_frame_one(want_p[v], want_n[v], want_t[v], world, normal_matrix, mirrored);
+    mesh_detail::to_frame({positions.data() + offset, count}, {normals.data() + offset, count},
+                          {tangents.data() + offset, count}, world, normal_matrix, mirrored);
+    ASSERT_EQ(std::memcmp(positions.data(), want_p.data(), positions.size() * sizeof positions[0]), 0) << round;
+    ASSERT_EQ(std::memcmp(normals.data(), want_n.data(), normals.size() * sizeof normals[0]), 0) << round;
+    ASSERT_EQ(std::memcmp(tangents.data(), want_t.data(), tangents.size() * sizeof tangents[0]), 0) << round;
+  }
 }
 
 }  // namespace

@@ -258,7 +258,13 @@ TEST(MikkTSpace, TheSameBitsAsTheSlowPathOnRandomMeshes) {
         continue;
       }
       positions.emplace_back(lattice(4), lattice(4), lattice(2));
-      normals.push_back(random() % 8 == 0 ? glm::vec3(0.0f) : glm::vec3(lattice(3), lattice(3), lattice(3) + 1.5f));
+      // A quarter of the meshes have unit normals (of length 1 in float: their divisions are skipped where four
+      // corners of a batch have them), the others normals of any length.
+      glm::vec3 unit_normal(0.0f);
+      unit_normal[int(random() % 3)] = random() % 2 ? 1.0f : -1.0f;
+      normals.push_back(random() % 8 == 0 ? glm::vec3(0.0f)
+                        : mesh % 4 == 1   ? unit_normal
+                                          : glm::vec3(lattice(3), lattice(3), lattice(3) + 1.5f));
       uvs.emplace_back(lattice(4), lattice(4));
     }
     std::vector<std::uint32_t> indices;
