@@ -71,7 +71,8 @@ AoMapSize ao_map_size(int field_width, int field_height, const AoDesc& desc);
 // What a bake (or a cache read) holds besides the field and the stored map: the map in floats and, for coarse
 // taps, the max pyramid of the heights above level 0 (height_bytes per cell: as the heights are stored) and, without jitter, the tap columns every row shares
 // (bake/ao_texel.hpp's UniformColumns). For memory plans; nothing is baked.
-std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc, int height_bytes = sizeof(double));
+std::uint64_t ao_bake_bytes(int field_width, int field_height, const AoDesc& desc,
+                            int height_bytes = sizeof(double));
 
 // XXH3-64 of the format version, W, H, address mode, heights (as doubles, whatever they are stored as: float
 // heights have the key of their fp64 copy), depth scale, direction count (clamped to 4..16), radius, coarse,

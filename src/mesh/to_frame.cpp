@@ -1,7 +1,6 @@
 // A glTF primitive's vertices into qdmr's frame (mesh/to_frame.hpp).
 #include "mesh/to_frame.hpp"
 
-#include <emmintrin.h>  // SSE2: x86-64's baseline
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -9,6 +8,7 @@
 #include <limits>
 
 #include <glm/geometric.hpp>
+#include <xsimd/xsimd.hpp>
 
 #include "mesh/builders.hpp"
 
@@ -29,48 +29,50 @@ void to_frame_one(glm::vec3& position, glm::vec3& normal, glm::vec4& tangent, co
 
 namespace {
 
+// Two vertices side by side in SSE2's double lanes (x86-64's baseline: this file is built once, for every ISA).
+using Lanes = xsimd::batch<double, xsimd::sse2>;
+
 // Two vertices' x, y, z (lane 0 the first), in double.
 struct Pair {
-  __m128d x, y, z;
+  Lanes x, y, z;
 };
 
 template <class V>
 Pair load(const V& a, const V& b) {
-  return {_mm_set_pd(double(b.x), double(a.x)), _mm_set_pd(double(b.y), double(a.y)), _mm_set_pd(double(b.z), double(a.z))};
+  const auto lanes = [](double first, double second) {
+    alignas(16) const double v[2] = {first, second};
+    return Lanes::load_aligned(v);
+  };
+  return {lanes(double(a.x), double(b.x)), lanes(double(a.y), double(b.y)), lanes(double(a.z), double(b.z))};
 }
 
 // Row i of a 3x3 product: (m[0][i] x + m[1][i] y) + m[2][i] z, as glm's mat3 x vec3.
 template <class M>
-__m128d row(const M& m, int i, const Pair& v) {
-  return _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(m[0][i]), v.x), _mm_mul_pd(_mm_set1_pd(m[1][i]), v.y)),
-                    _mm_mul_pd(_mm_set1_pd(m[2][i]), v.z));
+Lanes row(const M& m, int i, const Pair& v) {
+  return (Lanes(m[0][i]) * v.x + Lanes(m[1][i]) * v.y) + Lanes(m[2][i]) * v.z;
 }
 
 // glm::length: sqrt((x x + y y) + z z).
-__m128d length(const Pair& v) {
-  return _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(v.x, v.x), _mm_mul_pd(v.y, v.y)), _mm_mul_pd(v.z, v.z)));
-}
+Lanes length(const Pair& v) { return xsimd::sqrt((v.x * v.x + v.y * v.y) + v.z * v.z); }
 
-// Per lane: len > 0 and finite (NaN fails both), as bits 0 and 1.
-int usable(__m128d len) {
-  const __m128d fine = _mm_and_pd(_mm_cmpgt_pd(len, _mm_setzero_pd()),
-                                  _mm_cmple_pd(len, _mm_set1_pd(std::numeric_limits<double>::max())));
-  return _mm_movemask_pd(fine);
+// Per lane: len > 0 and finite (NaN fails both).
+xsimd::batch_bool<double, xsimd::sse2> usable(const Lanes& len) {
+  return (len > Lanes(0.0)) & (len <= Lanes(std::numeric_limits<double>::max()));
 }
 
 // A pair stored; lane `lane` read back as one vertex rounded to float (glm::vec3 of a dvec3).
 struct Stored {
   alignas(16) double x[2], y[2], z[2];
   explicit Stored(const Pair& v) {
-    _mm_store_pd(x, v.x);
-    _mm_store_pd(y, v.y);
-    _mm_store_pd(z, v.z);
+    v.x.store_aligned(x);
+    v.y.store_aligned(y);
+    v.z.store_aligned(z);
   }
   glm::vec3 operator[](int lane) const { return glm::vec3(float(x[lane]), float(y[lane]), float(z[lane])); }
 };
 
 // v / len per component (three divisions, as a glm vector over a scalar).
-Pair over(const Pair& v, __m128d len) { return {_mm_div_pd(v.x, len), _mm_div_pd(v.y, len), _mm_div_pd(v.z, len)}; }
+Pair over(const Pair& v, const Lanes& len) { return {v.x / len, v.y / len, v.z / len}; }
 
 }  // namespace
 
@@ -83,9 +85,8 @@ void to_frame(std::span<glm::vec3> positions, std::span<glm::vec3> normals, std:
       // Position: (m[0] x + m[1] y) + (m[2] z + m[3] 1), glm's dmat4 x dvec4.
       const Pair p = load(positions[v], positions[v + 1]);
       const auto moved = [&](int i) {
-        return _mm_add_pd(
-            _mm_add_pd(_mm_mul_pd(_mm_set1_pd(world[0][i]), p.x), _mm_mul_pd(_mm_set1_pd(world[1][i]), p.y)),
-            _mm_add_pd(_mm_mul_pd(_mm_set1_pd(world[2][i]), p.z), _mm_mul_pd(_mm_set1_pd(world[3][i]), _mm_set1_pd(1.0))));
+        return (Lanes(world[0][i]) * p.x + Lanes(world[1][i]) * p.y) +
+               (Lanes(world[2][i]) * p.z + Lanes(world[3][i]) * Lanes(1.0));
       };
       const Stored position(Pair{moved(0), moved(1), moved(2)});
       positions[v] = position[0];
@@ -93,20 +94,20 @@ void to_frame(std::span<glm::vec3> positions, std::span<glm::vec3> normals, std:
 
       const Pair n0 = load(normals[v], normals[v + 1]);
       const Pair n = {row(normal_matrix, 0, n0), row(normal_matrix, 1, n0), row(normal_matrix, 2, n0)};
-      const __m128d len = length(n);
-      const int n_ok = usable(len);
+      const Lanes len = length(n);
+      const auto n_ok = usable(len);
       const Stored unit_n(over(n, len));
-      for (int lane = 0; lane < 2; ++lane) normals[v + lane] = n_ok >> lane & 1 ? unit_n[lane] : glm::vec3(0, 0, 1);
+      for (int lane = 0; lane < 2; ++lane) normals[v + lane] = n_ok.get(std::size_t(lane)) ? unit_n[lane] : glm::vec3(0, 0, 1);
 
       const glm::vec4 t[2] = {tangents[v], tangents[v + 1]};
       const Pair t0 = load(t[0], t[1]);
       const Pair tw = {row(linear, 0, t0), row(linear, 1, t0), row(linear, 2, t0)};
-      const __m128d tl = length(tw);
-      const int t_ok = usable(tl);
+      const Lanes tl = length(tw);
+      const auto t_ok = usable(tl);
       const Stored unit_t(over(tw, tl));
       for (int lane = 0; lane < 2; ++lane) {
         const float w = (t[lane].w < 0.0f) != mirrored ? -1.0f : 1.0f;
-        tangents[v + lane] = glm::vec4(t_ok >> lane & 1 ? unit_t[lane] : any_orthogonal(normals[v + lane]), w);
+        tangents[v + lane] = glm::vec4(t_ok.get(std::size_t(lane)) ? unit_t[lane] : any_orthogonal(normals[v + lane]), w);
       }
     }
     for (; v < range.end(); ++v) to_frame_one(positions[v], normals[v], tangents[v], world, normal_matrix, mirrored);
