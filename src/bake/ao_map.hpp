@@ -16,8 +16,8 @@
 // it needs no rebake). depth_scale is the material's technique depth scale (depth in UV units).
 #include <cstdint>
 #include <filesystem>
-#include <type_traits>
 
+#include "bake/ao_map_row.hpp"
 #include "bake/ao_pattern.hpp"
 #include "bake/ao_texel.hpp"
 #include "qdmr/scene/scene.hpp"
@@ -31,22 +31,6 @@ inline ao::Pattern pattern_of(const AoDesc& desc) {
   return {.directions = desc.directions, .jitter = desc.jitter, .seed = desc.seed, .radius = desc.radius,
           .coarse = desc.coarse};
 }
-
-// Row j of a map (map width floats into row) by a kernel's vectors (Kernel::ao_map_row, which preparation passes
-// so that `--isa` holds there too), one function per stored height type. Every row function gives the definition's
-// bits; a null one (the default) bakes by the definition texel by texel (scalar, baseline x86-64).
-template <class T>
-using AoRowOf = void (*)(const ao::Bake<T>& bake, int j, float* row);
-struct AoMapRow {
-  AoRowOf<double> f64 = nullptr;
-  AoRowOf<float> f32 = nullptr;
-
-  template <class T>
-  AoRowOf<T> of() const {
-    if constexpr (std::is_same_v<T, float>) return f32;
-    else return f64;
-  }
-};
 
 // A one-channel fp32 image, row 0 at v = 0. Parallel over rows with oneTBB; the same bits for any thread count,
 // and for float heights the same as for a HeightField of the same values. Throws qdmr::Error on an empty field.

@@ -5,12 +5,15 @@
 #include <mutex>
 #include <optional>
 
+#include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 #include <tbb/parallel_for.h>
 
 #include "qdmr/core/progress.hpp"
 #include "qdmr/reference/reference_memo.hpp"
+#include "qdmr/scene/scene.hpp"
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
 #include "texture/cache_model.hpp"
@@ -22,6 +25,25 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// The camera's view and projection matrices (OpenGL conventions): the geometry stage's and the light rig's.
+glm::mat4 view_matrix(const CameraDesc& camera) { return glm::lookAt(camera.position, camera.target, camera.up); }
+
+glm::mat4 projection_matrix(const CameraDesc& camera, const OutputDesc& output) {
+  return glm::perspective(glm::radians(camera.fov_y_deg), float(output.width) / float(output.height), camera.near,
+                          camera.far);
+}
+
+// The scene's lights and camera as the programs read them.
+LightRig light_rig(const SceneDesc& scene) {
+  LightRig rig;
+  for (const auto& d : scene.lights.directional)
+    rig.directional.push_back({glm::normalize(d.direction), d.color * d.intensity});
+  rig.ambient = scene.lights.ambient.color * scene.lights.ambient.intensity;
+  rig.camera_position = scene.camera.position;
+  rig.view_projection = projection_matrix(scene.camera, scene.output) * view_matrix(scene.camera);
+  return rig;
 }
 
 glm::mat4 model_matrix(const TransformDesc& t) {
@@ -138,7 +160,7 @@ void summarise_cache(const TextureCacheDesc& desc, const TextureAddressMap& map,
 
 std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
                                                     ReferenceMemo* memo) {
-  const LightRig lights = LightRig::from_scene(plan.scene);
+  const LightRig lights = light_rig(plan.scene);
   std::vector<std::unique_ptr<Program>> programs;
   for (const MaterialPlan& m : plan.materials) {
     const auto texture = [&](int i) { return i >= 0 ? assets.textures[std::size_t(i)].get() : nullptr; };
@@ -216,8 +238,8 @@ void draw(const FramePlan& plan, const Assets& assets, const Kernel& kernel,
     items[i].mesh_materials = plan.meshes[i].mtl_materials;
     items[i].model = model_matrix(scene.objects[i].transform);
   }
-  const glm::mat4 view = LightRig::view_matrix(scene.camera);
-  const glm::mat4 projection = LightRig::projection_matrix(scene.camera, scene.output);
+  const glm::mat4 view = view_matrix(scene.camera);
+  const glm::mat4 projection = projection_matrix(scene.camera, scene.output);
   run_geometry(items, view, projection, viewport, scratch.geometry_scratch, scratch.geometry);
   const GeometryResult& geometry = scratch.geometry;
   stats.geometry_ms = ms_since(start);

@@ -12,7 +12,7 @@
 #include <cstdint>
 
 #include "core/simd.hpp"
-#include "qdmr/scene/material_modes.hpp"
+#include "qdmr/core/material_modes.hpp"
 #include "kernel/sampler.hpp"
 #include "kernel/sampling_code.hpp"
 

@@ -13,7 +13,7 @@
 #include "program/program.hpp"
 #include "qdmr/program/program_key.hpp"
 #include "qdmr/program/program_params.hpp"
-#include "bake/ao_map.hpp"
+#include "bake/ao_map_row.hpp"
 #include "qdmr/core/isa.hpp"
 #include "qdmr/texture/bc3.hpp"
 #include "texture/blend_box_values.hpp"

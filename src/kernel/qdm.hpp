@@ -2,7 +2,7 @@
 // Quadtree displacement mapping over a max-quadtree; V is the trace variant (kernel/displacement.hpp).
 #include <limits>
 
-#include "qdmr/scene/material_modes.hpp"
+#include "qdmr/core/material_modes.hpp"
 #include "kernel/height_surface.hpp"
 #include "kernel/trace_ray.hpp"
 

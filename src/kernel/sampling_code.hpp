@@ -9,7 +9,7 @@
 #include "kernel/gather.hpp"
 #include "core/simd.hpp"
 #include "kernel/fetch_trace.hpp"
-#include "texture/internal.hpp"
+#include "texture/srgb_decode.hpp"
 #include "kernel/sampler.hpp"
 
 namespace qdmr::QDMR_ISA_NAMESPACE::sampling_code {

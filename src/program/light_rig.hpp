@@ -1,12 +1,11 @@
 #pragma once
 // Light sources and camera in the form the shading programs use: world-space unit directions, premultiplied
-// colours, the camera position and its view-projection matrix.
+// colours, the camera position and its view-projection matrix. Made from the scene by make_programs
+// (src/draw/draw.cpp): a program never sees the scene's types.
 #include <vector>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
-
-#include "qdmr/scene/scene.hpp"
 
 namespace qdmr {
 
@@ -19,12 +18,6 @@ struct LightRig {
   glm::vec3 ambient{0.0f};
   glm::vec3 camera_position{0.0f};
   glm::mat4 view_projection{1.0f};  // world to clip space, for programs that write displaced depth
-
-  // The camera's view and projection matrices (OpenGL conventions), shared with the geometry stage.
-  static glm::mat4 view_matrix(const CameraDesc& camera);
-  static glm::mat4 projection_matrix(const CameraDesc& camera, const OutputDesc& output);
-
-  static LightRig from_scene(const SceneDesc& scene);
 };
 
 }  // namespace qdmr

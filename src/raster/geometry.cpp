@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "qdmr/core/limits.hpp"
+#include "qdmr/mesh/mesh.hpp"
 
 namespace qdmr {
 namespace {

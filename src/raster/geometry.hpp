@@ -8,11 +8,12 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
-#include "qdmr/mesh/mesh.hpp"
 #include "program/varyings.hpp"
 #include "qdmr/core/pixel_buffer.hpp"
 
 namespace qdmr {
+
+struct MeshData;  // qdmr/mesh/mesh.hpp
 
 struct ClipVertex {
   glm::vec4 clip;  // homogeneous clip-space position (GL convention: -w <= z <= w)

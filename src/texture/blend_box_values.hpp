@@ -9,7 +9,7 @@
 #include <cstdint>
 
 #include "qdmr/core/zeroed_buffer.hpp"
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/core/material_modes.hpp"
 #include "texture/height_view.hpp"
 #include "texture/layer_heights.hpp"
 #include "qdmr/texture/mip_texture.hpp"

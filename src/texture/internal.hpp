@@ -1,10 +1,10 @@
 #pragma once
 // Texture module internals shared between its .cpp files and tests.
-#include <array>
 #include <vector>
 
 #include "qdmr/scene/scene.hpp"
 #include "qdmr/texture/image.hpp"
+#include "texture/srgb_decode.hpp"
 
 namespace qdmr::texture_detail {
 
@@ -29,14 +29,6 @@ struct WaveRows {
 };
 // Validates the pattern (as generate_pattern does) and makes its tables at the pattern's time and scroll.
 WaveRows wave_rows(const ProceduralDesc& desc);
-
-// The exact piecewise sRGB decode (IEC 61966-2-1), evaluated in double and rounded to float.
-float srgb_to_linear(float c);
-
-// srgb_to_linear(k / 255) for every byte k: the sampler's decode table. Built before main by baseline code (a
-// kernel's own static initialiser would run AVX code on any CPU; a function-local static would test its guard at
-// every fetch).
-extern const std::array<float, 256> kSrgbByteToLinear;
 
 // Strength 1 of a from_height normal map: the surface of h in [0,1] is this deep in UV units of one repeat.
 inline constexpr double kFromHeightDepth = 1.0 / 16.0;

@@ -112,9 +112,8 @@ Image albedo_texture(const TextureDesc& desc, const std::string& where) {
       const std::vector<int> channels = select_channels(file, desc.channel, 3, desc, where);
       Image rgb = pick(std::move(file), channels);
       if (desc.srgb) {
-        // 8-bit values (k / 255 exactly, as read_image gives them) from a table; the same results, faster.
-        std::array<float, 256> table;
-        for (int k = 0; k < 256; ++k) table[std::size_t(k)] = texture_detail::srgb_to_linear(float(k) / 255.0f);
+        // 8-bit values (k / 255 exactly, as read_image gives them) from the samplers' table; the same results, faster.
+        const std::array<float, 256>& table = texture_detail::kSrgbByteToLinear;
         for_rows(rgb.height, [&](int y) {
           float* row = &rgb.at(0, y, 0);
           for (int i = 0; i < rgb.width * 3; ++i) {
@@ -299,21 +298,6 @@ Image orm_texture(const LayerDesc& layer, const std::string& where) {
 }
 
 }  // namespace
-
-namespace texture_detail {
-
-float srgb_to_linear(float c) {
-  const double v = c;
-  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-}
-
-const std::array<float, 256> kSrgbByteToLinear = [] {
-  std::array<float, 256> table{};
-  for (int k = 0; k < 256; ++k) table[std::size_t(k)] = srgb_to_linear(float(k) / 255.0f);
-  return table;
-}();
-
-}  // namespace texture_detail
 
 const char* purpose_name(TexturePurpose purpose) {
   switch (purpose) {

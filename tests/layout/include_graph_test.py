@@ -76,3 +76,29 @@ def test_a_malformed_diagram_line_is_refused(tmp_path):
     code, out = check(tmp_path)
     assert code == 1
     assert "not `folder -> folders...`" in out
+
+
+def test_a_wall_fails_on_a_chain_of_includes_through_another_folder(tmp_path):
+    # e.cpp reaches scene only through mid's header: the folder edges allow it, the wall does not.
+    files = dict(GOOD_FILES, **{"src/mid/x.hpp": '#include "qdmr/scene/b.hpp"\n',
+                                "src/draw/e.cpp": '\n#include "mid/x.hpp"\n'})
+    diagram = "core ->\nscene -> core\nmid -> scene\ndraw -> mid scene\ndraw !> scene\n"
+    make_tree(tmp_path, files, diagram)
+    code, out = check(tmp_path)
+    assert code == 1
+    assert "src/draw/e.cpp:2 -> src/mid/x.hpp:1 -> include/qdmr/scene/b.hpp: draw reaches scene" in out
+    # Without the chain, only the direct includes: c.cpp includes scene itself.
+    files["src/mid/x.hpp"] = '#include "core/a.hpp"\n'
+    make_tree(tmp_path, files, "core ->\nscene -> core\nmid -> core\ndraw -> mid scene\ndraw !> scene\n")
+    code, out = check(tmp_path)
+    assert code == 1
+    assert "src/draw/c.cpp:1 -> include/qdmr/scene/b.hpp: draw reaches scene" in out
+    assert "e.cpp" not in out
+
+
+def test_a_wall_that_holds_passes(tmp_path):
+    files = dict(GOOD_FILES, **{"src/core/x.hpp": "#pragma once\n", "src/draw/e.cpp": '#include "core/x.hpp"\n'})
+    make_tree(tmp_path, files, "core ->\nscene -> core\ndraw -> core scene\ncore !> scene draw\n")
+    code, out = check(tmp_path)
+    assert code == 0, out
+    assert "its walls (core !> scene draw)" in out

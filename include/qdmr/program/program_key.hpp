@@ -8,7 +8,7 @@
 #include <string>
 
 #include "qdmr/core/sampling.hpp"
-#include "qdmr/scene/material_modes.hpp"
+#include "qdmr/core/material_modes.hpp"
 
 namespace qdmr {
 

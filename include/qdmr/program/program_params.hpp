@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "qdmr/scene/material_modes.hpp"
+#include "qdmr/core/material_modes.hpp"
 
 namespace qdmr {
 

@@ -14,7 +14,7 @@
 
 #include "qdmr/core/sampling.hpp"
 #include "qdmr/core/texture_cache.hpp"
-#include "qdmr/scene/material_modes.hpp"
+#include "qdmr/core/material_modes.hpp"
 
 namespace qdmr {
 

@@ -11,7 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "qdmr/scene/scene.hpp"
+#include "qdmr/core/sampling.hpp"
 #include "qdmr/texture/image.hpp"
 
 namespace qdmr {

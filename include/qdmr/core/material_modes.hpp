@@ -1,6 +1,7 @@
 #pragma once
 // The modes a material picks (technique, lighting, shadow, ambient occlusion, blending) and the specular-from-albedo
-// rule: the vocabulary the scene description (scene.hpp) and the shading programs (src/program/) share.
+// rule: the vocabulary the scene description (qdmr/scene/scene.hpp) and the shading programs (src/program/,
+// src/kernel/) share. In core, so that the programs reach none of the scene's headers.
 namespace qdmr {
 
 // Specular reflectance generated from the albedo instead of stored (the talk's terrain saves the texture):
