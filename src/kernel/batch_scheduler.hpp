@@ -2,14 +2,15 @@
 // The one way a program's group of batches (ShadingProgram::shade: 1 .. kMaxGroupBatches batches that write no
 // pixel in common) is shaded: in stages, each a plain member function of the program's stage type, called by
 // shade_in_stages() below. The scheduler owns the order, the pairing and the lane packing; the stages own what is
-// computed. A new technique is a new trace (and trace_pair), a new shadow or AO mode a change to light: neither
-// touches this file.
+// computed. A new technique is a new trace (and, if interleaving two batches' loops pays, a trace_pair), a new
+// shadow or AO mode a change to light: neither touches this file.
 //
 // The stages, in the order they run for each batch (S: the program's stage type, see BatchStages):
 //   setup(in)                quad-wise: what needs whole quads (derivatives, LODs, the tangent frame, the ray);
 //                            setup_pair(a, b, ...), where S has it, sets up two batches at once.
 //   surface(in, setup)       what the trace walks and the surface is sampled on, for this batch.
-//   trace(surface, setup)    the hit; trace_pair() of two batches interleaves their loops where that pays.
+//   trace(surface, setup)    the hit; trace_pair(...), where S has it, traces two batches at once (their loops
+//                            interleaved); else a pair's batches are traced one after the other.
 //   surface_at_hit(...)      the surface's samples at the hit (colour, normal, AO, ...).
 //   light(in, setup, ...)    lighting: the lane-wise outputs (S::output_values).
 //   finish(in, setup, out)   quad-wise again, on the batch's own lanes: what reads whole quads after the hit (the
@@ -37,7 +38,7 @@ enum class PackLanes {
   Groups,  // a group whose covered lanes fit in fewer batches runs as those (simd::LaneCompaction)
 };
 
-// What shade_in_stages() calls. For packed batches, visitors name the lane values each way, so that no packing code
+// What shade_in_stages() calls (and, where S has them, setup_pair and trace_pair). For packed batches, visitors name the lane values each way, so that no packing code
 // lists members by hand: S::Setup::values(f), s.lane_inputs(f) (what the lane-wise stages read of Fragments) and
 // S::output_values(f) (what they write of ShadeOutput) call f(value) for each, `value(x)` being that Float in x.
 // A Setup's `active`, where it has one, is the lanes the lane-wise stages work on: a packed batch's used lanes.
@@ -48,7 +49,6 @@ concept BatchStages = requires(const S& s, const Fragments& in, const typename S
   { s.setup(in) } -> std::same_as<typename S::Setup>;
   s.surface(in, setup);
   { s.trace(s.surface(in, setup), setup) } -> std::same_as<typename S::Hit>;
-  s.trace_pair(s.surface(in, setup), setup, hit_out, s.surface(in, setup), setup, hit_out);
   { s.surface_at_hit(setup, s.surface(in, setup), hit) } -> std::same_as<typename S::AtHit>;
   s.light(in, setup, s.surface(in, setup), at, out);
   s.finish(in, setup, out);
@@ -82,7 +82,12 @@ template <class S>
     decltype(auto) surface_a = s.surface(*in[k], setup_a);
     decltype(auto) surface_b = s.surface(*in[k + 1], setup_b);
     typename S::Hit hit_a, hit_b;
-    s.trace_pair(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
+    if constexpr (requires { s.trace_pair(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b); }) {
+      s.trace_pair(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
+    } else {
+      hit_a = s.trace(surface_a, setup_a);
+      hit_b = s.trace(surface_b, setup_b);
+    }
     const typename S::AtHit at_a = s.surface_at_hit(setup_a, surface_a, hit_a);
     const typename S::AtHit at_b = s.surface_at_hit(setup_b, surface_b, hit_b);
     s.light(*in[k], setup_a, surface_a, at_a, *out[k]);

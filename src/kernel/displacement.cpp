@@ -554,9 +554,14 @@ public:
   Hit trace(const Surface& surface, const Setup& setup) const { return p_.trace<V>(surface, setup); }
 
   // Two batches' traces: QDM's walks step in one loop, a single layer's relief runs its binary searches side by
-  // side, the rest (POM's loop runs at the core's throughput already) one after the other.
+  // side. Other techniques have none: the scheduler traces a pair's batches one after the other (POM's loop runs
+  // at the core's throughput already; CSM and RCSM batches are never paired).
+  static constexpr bool kTracePair =
+      V::technique == TechniqueKind::Qdm || (V::technique == TechniqueKind::Relief && !kBlend);
   void trace_pair(const Surface& surface_a, const Setup& setup_a, Hit& hit_a, const Surface& surface_b,
-                  const Setup& setup_b, Hit& hit_b) const {
+                  const Setup& setup_b, Hit& hit_b) const
+    requires kTracePair
+  {
     if constexpr (V::technique == TechniqueKind::Qdm) {
       p_.walk_pair<V>(surface_a, setup_a, hit_a, surface_b, setup_b, hit_b);
       if constexpr (kBlend) {
@@ -565,19 +570,14 @@ public:
       } else {
         p_.refine_qdm_hits(surface_a, setup_a, hit_a, setup_b, hit_b);
       }
-    } else if constexpr (V::technique == TechniqueKind::Relief && !kBlend) {
-      if (fetch_recorder_listens()) {
-        hit_a = trace(surface_a, setup_a);
-        hit_b = trace(surface_b, setup_b);
-      } else {
-        trace::relief_pair(surface_a, p_.trace_, setup_a.ray, setup_a.ds, setup_a.height_lod, setup_a.active, hit_a,
-                           setup_b.ray, setup_b.ds, setup_b.height_lod, setup_b.active, hit_b);
-        hit_a.box_s = hit_a.s;
-        hit_b.box_s = hit_b.s;
-      }
-    } else {
+    } else if (fetch_recorder_listens()) {  // relief
       hit_a = trace(surface_a, setup_a);
       hit_b = trace(surface_b, setup_b);
+    } else {
+      trace::relief_pair(surface_a, p_.trace_, setup_a.ray, setup_a.ds, setup_a.height_lod, setup_a.active, hit_a,
+                         setup_b.ray, setup_b.ds, setup_b.height_lod, setup_b.active, hit_b);
+      hit_a.box_s = hit_a.s;
+      hit_b.box_s = hit_b.s;
     }
   }
 

@@ -82,8 +82,9 @@ private:
   static constexpr bool pairs_technique(TechniqueKind k) {
     return k == TechniqueKind::Qdm || k == TechniqueKind::Relief || k == TechniqueKind::Pom;
   }
-  // The stages of a batch (batch_scheduler.hpp) over one layer's surface or a blend's: setup_for, the trace (and
-  // trace_pair), surface_at_hit, light_hit, the displaced depth; run by shade_in_stages for the instantiation V.
+  // The stages of a batch (batch_scheduler.hpp) over one layer's surface or a blend's: setup_for, the trace (and,
+  // for QDM and one layer's relief, trace_pair), surface_at_hit, light_hit, the displaced depth; run by
+  // shade_in_stages for the instantiation V.
   template <class V, class Surface>
   class Stages;
   struct SurfaceAtHit;

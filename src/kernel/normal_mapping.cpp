@@ -1,5 +1,7 @@
 #include "kernel/normal_mapping.hpp"
 
+#include <type_traits>
+
 #include "kernel/batch_scheduler.hpp"
 #include "kernel/lighting_models.hpp"
 #include "kernel/shading_math.hpp"
@@ -107,8 +109,10 @@ class NormalMappingProgram::Stages {
 public:
   static constexpr PackLanes kPackLanes = PackLanes::Pairs;
   // What reads whole quads: the LODs (the ORM texture's with Orm) and the samples' prefetch hint.
+  struct NoOrm {};
   struct Setup {
-    Float lod, normal_lod, orm_lod;
+    Float lod, normal_lod;
+    [[no_unique_address]] std::conditional_t<Orm, Float, NoOrm> orm_lod;  // the ORM texture's, with one
     UvAhead ahead;
 
     template <class F>
@@ -153,7 +157,6 @@ public:
     return {TangentFrame::from(in), view_vector(in, p_.lights_), in.varyings[kU], in.varyings[kV]};
   }
   Hit trace(const Surface&, const Setup&) const { return {}; }
-  void trace_pair(const Surface&, const Setup&, Hit&, const Surface&, const Setup&, Hit&) const {}
 
   Samples surface_at_hit(const Setup& setup, const Surface& surface, const Hit&) const {
     Samples s;
