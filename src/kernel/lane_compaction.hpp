@@ -101,7 +101,7 @@ private:
     return (lane << 2) * Int(0x01010101) + Int(0x03020100);
 #endif
   }
-  // Lane i of the result: lane control[i] of x.
+  // Lane i of the result: lane control[i] of x (raw intrinsics: xsimd 8 has no permutation by a run-time index).
   static Float permute(const Float& x, const Int& control) {
 #if defined(__AVX512F__)
     return _mm512_permutexvar_ps(control, x);

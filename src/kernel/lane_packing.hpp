@@ -3,7 +3,8 @@
 // other lanes of their quads only feed derivatives), the work that is lane by lane can run once for two batches:
 // pack() moves the lanes set in `first` of one value, then those set in `second` of the other, side by side from
 // lane 0; first() and second() give each batch its lanes back. Lanes are moved, never computed, so every packed
-// lane's result has the bits it would have had in its own batch.
+// lane's result has the bits it would have had in its own batch. Raw intrinsics: xsimd 8 has no compress or expand
+// and no permutation by a run-time index vector.
 #include <bit>
 #include <cstdint>
 

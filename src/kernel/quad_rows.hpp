@@ -2,7 +2,8 @@
 // A batch's lanes and the two framebuffer rows it covers. A batch holds kQuadsPerBatch 2x2 quads side by side:
 // lane 4q + 2r + c is pixel (2q + c, r), so each row's 2 * kQuadsPerBatch pixels are pairs of lanes. These move
 // a batch's lanes from and to two rows of floats with register shuffles (pixel pairs as 64-bit elements): a
-// round trip through an array of lanes (scalar stores, then a vector load) stalls on store forwarding.
+// round trip through an array of lanes (scalar stores, then a vector load) stalls on store forwarding. Raw
+// intrinsics: xsimd 8 has no two-source shuffle (shufps, vpermt2ps) and no permutation by an index vector.
 #include "core/simd.hpp"
 
 #if defined(__SSE2__)

@@ -99,7 +99,7 @@ Float edges_to_float(const Int64& low, const Int64& high) {
                       xsimd::bitwise_cast<Double>(high + magic_bits) - Double(kMagic));
 }
 
-// Bit j set where lane j of v is negative (its sign bit).
+// Bit j set where lane j of v is negative (its sign bit). Raw intrinsics: xsimd 8 has no mask-to-bits.
 std::uint32_t negative_lanes(const Int64& v) {
 #if defined(__AVX512F__)
   return std::uint32_t(_mm512_movepi64_mask(__m512i(v)));
@@ -575,7 +575,7 @@ private:
 constexpr int kMaxTileColorPixels = 128 * 128;
 
 // The n floats at src to dst by streaming stores (movntps: the frame's cache lines are written whole, never read
-// for ownership), dst's unaligned head and tail by plain stores.
+// for ownership), dst's unaligned head and tail by plain stores. Raw intrinsics: xsimd 8 has no streaming store.
 void stream_floats(float* dst, const float* src, std::size_t n) {
   for (; n > 0 && reinterpret_cast<std::uintptr_t>(dst) % 16 != 0; --n) *dst++ = *src++;
   for (; n >= 4; n -= 4, dst += 4, src += 4) _mm_stream_ps(dst, _mm_loadu_ps(src));
