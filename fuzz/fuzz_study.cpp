@@ -1,6 +1,6 @@
 // libFuzzer harness: a study spec through what `qdmr study SPEC` does before its first render: read_study_spec
 // (every check of the spec), expand_study (the configurations, max_configurations), shard_configurations,
-// then (study/runner.cpp) the base scene read once, the base camera from it with the spec's overrides, and for
+// then (study/study.cpp) the base scene read once, the base camera from it with the spec's overrides, and for
 // the first configurations their overrides (study_overrides: --set axes, camera orbits) and those of their
 // image-difference baseline applied to the base scene in memory. Input: the spec JSON, written as spec.json next
 // to a valid scene.json (fuzz_util.hpp), which the seeds name.
@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const qdmr::StudySpec spec = qdmr::read_study_spec(file);
     const std::vector<qdmr::StudyConfig> configs = qdmr::expand_study(spec);
     static_cast<void>(qdmr::shard_configurations(spec, configs, {1, 2}));
-    // As SceneSource and base_camera in study/runner.cpp.
+    // As SceneSource and base_camera in study/study.cpp.
     const nlohmann::json document = qdmr::scene_detail::parse_json_file(spec.scene, qdmr::InputKind::Scene);
     const auto load = [&](const std::vector<qdmr::SceneOverride>& overrides) {
       return qdmr::load_scene_json(document, spec.scene, spec.scene.parent_path(), overrides);
