@@ -16,6 +16,7 @@
 #include "qdmr/scene/scene.hpp"
 #include "raster/binner.hpp"
 #include "raster/geometry.hpp"
+#include "texture/blend_box_values.hpp"
 #include "texture/cache_model.hpp"
 
 namespace qdmr {
@@ -181,7 +182,9 @@ std::vector<std::unique_ptr<Program>> make_programs(const FramePlan& plan, const
       inputs.box_values = c->box_values ? c->box_values->data() : nullptr;
       // The period of its box values where it has them, else of the fp64 surface it was made from.
       if (c->box_values) {
-        inputs.combined_period_u = inputs.combined_period_v = c->layer_heights->width * m.weights_scale;
+        const HeightView<float> values = box_value_view(*c->box_values, *c->layer_heights, m.weights_scale);
+        inputs.combined_period_u = values.width;
+        inputs.combined_period_v = values.height;
       } else {
         const HeightField& combined = *assets.derived[std::size_t(m.combined_surface)].field;
         inputs.combined_period_u = combined.width;

@@ -409,7 +409,7 @@ private:
           // The tree (and the blend's AO map) of the values the walk reads: the plan made no fp64 surface for them.
           if (!out.box_values) throw Error(d.where, "internal: the plan expected the blend's box values");
           out.texture = std::make_shared<const Texture>(combined_quadtree(
-              box_value_view(*out.box_values, out.layer_heights->width * m.weights_scale), kernel_.mip_extremum()));
+              box_value_view(*out.box_values, *out.layer_heights, m.weights_scale), kernel_.mip_extremum()));
         } else {
           out.texture = std::make_shared<const Texture>(combined_quadtree(*input(0).field, kernel_.mip_extremum()));
         }
@@ -426,8 +426,7 @@ private:
                      TexelFormat::R16, MipReduce::Box);
         };
         out.texture = surface.field ? bake(height_view(*surface.field))
-                                    : bake(box_value_view(*surface.box_values,
-                                                          surface.layer_heights->width * m.weights_scale));
+                                    : bake(box_value_view(*surface.box_values, *surface.layer_heights, m.weights_scale));
         break;
       }
       case DerivedKind::TwinTexels:

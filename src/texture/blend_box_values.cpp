@@ -19,7 +19,8 @@ std::size_t blend_box_value_count(const BlendBoxSource& source) {
                      sizeof(float));
 }
 
-HeightView<float> box_value_view(const ZeroedBuffer<float>& values, int period) {
+HeightView<float> box_value_view(const ZeroedBuffer<float>& values, const LayerHeights& heights, int repeats) {
+  const int period = heights.width * repeats;
   if (period <= 0 || values.size() != std::size_t(period) * std::size_t(period))
     throw Error("box values", "the values do not fill a period of " + std::to_string(period) + " squared");
   return {period, period, AddressMode::Wrap, values.data()};

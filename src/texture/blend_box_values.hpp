@@ -33,9 +33,9 @@ struct BlendBoxSource {
 // or 0 where blend_box_values_bytes() is 0. A draw kernel computes them (Kernel::blend_box_values, src/kernel/).
 std::size_t blend_box_value_count(const BlendBoxSource& source);
 
-// The values of a period x period blend (blend_box_value_count's layout) as a height field that wraps: the surface
-// the walk intersects, from which the combined quadtree and the blend's baked AO map are made. Throws when the
-// values do not fill the period.
-HeightView<float> box_value_view(const ZeroedBuffer<float>& values, int period);
+// The values of a blend of these layer heights over `repeats` repeats (blend_box_value_count's layout: period =
+// heights.width * repeats, square) as a height field that wraps: the surface the walk intersects, from which the
+// combined quadtree and the blend's baked AO map are made. Throws when the values do not fill the period.
+HeightView<float> box_value_view(const ZeroedBuffer<float>& values, const LayerHeights& heights, int repeats);
 
 }  // namespace qdmr
