@@ -22,8 +22,11 @@ struct HeightView {
   }
 };
 
+// A field whose heights do not fill width x height gives a view without heights (h null), which the bakes refuse as
+// an empty or inconsistent field.
 inline HeightView<double> height_view(const HeightField& field) {
-  return {field.width, field.height, field.address, field.h.data()};
+  const bool filled = field.h.size() == std::size_t(field.width) * std::size_t(field.height);
+  return {field.width, field.height, field.address, filled ? field.h.data() : nullptr};
 }
 
 }  // namespace qdmr
