@@ -26,7 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-HeightField random_field(int w, int h, AddressMode address, std::uint32_t seed) {
+HeightField continuous_random_field(int w, int h, AddressMode address, std::uint32_t seed) {
   HeightField f;
   f.width = w;
   f.height = h;
@@ -68,7 +68,7 @@ TEST(AoMap, FlatFieldIsExactlyOpen) {
 }
 
 TEST(AoMap, ResolutionAndErrors) {
-  const HeightField f = random_field(16, 8, AddressMode::Wrap, 4);
+  const HeightField f = continuous_random_field(16, 8, AddressMode::Wrap, 4);
   AoDesc d = baked_desc(true);
   d.resolution = 40;  // 40 x (40 * 8 / 16)
   const Image map = bake_ao_map(f, 0.1, d);
@@ -105,7 +105,7 @@ TEST(AoMap, PitCentreWithinTheClosedFormBounds) {
 }
 
 TEST(AoMap, SameBitsForAnyThreadCount) {
-  const HeightField f = random_field(32, 32, AddressMode::Mirror, 8);
+  const HeightField f = continuous_random_field(32, 32, AddressMode::Mirror, 8);
   for (bool coarse : {false, true}) {
     AoDesc d = baked_desc(coarse);
     d.jitter = true;
@@ -176,7 +176,7 @@ TEST(AoMap, FloatHeightsBakeAsTheirDoubles) {
     for (AddressMode address : {AddressMode::Wrap, AddressMode::Clamp, AddressMode::Mirror})
       for (bool coarse : {true, false})
         for (bool jitter : {false, true}) {
-          const HeightField f = random_field(41, 27, address, std::uint32_t(31 + cases++));
+          const HeightField f = continuous_random_field(41, 27, address, std::uint32_t(31 + cases++));
           const std::vector<float> floats(f.h.begin(), f.h.end());
           for (std::size_t k = 0; k < floats.size(); ++k) ASSERT_EQ(double(floats[k]), f.h[k]);  // exact copies
           const HeightView<float> view{f.width, f.height, f.address, floats.data()};
@@ -206,7 +206,7 @@ TEST(AoMap, BakeIsTheDefinitionBitForBit) {
         for (double ds : {0.002, 0.05, 2.0, 1e-300})
           for (float radius : {0.03f, 0.2f, 0.6f, 1e7f}) {
             if (radius > 1.0f && coarse) continue;  // coarse taps stop at 2^30 texels
-            const HeightField f = random_field(37, 23, address, std::uint32_t(7 + cases));
+            const HeightField f = continuous_random_field(37, 23, address, std::uint32_t(7 + cases));
             AoDesc d = baked_desc(coarse);
             d.radius = radius;
             d.jitter = cases % 2 == 1;
@@ -222,16 +222,9 @@ TEST(AoMap, BakeIsTheDefinitionBitForBit) {
   }
 }
 
-fs::path only_file(const fs::path& dir) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
-  EXPECT_EQ(files.size(), 1u);
-  return files.empty() ? fs::path() : files[0];
-}
-
 TEST(AoMap, CacheMissThenHitThenCorruptFilesAreRebuilt) {
   TempDir dir;
-  const HeightField f = random_field(16, 12, AddressMode::Clamp, 21);
+  const HeightField f = continuous_random_field(16, 12, AddressMode::Clamp, 21);
   const AoDesc d = baked_desc(false);
   const Image expected = bake_ao_map(f, 0.05, d);
   EXPECT_EQ(load_or_bake_ao_map(f, 0.05, d, dir / "cache").texels, expected.texels);
@@ -267,7 +260,7 @@ TEST(AoMap, CacheMissThenHitThenCorruptFilesAreRebuilt) {
 }
 
 TEST(AoMap, KeyCoversWhatChangesTheMap) {
-  const HeightField f = random_field(8, 8, AddressMode::Wrap, 3);
+  const HeightField f = continuous_random_field(8, 8, AddressMode::Wrap, 3);
   const AoDesc d = baked_desc(true);
   const std::uint64_t key = ao_map_key(f, 0.05, d);
   const auto changed = [&](auto edit) {
@@ -305,7 +298,7 @@ TEST(AoMap, KeyCoversWhatChangesTheMap) {
 TEST(AoMap, UnwritableCacheStillBakesAndSaysWhy) {
   TempDir dir;
   write_file(dir / "not-a-folder", "x");
-  const HeightField f = random_field(8, 8, AddressMode::Wrap, 2);
+  const HeightField f = continuous_random_field(8, 8, AddressMode::Wrap, 2);
   const AoDesc d = baked_desc(true);
   CapturedWarnings warnings;
   EXPECT_EQ(load_or_bake_ao_map(f, 0.05, d, dir / "not-a-folder").texels, bake_ao_map(f, 0.05, d).texels);

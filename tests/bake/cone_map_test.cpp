@@ -431,13 +431,6 @@ TEST(ConeMap, SameBitsForAnyThreadCount) {
 
 // --- cache ---------------------------------------------------------------------------------------------------
 
-fs::path only_file(const fs::path& dir) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
-  EXPECT_EQ(files.size(), 1u);
-  return files.empty() ? fs::path() : files[0];
-}
-
 TEST(ConeMapCache, MissThenHitThenCorruptFilesAreRebuilt) {
   TempDir dir;
   const HeightField f = random_field(16, 12, AddressMode::Clamp, 21);
@@ -535,17 +528,6 @@ void write_gray_png(const fs::path& file, int w, int h, const std::vector<std::u
   ASSERT_TRUE(out->open(file.string(), OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::UINT8)));
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
   ASSERT_TRUE(out->close());
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    const std::size_t end = std::min(text.find('\n', start), text.size());
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return lines;
 }
 
 TEST(ConeMapCli, BakesTheSameMapAsTheLibrary) {

@@ -22,17 +22,6 @@ constexpr const char* kScene = R"({
   "objects": [{"mesh": {"type": "plane"}, "material": "rock"}]
 })";
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  for (std::size_t start = 0; start < text.size();) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return lines;
-}
-
 // A folder with the scene (and the inputs a case adds) and an empty output folder.
 class CliBadInput : public testing::Test {
 protected:

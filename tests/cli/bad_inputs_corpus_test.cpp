@@ -89,17 +89,6 @@ std::map<std::string, std::string> snapshot(const fs::path& root, bool hash_larg
   return state;
 }
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  for (std::size_t start = 0; start < text.size();) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return lines;
-}
-
 TEST(BadInputs, Corpus) {
   const fs::path corpus = source_dir() / "tests" / "bad_inputs";
   const nlohmann::json manifest = nlohmann::json::parse(read_file(corpus / "cases.json"));

@@ -31,7 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 using imageio::PixelType;
 
-constexpr int kWidth = 37, kHeight = 23;
+constexpr int kExrWidth = 37, kExrHeight = 23;
 
 struct ExrLayout {
   const char* name;
@@ -48,7 +48,7 @@ struct ExrLayout {
 // Samples from a hash, written as floats and 32-bit integers (OpenImageIO stores them as each channel's type):
 // floats of every sign and exponent, NaN and infinity included, so a half channel holds every kind of half too.
 void write_exr_file(const fs::path& file, const ExrLayout& layout) {
-  OIIO::ImageSpec spec(kWidth, kHeight, int(layout.channels.size()), layout.types[0]);
+  OIIO::ImageSpec spec(kExrWidth, kExrHeight, int(layout.channels.size()), layout.types[0]);
   spec.channelnames = layout.channels;
   if (layout.types.size() > 1) spec.channelformats = layout.types;
   spec.x = layout.x;
@@ -66,8 +66,8 @@ void write_exr_file(const fs::path& file, const ExrLayout& layout) {
   for (const auto& [name, value] : layout.strings) spec.attribute(name, value);
   const std::size_t channels = layout.channels.size();
   const std::size_t pixel = 4 * channels;  // every sample 4 bytes: a float or a 32-bit integer
-  std::vector<unsigned char> pixels(pixel * kWidth * kHeight);
-  for (std::size_t p = 0; p < std::size_t(kWidth) * kHeight; ++p)
+  std::vector<unsigned char> pixels(pixel * kExrWidth * kExrHeight);
+  for (std::size_t p = 0; p < std::size_t(kExrWidth) * kExrHeight; ++p)
     for (std::size_t c = 0; c < channels; ++c) {
       const std::uint32_t h = sample_hash(std::uint32_t(p * 16 + c));
       float value;
@@ -108,7 +108,7 @@ void write_exr_file(const fs::path& file, const ExrLayout& layout) {
     } else {
       // Mixed types: OpenImageIO takes them as TypeUnknown ("as the file's"), so convert each channel to its type.
       std::vector<unsigned char> native;
-      for (std::size_t p = 0; p < std::size_t(kWidth) * kHeight; ++p)
+      for (std::size_t p = 0; p < std::size_t(kExrWidth) * kExrHeight; ++p)
         for (std::size_t c = 0; c < channels; ++c) {
           const unsigned char* from = data.data() + p * pixel + 4 * c;
           const OIIO::TypeDesc type = spec.channelformat(int(c));
@@ -121,7 +121,7 @@ void write_exr_file(const fs::path& file, const ExrLayout& layout) {
   }
   // The smaller levels, as OpenEXR rounds them down (18x11, 9x5, 4x2, 2x1, 1x1), each from the end of the
   // samples: not level 0's.
-  for (int width = kWidth, height = kHeight; layout.mipmapped && (width > 1 || height > 1);) {
+  for (int width = kExrWidth, height = kExrHeight; layout.mipmapped && (width > 1 || height > 1);) {
     width = std::max(1, width / 2);
     height = std::max(1, height / 2);
     OIIO::ImageSpec level = spec;
@@ -174,16 +174,16 @@ TEST(ExrReader, FilesReadAsOpenImageIOReadsThem) {
 
 // A file with a channel sampled every other pixel, written by OpenEXR itself (OpenImageIO writes none).
 void write_subsampled_exr(const fs::path& file) {
-  Imf::Header header(kWidth + 1, kHeight + 1);
+  Imf::Header header(kExrWidth + 1, kExrHeight + 1);
   header.channels().insert("Y", Imf::Channel(Imf::HALF));
   header.channels().insert("C", Imf::Channel(Imf::HALF, 2, 2));
-  std::vector<std::uint16_t> y(std::size_t(kWidth + 1) * (kHeight + 1), 0x3C00), c(y.size() / 4, 0x3800);
+  std::vector<std::uint16_t> y(std::size_t(kExrWidth + 1) * (kExrHeight + 1), 0x3C00), c(y.size() / 4, 0x3800);
   Imf::FrameBuffer frame;
-  frame.insert("Y", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(y.data()), 2, 2 * std::size_t(kWidth + 1)));
-  frame.insert("C", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(c.data()), 2, std::size_t(kWidth + 1), 2, 2));
+  frame.insert("Y", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(y.data()), 2, 2 * std::size_t(kExrWidth + 1)));
+  frame.insert("C", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(c.data()), 2, std::size_t(kExrWidth + 1), 2, 2));
   Imf::OutputFile out(file.string().c_str(), header);
   out.setFrameBuffer(frame);
-  out.writePixels(kHeight + 1);
+  out.writePixels(kExrHeight + 1);
 }
 
 // Deep data, one Z sample in every pixel of a 4x4 scanline file.

@@ -54,7 +54,7 @@ Bytes damaged_iptc_segment() {
   return segment(0xED, Bytes("Photoshop 3.0", 14) + resource);
 }
 
-std::string error_of(const fs::path& file) {
+std::string jpeg_error_of(const fs::path& file) {
   std::vector<unsigned char> stripped;
   std::string error;
   EXPECT_FALSE(imageio::jpeg_without_metadata(file.string(), stripped, error));
@@ -112,7 +112,7 @@ TEST(JpegSegments, DamagedSegmentsBeforeTheFirstScanAreRefusedWithWhatIsWrong) {
   const Bytes plain = gradient_jpeg(dir / "plain.jpg");
   const auto refused = [&](const std::string& name, const Bytes& bytes) {
     write_bytes(dir / name, bytes);
-    return error_of(dir / name);
+    return jpeg_error_of(dir / name);
   };
   EXPECT_NE(refused("soi.jpg", plain.substr(0, 2)).find("truncated JPEG (it ends at byte 2"), std::string::npos);
   EXPECT_NE(refused("stuffed.jpg", plain.substr(0, 2) + Bytes("\xFF\x00", 2) + plain.substr(2)).find("byte 2 is not a marker"),
@@ -122,7 +122,7 @@ TEST(JpegSegments, DamagedSegmentsBeforeTheFirstScanAreRefusedWithWhatIsWrong) {
   const Bytes past_end = plain.substr(0, 2) + Bytes("\xFF\xED\x7F\xFF", 4) + "Photoshop 3.0";
   EXPECT_NE(refused("past_end.jpg", past_end).find("the FFED segment at byte 2 claims 32767 bytes after its marker, the file has 15)"),
             std::string::npos)
-      << error_of(dir / "past_end.jpg");
+      << jpeg_error_of(dir / "past_end.jpg");
   const Bytes short_length = plain.substr(0, 2) + Bytes("\xFF\xE1\x00\x01", 4) + plain.substr(2);
   EXPECT_NE(refused("short.jpg", short_length).find("declares 1 bytes"), std::string::npos);
   // A file that does not start with SOI is left to the decoder, which refuses it before reading any segment.

@@ -260,10 +260,6 @@ TEST(NativeReader, JpegOfEveryLayoutReadsAsOpenImageIOReadsIt) {
 
 // --- damaged files -------------------------------------------------------------------------------------------
 
-void write_bytes(const fs::path& file, const std::string& bytes) {
-  std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 // Damage in the pixel data (not in the headers image.cpp checks first): both readers fail, neither crashes.
 TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
   TempDir dir;
@@ -278,7 +274,7 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
     const std::size_t idat = bytes.find("IDAT");
     ASSERT_NE(idat, std::string::npos);
     for (std::size_t i = idat + 30; i < idat + 60 && i < bytes.size(); ++i) bytes[i] = char(0xA5 ^ i);
-    write_bytes(dir / (std::string("bad_") + name), bytes);
+    write_file(dir / (std::string("bad_") + name), bytes);
   }
   for (const char* name : {"j.jpg", "pj.jpg"}) {
     // The entropy-coded data cut after its first half and the end marker put back: libjpeg warns and pads.
@@ -286,7 +282,7 @@ TEST(NativeReader, DamagedPixelDataFailsInBothReaders) {
     const std::size_t scan = bytes.find("\xFF\xDA");
     ASSERT_NE(scan, std::string::npos);
     bytes = bytes.substr(0, scan + (bytes.size() - scan) / 2) + "\xFF\xD9";
-    write_bytes(dir / (std::string("bad_") + name), bytes);
+    write_file(dir / (std::string("bad_") + name), bytes);
   }
   for (const char* name : {"bad_p.png", "bad_i.png", "bad_j.jpg", "bad_pj.jpg"}) {
     Decoded oiio, native;
@@ -353,7 +349,7 @@ TEST(NativeReader, OtherSampleTypesAreTheFilesValuesConverted) {
 // A file of neither format is not claimed (the backend reads it); nothing is decoded.
 TEST(NativeReader, OtherFilesAreLeftToTheBackend) {
   TempDir dir;
-  write_bytes(dir / "x.png", "II*\0not really a TIFF");
+  write_file(dir / "x.png", "II*\0not really a TIFF");
   imageio::ReadSpec spec;
   std::string error;
   bool claimed = true;

@@ -23,17 +23,17 @@ namespace {
 namespace fs = std::filesystem;
 using imageio::PixelType;
 
-constexpr int kWidth = 37, kHeight = 23;  // bitmap rows of 4 bytes and 5 bits
+constexpr int kPnmWidth = 37, kPnmHeight = 23;  // bitmap rows of 4 bytes and 5 bits
 
 // A P1-P6 file of hashed samples in [0, limit] (limit <= maxval), with a comment in its header.
 std::string pnm_file(int kind, std::uint32_t maxval, std::uint32_t limit) {
   const int channels = kind == 3 || kind == 6 ? 3 : 1;
   const bool bitmap = kind == 1 || kind == 4;
-  std::string out = "P" + std::to_string(kind) + "\n# written by pnm_reader_test\n" + std::to_string(kWidth) + " " +
-                    std::to_string(kHeight) + (bitmap ? "\n" : "\n" + std::to_string(maxval) + "\n");
-  for (int y = 0; y < kHeight; ++y) {
-    std::vector<unsigned char> bits((kWidth + 7) / 8, 0);
-    for (int i = 0; i < kWidth * channels; ++i) {
+  std::string out = "P" + std::to_string(kind) + "\n# written by pnm_reader_test\n" + std::to_string(kPnmWidth) + " " +
+                    std::to_string(kPnmHeight) + (bitmap ? "\n" : "\n" + std::to_string(maxval) + "\n");
+  for (int y = 0; y < kPnmHeight; ++y) {
+    std::vector<unsigned char> bits((kPnmWidth + 7) / 8, 0);
+    for (int i = 0; i < kPnmWidth * channels; ++i) {
       const std::uint32_t k = sample_hash(std::uint32_t(y * 1000 + i) * 7u + maxval) % (limit + 1);
       if (kind == 4) {
         bits[std::size_t(i / 8)] |= static_cast<unsigned char>(k << (7 - i % 8));
@@ -58,8 +58,8 @@ std::string pfm_file(bool rgb, const std::string& scale) {
   const bool little = scale[0] == '-';
   std::string out = rgb ? "PF" : "Pf";  // appended piece by piece: GCC 12 warns wrongly on a chain of + here
   out += "\n# written by pnm_reader_test\n";
-  out += std::to_string(kWidth) + " " + std::to_string(kHeight) + "\n" + scale + "\n";
-  for (int i = 0; i < kWidth * kHeight * (rgb ? 3 : 1); ++i) {
+  out += std::to_string(kPnmWidth) + " " + std::to_string(kPnmHeight) + "\n" + scale + "\n";
+  for (int i = 0; i < kPnmWidth * kPnmHeight * (rgb ? 3 : 1); ++i) {
     std::uint32_t bits = sample_hash(std::uint32_t(i) * 13u + (rgb ? 1u : 0u));
     if (i % 5 == 0) bits &= 0x807FFFFFu;  // denormals and zeros
     if (i % 7 == 0) bits |= 0x7F800000u;  // infinities and NaNs

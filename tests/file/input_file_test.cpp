@@ -26,11 +26,6 @@ std::string pattern(std::size_t size) {
   return bytes;
 }
 
-void write_bytes(const fs::path& file, const std::string& bytes) {
-  std::ofstream out(file, std::ios::binary);
-  out.write(bytes.data(), std::streamsize(bytes.size()));
-}
-
 std::string error_of(const fs::path& file) {
   try {
     read_input_file(file, "test", InputKind::Obj);
@@ -46,7 +41,7 @@ TEST(InputFile, ReadsEveryByteAtTheSizesAroundItsBuffers) {
   for (const std::size_t size : {1u, 2u, 4095u, 4096u, 4097u, 8192u, 65535u, 65536u, 65537u, 300001u}) {
     const fs::path file = dir.path() / (std::to_string(size) + ".obj");
     const std::string bytes = pattern(size);
-    write_bytes(file, bytes);
+    write_file(file, bytes);
     const std::string read = read_input_file(file, "test", InputKind::Obj);
     ASSERT_EQ(read.size(), size);
     EXPECT_TRUE(read == bytes) << "size " << size;
@@ -56,7 +51,7 @@ TEST(InputFile, ReadsEveryByteAtTheSizesAroundItsBuffers) {
 TEST(InputFile, RefusesEmptyFilesFifosAndDirectoriesByName) {
   TempDir dir;
   const fs::path empty = dir.path() / "empty.obj";
-  write_bytes(empty, "");
+  write_file(empty, "");
   EXPECT_NE(error_of(empty).find("is empty (0 bytes)"), std::string::npos) << error_of(empty);
   const fs::path fifo = dir.path() / "pipe.obj";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
@@ -69,7 +64,7 @@ TEST(InputFile, ReadsPartsAndNamesAFileThatShrank) {
   TempDir dir;
   const fs::path file = dir.path() / "model.glb";
   const std::string bytes = pattern(100000);
-  write_bytes(file, bytes);
+  write_file(file, bytes);
   const InputFile open(file, "test", InputKind::Gltf);
   EXPECT_EQ(open.size(), bytes.size());
   EXPECT_EQ(open.read(70000, 30000), bytes.substr(70000));
@@ -82,14 +77,14 @@ TEST(InputFile, ReadsPartsAndNamesAFileThatShrank) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("ended at byte 50000"), std::string::npos) << e.what();
   }
-  write_bytes(dir.path() / "empty.glb", "");
+  write_file(dir.path() / "empty.glb", "");
   EXPECT_THROW(InputFile(dir.path() / "empty.glb", "test", InputKind::Gltf), Error);
 }
 
 TEST(InputFile, RemembersWhatItReadAsAnInputOfTheJob) {
   TempDir dir;
   const fs::path file = dir.path() / "model.obj";
-  write_bytes(file, "v 0 0 0\n");
+  write_file(file, "v 0 0 0\n");
   read_input_file(file, "test", InputKind::Obj);
   const std::vector<KnownInput> known = known_inputs();
   struct stat st {};

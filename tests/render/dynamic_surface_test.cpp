@@ -40,12 +40,6 @@ SceneDesc still_water() {
   return water(still);
 }
 
-Frame render(const SceneDesc& scene, int threads) {
-  RenderOptions options;
-  options.threads = threads;
-  return render_frame(scene, options);
-}
-
 TEST(DynamicSurface, TheWavesAreTimeDependentAndTheirStillTwinIsNot) {
   EXPECT_TRUE(water().time_dependent());
   EXPECT_FALSE(still_water().time_dependent());
@@ -54,8 +48,8 @@ TEST(DynamicSurface, TheWavesAreTimeDependentAndTheirStillTwinIsNot) {
 
 TEST(DynamicSurface, OneFrameEqualsTheSameHeightAsAStillTexture) {
   // Frame 0 is t = 0: the moving waves are where the still ones are, and so are every derived item and pixel.
-  const Frame dynamic = render(scene_at_frame(water(), 0), 2);
-  const Frame still = render(still_water(), 2);
+  const Frame dynamic = render_with_threads(scene_at_frame(water(), 0), 2);
+  const Frame still = render_with_threads(still_water(), 2);
   EXPECT_TRUE(same_bits(dynamic.color, still.color));
   // The textures too, byte for byte (a dynamic height's level 0 is made once for all its textures; a still one's
   // once per texture).
@@ -69,7 +63,7 @@ TEST(DynamicSurface, OneFrameEqualsTheSameHeightAsAStillTexture) {
     EXPECT_EQ(a.textures[i]->wrap_footprints, b.textures[i]->wrap_footprints) << still_plan.textures[i].where;
   }
   // And a later frame is another image (the test can fail).
-  EXPECT_FALSE(same_bits(render(scene_at_frame(water(), 5), 2).color, still.color));
+  EXPECT_FALSE(same_bits(render_with_threads(scene_at_frame(water(), 5), 2).color, still.color));
 }
 
 TEST(DynamicSurface, AScrollAtTimeZeroReadsTheStillPattern) {
@@ -107,7 +101,8 @@ TEST(DynamicSurface, AFrameOfASequenceEqualsTheFrameAloneOnAnyThreadCount) {
   const SceneDesc scene = water();
   const std::unique_ptr<Renderer> sequence = draw_sequence(scene, 3);
   const Frame& third = sequence->frame();
-  for (int threads : {1, 2, 3}) EXPECT_TRUE(same_bits(third.color, render(scene_at_frame(scene, 3), threads).color)) << threads;
+  for (int threads : {1, 2, 3})
+    EXPECT_TRUE(same_bits(third.color, render_with_threads(scene_at_frame(scene, 3), threads).color)) << threads;
 }
 
 // The items of `plan` whose lines are in `lines`, as "purpose where" / "kind where" for messages.
@@ -253,15 +248,16 @@ TEST(DynamicSurface, AnAmortizedFrameAloneEqualsTheFrameOfASequence) {
   const SceneDesc scene = water_ao(3);
   const std::unique_ptr<Renderer> sequence = draw_sequence(scene, 5);
   const Frame fifth = sequence->take_frame();
-  for (int threads : {1, 2, 3}) EXPECT_TRUE(same_bits(fifth.color, render(scene_at_frame(scene, 5), threads).color)) << threads;
+  for (int threads : {1, 2, 3})
+    EXPECT_TRUE(same_bits(fifth.color, render_with_threads(scene_at_frame(scene, 5), threads).color)) << threads;
   Renderer by_frames;  // set_frame from the scene as loaded
   by_frames.set_scene(scene);
   by_frames.set_frame(5);
   EXPECT_TRUE(same_bits(fifth.color, by_frames.draw().color));
   sequence->set_frame(2);  // back: replays frames 0 to 2
-  EXPECT_TRUE(same_bits(sequence->draw().color, render(scene_at_frame(scene, 2), 1).color));
+  EXPECT_TRUE(same_bits(sequence->draw().color, render_with_threads(scene_at_frame(scene, 2), 1).color));
   // And the amortized frame is not the frame baked whole (the test can fail).
-  EXPECT_FALSE(same_bits(fifth.color, render(scene_at_frame(water_ao(1), 5), 2).color));
+  EXPECT_FALSE(same_bits(fifth.color, render_with_threads(scene_at_frame(water_ao(1), 5), 2).color));
 }
 
 }  // namespace

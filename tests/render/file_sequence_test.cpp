@@ -57,12 +57,6 @@ SceneDesc water_from(const nlohmann::json& height, int frames = kFrames) {
 
 SceneDesc sequence(const Files& files) { return water_from({{"file", (files.dir / "h_%04d.exr").string()}}); }
 
-Frame render(const SceneDesc& scene, int threads) {
-  RenderOptions options;
-  options.threads = threads;
-  return render_frame(scene, options);
-}
-
 // The kinds of the plan's dynamic items ("height", "height max", "normal", ...).
 std::set<std::string> dynamic_kinds(const FramePlan& plan) {
   std::set<std::string> out;
@@ -90,7 +84,7 @@ TEST(FileSequence, AFrameEqualsTheSameFileAsAStillHeight) {
   const Files files;
   const SceneDesc still = water_from({{"file", (files.dir / "still.exr").string()}});
   const SceneDesc frame2 = scene_at_frame(sequence(files), 2);
-  EXPECT_TRUE(same_bits(render(frame2, 2).color, render(still, 2).color));
+  EXPECT_TRUE(same_bits(render_with_threads(frame2, 2).color, render_with_threads(still, 2).color));
   // The plan marks what is made from the sequence as dynamic: the heights, their max-quadtree, the normals; the
   // still file has none.
   EXPECT_EQ(dynamic_kinds(plan_frame(frame2)), (std::set<std::string>{"height", "height max", "normal"}));
@@ -110,7 +104,9 @@ TEST(FileSequence, AFrameOfASequenceEqualsTheFrameAloneOnAnyThreadCount) {
     renderer.draw();
   }
   for (int threads : {1, 2, 3})
-    EXPECT_TRUE(same_bits(renderer.frame().color, render(scene_at_frame(scene, kFrames - 1), threads).color)) << threads;
+    EXPECT_TRUE(same_bits(renderer.frame().color,
+                          render_with_threads(scene_at_frame(scene, kFrames - 1), threads).color))
+        << threads;
 }
 
 TEST(FileSequence, AWarmFrameRebuildsExactlyTheDynamicItems) {

@@ -19,12 +19,12 @@
 namespace qdmr::test {
 namespace {
 
-SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
+SceneDesc renderer_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
   return test::small_scene(name, std::move(overrides), 96, 54);
 }
 
 TEST(Renderer, FramesEqualTheOneShotRenderAndRepeat) {
-  const SceneDesc scene = small_scene("surface_blend_4layers");
+  const SceneDesc scene = renderer_scene("surface_blend_4layers");
   RenderOptions options;
   options.aovs = {Aov::Depth, Aov::Iterations};
   const Frame one_shot = render_frame(scene, options);
@@ -41,7 +41,7 @@ TEST(Renderer, FramesEqualTheOneShotRenderAndRepeat) {
 // A frame taken out and handed back (as the Python module does with frames nobody holds any more): the next draw
 // draws into its buffers, the same bits as before; a taken frame that is kept is not touched by later draws.
 TEST(Renderer, DrawsIntoARecycledFrame) {
-  const SceneDesc scene = small_scene("plane");
+  const SceneDesc scene = renderer_scene("plane");
   RenderOptions options;
   options.aovs = {Aov::Depth};
   Renderer renderer(options);
@@ -63,7 +63,7 @@ TEST(Renderer, DrawsIntoARecycledFrame) {
 }
 
 TEST(Renderer, CameraAndSizeChangesRePrepareNothing) {
-  SceneDesc scene = small_scene("terrain");
+  SceneDesc scene = renderer_scene("terrain");
   Renderer renderer;
   renderer.set_scene(scene);
   const RenderStats first = renderer.draw().stats;
@@ -92,7 +92,7 @@ TEST(Renderer, CameraAndSizeChangesRePrepareNothing) {
 // The stats name every item prepare built, once, in the plan's order, with its build time; the progress callback
 // sees the fraction of the plan's items grow to 1, one call at a time; a re-prepare that builds nothing has no steps.
 TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
-  SceneDesc scene = small_scene("terrain");
+  SceneDesc scene = renderer_scene("terrain");
   const FramePlan plan = plan_frame(scene, {});
   std::vector<double> fractions;
   RenderOptions options;
@@ -140,7 +140,7 @@ TEST(Renderer, StatsListEachBuiltItemAndProgressGrowsToOne) {
 // A stop request (the command's SIGINT or SIGTERM handler calls request_stop) ends a draw at its next tile with
 // qdmr::Interrupted; once the request is cleared the renderer draws the same frame as before.
 TEST(Renderer, AStopRequestEndsTheDrawAtTheNextTile) {
-  const SceneDesc scene = small_scene("plane");
+  const SceneDesc scene = renderer_scene("plane");
   Renderer renderer;
   renderer.set_scene(scene);
   const PixelBuffer before = renderer.draw().color;
@@ -163,7 +163,7 @@ TEST(Renderer, ANewTextureSettingIsANewTexture) {
   };
   std::vector<PixelBuffer> frames;
   for (const auto& overrides : scenes) {
-    const SceneDesc scene = small_scene("plane", overrides);
+    const SceneDesc scene = renderer_scene("plane", overrides);
     renderer.set_scene(scene);
     const Frame& frame = renderer.draw();
     EXPECT_TRUE(same_bits(frame.color, render_frame(scene, {}).color)) << overrides.size();
@@ -178,7 +178,7 @@ TEST(Renderer, ANewTextureSettingIsANewTexture) {
 TEST(Renderer, StatsNameTheVariantThePlanPicked) {
   for (const std::string name : {"terrain", "objects", "surface_blend_4layers", "pom_vs_qdm_depth_5.0"}) {
     Renderer renderer;
-    renderer.set_scene(small_scene(name));
+    renderer.set_scene(renderer_scene(name));
     const Frame& frame = renderer.draw();
     const FramePlan& plan = renderer.plan();
     ASSERT_EQ(frame.stats.materials.size(), plan.materials.size()) << name;
@@ -199,7 +199,7 @@ TEST(Renderer, EveryTraceVariantRunsTheInstantiationThePlanNames) {
       for (const std::string fetch : {"point", "trilinear"})
         for (const std::string level_up : {"stay", "one", "aligned"}) {
           if (technique != "qdm" && (math != "sm4" || fetch != "point" || level_up != "one")) continue;
-          const SceneDesc scene = small_scene(
+          const SceneDesc scene = renderer_scene(
               "pom_vs_qdm_depth_5.0", {{"/materials/surface/technique/name", technique},
                                        {"/materials/surface/sampling/math", math},
                                        {"/materials/surface/technique/height_fetch", fetch},
@@ -230,7 +230,7 @@ TEST(Renderer, EveryTraceVariantRunsTheInstantiationThePlanNames) {
 
 TEST(Renderer, MemoryDoesNotGrowOverAThousandFrames) {
   Renderer renderer;
-  renderer.set_scene(small_scene("plane"), {Aov::Depth, Aov::Normal});
+  renderer.set_scene(renderer_scene("plane"), {Aov::Depth, Aov::Normal});
   for (int i = 0; i < 50; ++i) renderer.draw();  // sizes settle, allocator pools fill
   const std::uint64_t before = test::resident_bytes();
   for (int i = 0; i < 1000; ++i) renderer.draw();
@@ -244,7 +244,7 @@ TEST(Renderer, MemoryDoesNotGrowOverAThousandFrames) {
 // something reads depth after its tile (the reference summary's covered pixels), and the plan counts exactly
 // what the renderer holds: colour (3 floats a pixel), the AOVs asked for, and then depth (1).
 TEST(Renderer, FramebufferKeepsADepthPlaneOnlyWhereItIsRead) {
-  const SceneDesc scene = small_scene("terrain");
+  const SceneDesc scene = renderer_scene("terrain");
   const std::uint64_t pixels = 96 * 54;
   struct Case {
     std::vector<Aov> aovs;

@@ -13,7 +13,7 @@
 namespace qdmr::test {
 namespace {
 
-SceneDesc small_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
+SceneDesc cache_scene(const std::string& name, std::vector<SceneOverride> overrides = {}) {
   return test::small_scene(name, std::move(overrides), 160, 96);
 }
 
@@ -24,7 +24,7 @@ const PixelBuffer& misses_plane(const Frame& frame) {
 }
 
 TEST(TextureCache, IsOffUnlessAsked) {
-  const Frame frame = render_frame(small_scene("plane"), RenderOptions{});
+  const Frame frame = render_frame(cache_scene("plane"), RenderOptions{});
   EXPECT_FALSE(frame.stats.texture_cache.enabled);
   EXPECT_FALSE(frame.stats.to_json().contains("texture_cache"));
 }
@@ -32,7 +32,7 @@ TEST(TextureCache, IsOffUnlessAsked) {
 TEST(TextureCache, AskingForTheMissesAovTurnsItOn) {
   RenderOptions options;
   options.aovs = {Aov::CacheMisses};
-  const Frame frame = render_frame(small_scene("plane"), options);
+  const Frame frame = render_frame(cache_scene("plane"), options);
   const TextureCacheStats& c = frame.stats.texture_cache;
   ASSERT_TRUE(c.enabled);
   EXPECT_EQ(c.layout, "linear");
@@ -57,7 +57,7 @@ TEST(TextureCache, AskingForTheMissesAovTurnsItOn) {
 TEST(TextureCache, TheSameForEveryIsaThreadCountAndTileSize) {
   for (const char* name : {"terrain", "objects_displaced"}) {
     SCOPED_TRACE(name);
-    const SceneDesc scene = small_scene(name, {{"/texture_cache/layout", "\"tiled4\""}});
+    const SceneDesc scene = cache_scene(name, {{"/texture_cache/layout", "\"tiled4\""}});
     struct Setting {
       Isa isa;
       int threads, tile;
@@ -118,10 +118,10 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
     for (Isa isa : usable_isas()) {
       SCOPED_TRACE(std::string(name) + (c.overrides.empty() ? "" : " with " + c.overrides[0].pointer) + ", " +
                    std::string(isa_name(isa)));
-      const SceneDesc off = small_scene(name, c.overrides);
+      const SceneDesc off = cache_scene(name, c.overrides);
       auto cache_overrides = c.overrides;
       cache_overrides.push_back({"/texture_cache/layout", "\"morton\""});
-      const SceneDesc on = small_scene(name, cache_overrides);
+      const SceneDesc on = cache_scene(name, cache_overrides);
       ASSERT_TRUE(on.texture_cache.enabled);
       RenderOptions options;
       options.isa = isa;
@@ -160,7 +160,7 @@ TEST(TextureCache, LeavesTheImageAsItIs) {
 
 TEST(TextureCache, LayoutsChangeTheMissesNotTheReads) {
   const auto stats = [](const char* layout) {
-    return render_frame(small_scene("plane", {{"/texture_cache/layout", std::string("\"") + layout + "\""}}),
+    return render_frame(cache_scene("plane", {{"/texture_cache/layout", std::string("\"") + layout + "\""}}),
                         RenderOptions{})
         .stats.texture_cache;
   };
@@ -173,15 +173,15 @@ TEST(TextureCache, LayoutsChangeTheMissesNotTheReads) {
 TEST(TextureCache, RefusesATileThatIsNotAWholeNumberOfRegions) {
   RenderOptions options;
   options.tile_size = 40;
-  EXPECT_THROW(render_frame(small_scene("plane", {{"/texture_cache/region", "32"}}), options), Error);
+  EXPECT_THROW(render_frame(cache_scene("plane", {{"/texture_cache/region", "32"}}), options), Error);
   options.tile_size = 48;
-  EXPECT_NO_THROW(render_frame(small_scene("plane", {{"/texture_cache/region", "16"}}), options));
+  EXPECT_NO_THROW(render_frame(cache_scene("plane", {{"/texture_cache/region", "16"}}), options));
 }
 
 TEST(TextureCache, SceneSettingsAreChecked) {
   const auto message = [](const std::string& pointer, const std::string& value) {
     try {
-      small_scene("plane", {{pointer, value}});
+      cache_scene("plane", {{pointer, value}});
     } catch (const Error& e) {
       return std::string(e.what());
     }

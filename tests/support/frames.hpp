@@ -8,6 +8,7 @@
 
 #include "qdmr/core/pixel_buffer.hpp"
 #include "qdmr/load/load.hpp"
+#include "qdmr/render/render.hpp"
 #include "support/test_support.hpp"
 
 namespace qdmr::test {
@@ -17,6 +18,13 @@ inline SceneDesc small_scene(const std::string& name, std::vector<SceneOverride>
   overrides.push_back({"/output/width", std::to_string(width)});
   overrides.push_back({"/output/height", std::to_string(height)});
   return load_scene(source_dir() / "scenes" / (name + ".json"), overrides);
+}
+
+// One frame of `scene` on `threads` threads.
+inline Frame render_with_threads(const SceneDesc& scene, int threads) {
+  RenderOptions options;
+  options.threads = threads;
+  return render_frame(scene, options);
 }
 
 inline bool same_bits(const PixelBuffer& a, const PixelBuffer& b) {

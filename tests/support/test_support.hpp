@@ -71,4 +71,10 @@ std::string read_file(const std::filesystem::path& file);
 std::uint32_t sample_hash(std::uint32_t x);
 void write_file(const std::filesystem::path& file, const std::string& text);
 
+// The lines of `text`, without their '\n' (no empty last line for a text that ends with one).
+std::vector<std::string> lines_of(const std::string& text);
+
+// The one file in `dir` (a test failure if there are none or several; then an empty path or the first).
+std::filesystem::path only_file(const std::filesystem::path& dir);
+
 }  // namespace qdmr::test
