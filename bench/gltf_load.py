@@ -6,12 +6,13 @@ own: the peak of `qdmr plan` of the same .glb at resolution 1 (2 triangles) is t
 
 The .glb is written here: the grid of `{"type": "grid", "resolution": R}` (R = 708: 1,002,528 triangles) with
 POSITION, NORMAL, TEXCOORD_0 and 32-bit indices, and no TANGENT (qdmr generates them, MikkTSpace's way), or with
-TANGENT (--tangents: as exporters write them for normal-mapped assets). Each round runs
-`qdmr plan` and a 16x16 `qdmr render` of both once; the table holds the median wall time, the peak resident memory (getrusage of the
-child), the plan's mesh size, and the load average before and after (run it on a quiet machine, and under
-`flock /tmp/qdmr-build.lock` where builds share the machine).
+TANGENT (--tangents: as exporters write them for normal-mapped assets). Each round runs `qdmr plan` and then a
+16x16 `qdmr render` of the grid and of the .glb, one right after the other (the .glb first in every other round),
+and takes the ratio .glb / grid of that round; the table holds the median of those ratios, the median wall times,
+the CPU time and peak resident memory (wait4 of the child), the plan's mesh size, the CPU model and the load average after each
+round. Run it on a quiet machine, and under `flock /tmp/qdmr-build.lock` where builds share the machine.
 
-  bench/gltf_load.py [-n 5] [-B BUILD_DIR] [--resolution 708] [--tangents]
+  bench/gltf_load.py [-n 11] [-B BUILD_DIR] [--resolution 708] [--tangents]
 """
 import argparse
 import json
@@ -20,7 +21,9 @@ import re
 import statistics
 import struct
 import subprocess
+import sys
 import tempfile
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -67,27 +70,40 @@ def grid_glb(path, resolution, tangents=False):
         f.write(glb)
 
 
-def measure(binary, target, rounds, command):
-    script = ("import resource, subprocess, sys, time\n"
-              "s = time.perf_counter(); o = subprocess.run(sys.argv[1:], check=True, capture_output=True, text=True).stdout\n"
-              "t = time.perf_counter() - s\n"
-              "print(t, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss); print(o)\n")
-    times, peaks = [], []
-    for _ in range(rounds):
-        out = subprocess.run(["python3", "-c", script, binary, *command(target)], check=True, capture_output=True,
-                             text=True).stdout
-        first = out.split("\n", 1)[0]
-        t, kib = first.split()
-        times.append(float(t))
-        peaks.append(int(kib) / 1024)
-    mesh = re.search(r"meshes ([0-9.]+) MiB", subprocess.run([binary, "plan", target], check=True, capture_output=True,
-                                                             text=True).stdout)
-    return statistics.median(times), max(peaks), float(mesh.group(1)) if mesh else float("nan")
+# The command runs under a small Python process of its own: a child's peak resident memory (ru_maxrss) counts the
+# memory of the process it was forked from, and this one holds the asset it wrote.
+TIMER = ("import os, subprocess, sys, time\n"
+         "s = time.perf_counter(); c = subprocess.Popen(sys.argv[1:], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)\n"
+         "_, status, usage = os.wait4(c.pid, 0); t = time.perf_counter() - s\n"
+         "print(t, usage.ru_utime + usage.ru_stime, usage.ru_maxrss, os.waitstatus_to_exitcode(status))\n")
+
+
+def run(binary, args):
+    """Wall time, CPU time (user + system, all threads) and peak resident memory (MiB) of one command."""
+    out = subprocess.run([sys.executable, "-c", TIMER, binary, *args], check=True, capture_output=True, text=True).stdout
+    seconds, cpu, kib, code = out.split()
+    if int(code) != 0:
+        raise SystemExit("gltf_load: %s %s exited with %s" % (binary, " ".join(args), code))
+    return float(seconds), float(cpu), int(kib) / 1024
+
+
+def cpu_model():
+    """The model name and, where the name is short (virtual machines), the family and model numbers."""
+    fields = {}
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                fields.setdefault(key.strip(), value.strip())
+    except OSError:
+        pass
+    return "%s (family %s, model %s)" % (fields.get("model name", "unknown CPU"), fields.get("cpu family", "?"),
+                                        fields.get("model", "?"))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("-n", type=int, default=5)
+    ap.add_argument("-n", type=int, default=11, help="rounds (default 11)")
     ap.add_argument("-B", default=os.path.join(ROOT, "build", "release"))
     ap.add_argument("--resolution", type=int, default=708)
     ap.add_argument("--tangents", action="store_true", help="write TANGENT into the .glb")
@@ -105,24 +121,50 @@ def main():
         image = os.path.join(tmp, "x.png")
         commands = {"plan": lambda t: ["plan", t],
                     # The grid's mesh is built when the frame is prepared, a .glb's when the scene is loaded: a
-                    # 16x16 render holds both (and next to no drawing).
+                    # 16x16 render holds both (and next to no drawing). The target is this row.
                     "render 16x16": lambda t: ["render", t, "-o", image, "--width", "16", "--height", "16"]}
-        load = os.getloadavg()[0]
-        rows = [(what, name, measure(binary, target, args.n, command)) for what, command in commands.items()
-                for name, target in (("procedural grid", scene), (".glb", glb))]
-        empty = measure(binary, tiny, args.n, commands["plan"])[1]
-        load_after = os.getloadavg()[0]
+        targets = (("procedural grid", scene), (".glb", glb))
+        times = {(what, name): [] for what in commands for name, _ in targets}
+        cpus = {key: [] for key in times}
+        peaks = {key: [] for key in times}
+        ratios = {what: [] for what in commands}
+        cpu_ratios = {what: [] for what in commands}
+        empty = []
+        loads = [os.getloadavg()[0]]
+        # Round by round, the grid and the .glb one after the other (which goes first alternates), so a change of
+        # the machine's load moves both sides of each round's ratio alike.
+        for r in range(args.n):
+            for what, command in commands.items():
+                for name, target in (targets if r % 2 == 0 else targets[::-1]):
+                    t, cpu, peak = run(binary, command(target))
+                    times[(what, name)].append(t)
+                    cpus[(what, name)].append(cpu)
+                    peaks[(what, name)].append(peak)
+                ratios[what].append(times[(what, ".glb")][-1] / times[(what, "procedural grid")][-1])
+                cpu_ratios[what].append(cpus[(what, ".glb")][-1] / cpus[(what, "procedural grid")][-1])
+            empty.append(run(binary, commands["plan"](tiny))[2])
+            loads.append(os.getloadavg()[0])
+        plan = subprocess.run([binary, "plan", glb], check=True, capture_output=True, text=True).stdout
+        found = re.search(r"meshes ([0-9.]+) MiB", plan)
+        mesh = float(found.group(1)) if found else float("nan")
     triangles = 2 * args.resolution ** 2
-    print("| %d triangles%s, %d rounds | wall time (median) | peak RSS | plan's mesh size |" % (triangles, " (.glb with TANGENT)" if args.tangents else "", args.n))
+    print("%s, %d cores; load average (1 min) %.2f before, %.2f-%.2f during, %.2f after"
+          % (cpu_model(), os.cpu_count(), loads[0], min(loads[1:]), max(loads[1:]), loads[-1]))
+    print("| %d triangles%s, %d alternating rounds | wall time (median) | CPU time (median) | peak RSS (max) |"
+          % (triangles, " (.glb with TANGENT)" if args.tangents else "", args.n))
     print("|---|---|---|---|")
-    for what, name, (t, peak, mesh) in rows:
-        print("| %s: %s | %.3f s | %.1f MiB | %.1f MiB |" % (what, name, t, peak, mesh))
-    for what in commands:
-        grid, gltf = [r[2] for r in rows if r[0] == what]
-        print("| %s: .glb / grid | %.2f (target <= 1.5) | | |" % (what, gltf[0] / grid[0]))
-    gltf = [r[2] for r in rows if r[0] == "plan" and r[1] == ".glb"][0]
-    print("| plan: (.glb peak - %.1f MiB) / mesh | | %.2f (target <= 1.3) | |" % (empty, (gltf[1] - empty) / gltf[2]))
-    print("load average: %.2f before, %.2f after" % (load, load_after))
+    for (what, name), ts in times.items():
+        print("| %s: %s | %.3f s | %.3f s | %.1f MiB |" % (what, name, statistics.median(ts),
+                                                         statistics.median(cpus[(what, name)]), max(peaks[(what, name)])))
+    for what, rs in ratios.items():
+        note = ("target <= 1.5" if what != "plan" else
+                "not the target: the grid's plan builds no mesh, the .glb's loads it")
+        cs = cpu_ratios[what]
+        print("| %s: .glb / grid, median of the rounds' ratios (min-max; %s) | %.2f (%.2f-%.2f) | %.2f (%.2f-%.2f) | |"
+              % (what, note, statistics.median(rs), min(rs), max(rs), statistics.median(cs), min(cs), max(cs)))
+    gltf_peak = max(peaks[("plan", ".glb")])
+    print("| plan: (.glb peak - %.1f MiB, the command's own) / the plan's mesh size %.1f MiB | | | %.2f (target <= 1.3) |"
+          % (max(empty), mesh, (gltf_peak - max(empty)) / mesh))
 
 
 if __name__ == "__main__":
