@@ -6,6 +6,7 @@
 #include <type_traits>
 
 #include "core/simd.hpp"
+#include "kernel/kernel_calls.hpp"
 #include "kernel/preparation.hpp"
 #include "texture/bc3_search.hpp"
 
@@ -40,8 +41,13 @@ int candidate_errors(const std::uint8_t* texels, const bc3::Candidates& c, int* 
   return c.count;
 }
 
+Bc3AlphaBlock bc3_encode(const std::uint8_t texels[16]) { return bc3::encode(texels, candidate_errors); }
+
 }  // namespace
 
-Bc3AlphaBlock bc3_encode(const std::uint8_t texels[16]) { return bc3::encode(texels, candidate_errors); }
+Bc3Encode bc3_encoder() {
+  kernel_calls.bc3_encoders.fetch_add(1, std::memory_order_relaxed);
+  return &bc3_encode;
+}
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE

@@ -25,9 +25,12 @@ namespace qdmr {
 
 // How often a kernel's own code ran, per entry point: counted inside the per-ISA functions (not by the table),
 // so a call that reaches a kernel some other way still counts under the ISA that ran. Once per material, tile,
-// mip level or box-value table: relaxed atomics, no cost worth measuring.
+// mip level, box-value table or AO row, and once per encoder or row table handed out (a BC3 texture, a dynamic
+// height's rebuild: an atomic per 4x4 block or per row would cost more than it tells): relaxed atomics, no cost
+// worth measuring.
 struct KernelCalls {
-  std::atomic<std::uint64_t> programs{0}, tiles{0}, mip_levels{0}, box_values{0}, ao_rows{0};
+  std::atomic<std::uint64_t> programs{0}, tiles{0}, mip_levels{0}, box_values{0}, ao_rows{0}, bc3_encoders{0},
+      height_row_tables{0};
 };
 
 class Kernel {

@@ -50,7 +50,7 @@ public:
 
   const HeightRows& height_rows() const override { return qdmr::QDMR_ISA::height_rows(); }
 
-  Bc3Encode bc3_encode() const override { return &qdmr::QDMR_ISA::bc3_encode; }
+  Bc3Encode bc3_encode() const override { return qdmr::QDMR_ISA::bc3_encoder(); }
 
   const KernelCalls& calls() const override { return kernel_calls; }
 };

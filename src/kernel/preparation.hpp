@@ -19,10 +19,11 @@ void blend_box_values(const BlendBoxSource& source, float* out);
 void mip_extremum(bool max, TexelFormat format, const std::uint8_t* in, int in_w, int in_h, std::uint8_t* out,
                   int out_w, int out_h);
 
-// The rows of a dynamic height's rebuild on this kernel's vectors (kernel/height_rows.cpp).
+// The rows of a dynamic height's rebuild on this kernel's vectors (kernel/height_rows.cpp); counts a row table.
 const HeightRows& height_rows();
 
-// A BC3 alpha block encoded as encode_bc3_alpha encodes it, on this kernel's vectors (kernel/bc3_encode.cpp).
-Bc3AlphaBlock bc3_encode(const std::uint8_t texels[16]);
+// An encoder of BC3 alpha blocks as encode_bc3_alpha encodes them, on this kernel's vectors
+// (kernel/bc3_encode.cpp); counts an encoder.
+Bc3Encode bc3_encoder();
 
 }  // namespace qdmr::QDMR_ISA_NAMESPACE
