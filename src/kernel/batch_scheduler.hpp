@@ -24,6 +24,8 @@
 #include <bit>
 #include <concepts>
 #include <cstdint>
+#include <new>
+#include <type_traits>
 
 #include "kernel/batch.hpp"
 #include "kernel/lane_compaction.hpp"
@@ -207,7 +209,10 @@ void shade_in_stages(const S& s, const Fragments* const* in, ShadeOutput* const*
   int k = 0;
   if constexpr (requires { s.setup_pair(*in[0], *in[0], setups[0], setups[0]); })
     for (; k + 1 < n; k += 2) s.setup_pair(*in[k], *in[k + 1], setups[k], setups[k + 1]);
-  for (; k < n; ++k) setups[k] = s.setup(*in[k]);
+  // Each setup made in its slot: assigned (setups[k] = s.setup(...)), the returned Setup was made in a temporary
+  // and copied (displacement's with rep movsq), once per batch.
+  static_assert(std::is_trivially_destructible_v<typename S::Setup>, "a slot's old Setup is not destroyed");
+  for (; k < n; ++k) ::new (&setups[k]) typename S::Setup(s.setup(*in[k]));
   if (!stages_detail::shade_packed(s, in, setups, out, n)) stages_detail::shade_lanes(s, in, setups, out, n);
   for (k = 0; k < n; ++k) s.finish(*in[k], setups[k], *out[k]);
 }
