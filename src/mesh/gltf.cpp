@@ -1068,6 +1068,14 @@ private:
         m.sampling.filter = filter_of(s.minFilter);
         m.sampling.address = address_of(s.wrapS);
         if (s.wrapS != s.wrapT) note("material '" + m.name + "': wrapT differs from wrapS; qdmr addresses both axes with wrapS");
+        // One texel filter for minified and magnified texels (qdmr's filters): minFilter's. A magFilter that asks
+        // for the other one is a warning.
+        const bool min_nearest = m.sampling.filter == Filter::Point || m.sampling.filter == Filter::PointMipPoint ||
+                                 m.sampling.filter == Filter::PointMipLinear;
+        if ((s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST && !min_nearest) ||
+            (s.magFilter == TINYGLTF_TEXTURE_FILTER_LINEAR && min_nearest))
+          note("material '" + m.name + "': magFilter " + (min_nearest ? "LINEAR" : "NEAREST") +
+               " differs from minFilter's texel filter; qdmr filters magnified texels as minFilter says");
       }
     } else {
       layer.albedo.constant =

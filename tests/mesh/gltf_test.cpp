@@ -191,6 +191,18 @@ TEST(Gltf, TextureTransformSamplerAndFactors) {
   EXPECT_EQ(sampled.materials[0].sampling.filter, Filter::PointMipLinear);
   EXPECT_EQ(sampled.materials[0].sampling.address, AddressMode::Clamp);
   EXPECT_TRUE(has_note(sampled, "wrapT differs from wrapS"));
+  EXPECT_FALSE(has_note(sampled, "magFilter"));  // NEAREST, as NEAREST_MIPMAP_LINEAR's texels: they agree
+  // One texel filter for both (minFilter's): a magFilter asking for the other is a warning, either way round.
+  const auto mag_note = [&](int min_filter, int mag_filter) {
+    return has_note(edited([&](J& d) {
+                      d["samplers"] = J::array({{{"minFilter", min_filter}, {"magFilter", mag_filter}}});
+                      d["textures"][0]["sampler"] = 0;
+                    }),
+                    "magFilter");
+  };
+  EXPECT_TRUE(mag_note(9987, 9728));   // LINEAR_MIPMAP_LINEAR, NEAREST
+  EXPECT_TRUE(mag_note(9728, 9729));   // NEAREST, LINEAR
+  EXPECT_FALSE(mag_note(9985, 9729));  // LINEAR_MIPMAP_NEAREST, LINEAR
   // Factors without a texture: albedo = baseColor x (1 - metallic), F0 from metallic, roughness clamped.
   const MeshData metal = edited([](J& d) {
     d["materials"][0]["pbrMetallicRoughness"] = {{"baseColorFactor", {1.0, 0.5, 0.0, 1.0}}, {"metallicFactor", 0.5},
