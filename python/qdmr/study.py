@@ -21,10 +21,10 @@ def run(spec: Spec, out: Union[str, os.PathLike], *, resume: bool = True, thread
     once; shard=(I, N): the I-th of N shards only, balanced by estimated cost (`qdmr study --shard I/N`, merged
     by `qdmr study merge`).
 
-    client: a dask.distributed Client. The configurations are then drawn one task each on its workers: every
+    client: a dask.distributed Client. The configurations are then drawn a few per task on its workers: every
     worker process keeps one set of persistent renderers across its tasks and draws whole groups of configurations
     that share the exact reference and the heights it is traced on, taking from the others' runs when its own is
-    done and that pays, and from workers that have left; the rows come back to this process, which writes OUT as a
+    done and the times measured so far say that pays, and from workers that have left; the rows come back to this process, which writes OUT as a
     one-process run does (the same files; resume works across both). The
     folder must be on a file system the workers share with the caller (kept images are written there). threads
     then defaults to the worker's thread count.

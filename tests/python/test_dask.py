@@ -90,28 +90,68 @@ def test_configurations_are_grouped_by_the_reference_and_heights_they_share():
         measurer.share_groups([8])
 
 
-def test_a_worker_takes_from_another_run_only_when_it_pays():
+def schedule_of(*runs):
+    """A _Schedule of two workers' runs (group 0: configurations below 20, group 1 the others), every estimated cost 1."""
     from collections import deque
     from qdmr import _dask
-    group_of = {i: 0 if i < 20 else 1 for i in range(40)}
-    # Its own run first, in order.
-    queues = [deque([0, 1]), deque([20, 21, 22])]
-    assert _dask._next(queues, 0, group_of, set(), set()) == 0
-    # Done, and the other run is short and of a group it has not drawn: nothing (it would compute that group's
-    # reference again for two configurations).
-    queues = [deque(), deque([20, 21, 22])]
-    assert _dask._next(queues, 0, group_of, {0}, set()) is None and list(queues[1]) == [20, 21, 22]
-    # Of a group it has drawn: the back half, in order.
-    queues = [deque(), deque([20, 21, 22, 23])]
-    assert _dask._next(queues, 0, group_of, {0, 1}, set()) == 22
-    assert list(queues[0]) == [23] and list(queues[1]) == [20, 21]
-    # A long run of another group: its back half.
-    queues = [deque(), deque(range(20, 20 + _dask.MIN_STEAL))]
-    assert _dask._next(queues, 0, group_of, {0}, set()) == 20 + _dask.MIN_STEAL // 2
-    assert len(queues[1]) == _dask.MIN_STEAL // 2
-    # A lost worker's run, however short.
-    queues = [deque(), deque([20])]
-    assert _dask._next(queues, 0, group_of, {0}, {1}) == 20
+    indices = [i for run in runs for i in run]
+    return _dask._Schedule([deque(run) for run in runs], {i: 0 if i < 20 else 1 for i in indices},
+                           {i: 1.0 for i in indices})
+
+
+def test_tasks_shrink_to_single_configurations_at_the_end_of_a_run():
+    from qdmr import _dask
+    s = schedule_of(range(20), [])
+    # Before any drawing time is known: FIRST_CHUNK configurations.
+    assert s.chunk(0, 0.0) == list(range(_dask.FIRST_CHUNK)) == [0, 1, 2]
+    # The group's first costs 0.9 s beyond its estimate (its reference and heights), the others 0.1 s a unit.
+    s.finished(0, [(0, 1.0), (1, 0.1), (2, 0.1)], [], 0.3)
+    assert s.rate(0) == pytest.approx(0.1) and s.entry_cost() == pytest.approx(0.9)
+    # Then a third of the run left (17 configurations: 5), fewer and fewer, the last ones single.
+    sizes = []
+    while chunk := s.chunk(0, 0.3):
+        sizes.append(len(chunk))
+        s.finished(0, [(i, 0.1) for i in chunk], [], 0.3)
+    assert sizes == [5, 4, 2, 2, 1, 1, 1, 1] and sum(sizes) == 17
+    # CHUNK_SECONDS bounds a task of a long run: 2 s at 0.1 s a unit.
+    s = schedule_of(range(20), range(20, 20 + 300))
+    s.finished(1, [(i, 0.1) for i in s.chunk(1, 0.0)], [], 0.3)
+    assert len(s.chunk(1, 0.3)) == int(_dask.CHUNK_SECONDS / 0.1)
+
+
+def test_a_worker_takes_from_another_run_only_when_it_pays():
+    # Worker 1 has drawn 3 of its 20 configurations: 0.1 s each, its group's first 0.9 s more.
+    def started(s):
+        assert s.chunk(1, 0.0) == [20, 21, 22]
+        s.finished(1, [(20, 1.0), (21, 0.1), (22, 0.1)], [], 0.3)
+        return s
+    # 17 left (1.7 s): worker 0, done, takes the last 4 (0.9 s for the group's reference and heights, then 0.4 s:
+    # both finish 1.3 s from now), and draws them in its owner's order.
+    s = started(schedule_of([], range(20, 40)))
+    assert s.chunk(0, 0.3) == [36] and list(s.queues[0]) == [37, 38, 39] and s.queues[1][-1] == 35
+    # 8 left (0.8 s): computing the group's reference and heights again would finish later than leaving them.
+    s = started(schedule_of([], range(20, 31)))
+    assert s.chunk(0, 0.3) == [] and list(s.queues[1]) == list(range(23, 31))
+    # Of a group worker 0 has drawn: half of them.
+    s = started(schedule_of([], range(20, 31)))
+    s.drawn[0].add(1)
+    assert s.chunk(0, 0.3) == [27] and list(s.queues[1]) == list(range(23, 27))
+    # What worker 1 is drawing now counts, less the time since it began: 8 left after 3 given 0.1 s ago.
+    s = started(schedule_of([], range(20, 34)))
+    assert s.chunk(1, 0.3) == [23, 24, 25]
+    assert s.left(1, 0.4) == pytest.approx(0.2 + 0.8)
+    # A lost worker's run, however short: the back half.
+    s = started(schedule_of([], range(20, 25)))
+    s.lost.add(1)
+    assert s.chunk(0, 0.3) == [24] and list(s.queues[1]) == [23]
+
+
+def test_a_configuration_that_fails_after_others_is_sent_again_alone():
+    s = schedule_of(range(10), [])
+    assert s.chunk(0, 0.0) == [0, 1, 2]
+    s.finished(0, [(0, 1.0)], [1, 2], 0.5)  # 1 failed: 0's row came back, 1 and 2 were not drawn
+    assert s.chunk(0, 0.5) == [1]
+    assert s.flight[0] == [1]
 
 
 def test_a_lost_worker_s_configurations_are_drawn_by_the_others(tmp_path):
