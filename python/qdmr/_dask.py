@@ -20,6 +20,12 @@ from . import _qdmr
 _measurer: Optional[tuple] = None
 _measurer_lock = threading.Lock()  # a worker with several threads runs one configuration at a time
 
+IN_FLIGHT = 2  # tasks queued per worker: the next one starts while the caller takes the last one's rows
+WATCH_SECONDS = 1.0  # with no rows for this long, the caller checks whether a worker has left
+FIRST_CHUNK = 3  # configurations in each of a worker's first tasks, before any drawing time is known
+CHUNK_SECONDS = 2.0  # later tasks: about this long, or a third of the worker's run left if less (the last are single)
+MIN_GAIN = 0.05  # seconds a take from another worker's run must save, by the times measured so far
+
 
 def _keep_freed_memory() -> None:
     """Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536 (distributed.nanny.pre-spawn-environ). Setting
@@ -44,11 +50,6 @@ def _worker_threads() -> Optional[int]:
         return get_worker().state.nthreads
     except (ImportError, ValueError, AttributeError):
         return None
-IN_FLIGHT = 2  # tasks queued per worker: the next one starts while the caller takes the last one's rows
-WATCH_SECONDS = 1.0  # with no rows for this long, the caller checks whether a worker has left
-FIRST_CHUNK = 3  # configurations in each of a worker's first tasks, before any drawing time is known
-CHUNK_SECONDS = 2.0  # later tasks: about this long, or a third of the worker's run left if less (the last are single)
-MIN_GAIN = 0.05  # seconds a take from another worker's run must save, by the times measured so far
 
 
 def _measure(spec: Any, base_dir: Optional[str], force: bool, threads: Optional[int], spec_hash: str, out: str,
