@@ -83,7 +83,7 @@ int run_bench(const BenchArgs& args) {
                          : std::filesystem::path(args.image);
 
   auto start = Clock::now();
-  const SceneDesc scene = load_scene(args.scene, overrides);
+  const SceneDesc scene = load_scene(args.scene, overrides, 0, options.threads);  // on the draw's threads
   const double load_ms = ms_since(start);
 
   Renderer renderer(options);

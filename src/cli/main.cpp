@@ -179,8 +179,8 @@ int run_render(const SceneArgs& args, const RenderArgs& render) {
 
   auto start = Clock::now();
   const qdmr::SceneDesc scene = [&] {
-    try {  // a glTF mesh's drawn copies are held to the limit before they are read
-      return qdmr::load_scene(args.scene, overrides(args, &render), options.max_memory_bytes);
+    try {  // a glTF mesh's drawn copies are held to the limit before they are read; --threads bounds the load too
+      return qdmr::load_scene(args.scene, overrides(args, &render), options.max_memory_bytes, options.threads);
     } catch (const qdmr::Error& e) {
       const std::string what = e.what();
       if (what.find("MiB, more than the limit of") == std::string::npos) throw;

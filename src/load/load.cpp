@@ -9,6 +9,9 @@
 #include <set>
 #include <sstream>
 
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
 #include "file/input_file.hpp"
 #include "qdmr/core/error.hpp"
 #include "qdmr/mesh/mesh.hpp"
@@ -142,31 +145,43 @@ SceneDesc load_gltf_asset(const std::filesystem::path& file, const std::vector<S
   return scene;
 }
 
+// load() in an arena of `threads` threads (at most the cores: oneTBB would give no more), or in the caller's
+// arena (threads 0, or as many as it has).
+template <class Load>
+SceneDesc on_threads(int threads, const Load& load) {
+  if (threads <= 0) return load();
+  const int bounded = std::min(threads, tbb::info::default_concurrency());
+  if (bounded == tbb::this_task_arena::max_concurrency()) return load();
+  return tbb::task_arena(bounded).execute(load);
+}
+
 }  // namespace
 
 SceneDesc load_scene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides,
-                     std::uint64_t max_memory_bytes) {
-  if (is_gltf_file(file)) return load_gltf_asset(file, overrides, max_memory_bytes);
-  const nlohmann::json document = scene_detail::parse_json_file(file, InputKind::Scene);
-  return load_scene_json(document, file, file.parent_path(), overrides, max_memory_bytes);
+                     std::uint64_t max_memory_bytes, int threads) {
+  return on_threads(threads, [&] {
+    if (is_gltf_file(file)) return load_gltf_asset(file, overrides, max_memory_bytes);
+    const nlohmann::json document = scene_detail::parse_json_file(file, InputKind::Scene);
+    return load_scene_json(document, file, file.parent_path(), overrides, max_memory_bytes);
+  });
 }
 
 SceneDesc load_scene_json(const nlohmann::json& document, const std::filesystem::path& name,
                           const std::filesystem::path& base_dir, const std::vector<SceneOverride>& overrides,
-                          std::uint64_t max_memory_bytes) {
-  const scene_detail::Context context{name.string(), base_dir};
-  if (overrides.empty()) {
-    SceneDesc scene = scene_detail::validate_scene(document, context);
-    resolve_file_meshes(scene, document, context, max_memory_bytes);
+                          std::uint64_t max_memory_bytes, int threads) {
+  return on_threads(threads, [&] {
+    const scene_detail::Context context{name.string(), base_dir};
+    nlohmann::json overridden;
+    if (!overrides.empty()) {
+      overridden = document;
+      scene_detail::apply_overrides(overridden, overrides, context.file);
+    }
+    const nlohmann::json& used = overrides.empty() ? document : overridden;
+    SceneDesc scene = scene_detail::validate_scene(used, context);
+    resolve_file_meshes(scene, used, context, max_memory_bytes);
     check_file_sequences(scene);
     return scene;
-  }
-  nlohmann::json overridden = document;
-  scene_detail::apply_overrides(overridden, overrides, context.file);
-  SceneDesc scene = scene_detail::validate_scene(overridden, context);
-  resolve_file_meshes(scene, overridden, context, max_memory_bytes);
-  check_file_sequences(scene);
-  return scene;
+  });
 }
 
 }  // namespace qdmr

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -279,7 +280,11 @@ struct CornerBatch {
   }
 };
 
+std::atomic<std::size_t> parts_seen{0};
+
 }  // namespace
+
+std::size_t take_mikktspace_parts_seen() { return parts_seen.exchange(0); }
 
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                                      std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
@@ -300,6 +305,8 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
   std::once_flag mirrored_made;
   std::vector<std::uint8_t> flags(n, 0);
   const std::size_t parts = std::size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+  for (std::size_t seen = parts_seen.load(); seen < parts && !parts_seen.compare_exchange_weak(seen, parts);) {
+  }
   tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
     const std::uint32_t lo = std::uint32_t(n * part / parts), hi = std::uint32_t(n * (part + 1) / parts);
     const auto mine = [&](std::uint32_t v) { return same[v] >= lo && same[v] < hi; };

@@ -14,6 +14,7 @@
 // connected through shared edges share a tangent here) and its angular split threshold (off by default there too).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -41,6 +42,10 @@ struct MikkTSpaceCopies {
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                                      std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
                                      std::span<glm::vec4> tangents);
+
+// The most parts (the vertices' shares, one a thread of the caller's arena) a call of mikktspace_tangents has
+// split its work into since the last take; taking it resets it. A seam for tests: the threads a load ran on.
+std::size_t take_mikktspace_parts_seen();
 
 // acos from +, *, / and sqrt only (Cephes' asinf polynomial, in double): the same bits on every machine, where
 // libm's acos may take an FMA variant on some CPUs. Accurate to about 1e-7; x is clamped to [-1, 1].

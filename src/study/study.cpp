@@ -83,18 +83,20 @@ StudyConfig baseline_config(const StudySpec& spec, const StudyConfig& config) {
   return base;
 }
 
-// The base scene's document, read once; each configuration is its overrides applied in memory.
+// The base scene's document, read once; each configuration is its overrides applied in memory, loaded on the
+// configuration's threads (0: every core).
 class SceneSource {
 public:
-  explicit SceneSource(const std::filesystem::path& file)
-      : file_(file), document_(scene_detail::parse_json_file(file, InputKind::Scene)) {}
+  SceneSource(const std::filesystem::path& file, int threads)
+      : file_(file), document_(scene_detail::parse_json_file(file, InputKind::Scene)), threads_(threads) {}
   SceneDesc load(const std::vector<SceneOverride>& overrides) const {
-    return load_scene_json(document_, file_, file_.parent_path(), overrides);
+    return load_scene_json(document_, file_, file_.parent_path(), overrides, 0, threads_);
   }
 
 private:
   std::filesystem::path file_;
   nlohmann::json document_;
+  int threads_;
 };
 
 // One configuration's row: everything deterministic from a frame without AOVs (timing) and one with the error
@@ -392,7 +394,7 @@ std::vector<std::size_t> shard_configurations(const StudySpec& spec, const std::
 
 struct StudyMeasurer::State {
   State(const StudySpec& s, int threads, bool force)
-      : spec(s), configs(expand_study(spec, force)), source(spec.scene), camera(base_camera(spec, source)),
+      : spec(s), configs(expand_study(spec, force)), source(spec.scene, threads), camera(base_camera(spec, source)),
         measurer(spec, source, threads) {}
   StudySpec spec;
   std::vector<StudyConfig> configs;
