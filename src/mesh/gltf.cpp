@@ -293,22 +293,30 @@ public:
       return;
     }
     read(*e.source, e.first, e.count * e.bytes, reinterpret_cast<unsigned char*>(out));
-    const std::size_t bad = first_where(e.count, [&](std::size_t i) {
-      bool finite = true;
-      for (std::size_t c = 0; c < components; ++c) finite &= std::isfinite(out[components * i + c]);
-      return !finite;
-    });
+    // Float by float: one is not finite where its exponent's bits are all set.
+    const std::size_t bad = first_where(components * e.count, [&](std::size_t j) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, out + j, 4);
+      return (bits & 0x7f800000u) == 0x7f800000u;
+    }) / components;
     if (bad < e.count) fail("/accessors/" + std::to_string(index), "element " + std::to_string(bad) + " is not finite");
   }
 
-  // The smallest i < count for which bad(i), else count; on threads.
+  // The smallest i < count for which bad(i), else count; on threads. Blocks of kCheckBlock are first asked whether
+  // any i is bad, without stopping at one (a loop the compiler vectorises); a block where one is, is searched.
   template <class Bad>
   static std::size_t first_where(std::size_t count, Bad&& bad) {
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, count, kCheckGrain), count,
         [&](const tbb::blocked_range<std::size_t>& r, std::size_t found) {
-          for (std::size_t i = r.begin(); i < r.end() && i < found; ++i)
-            if (bad(i)) return i;
+          for (std::size_t lo = r.begin(); lo < r.end() && lo < found; lo += kCheckBlock) {
+            const std::size_t hi = std::min(r.end(), lo + kCheckBlock);
+            unsigned any = 0;
+            for (std::size_t i = lo; i < hi; ++i) any |= unsigned(bad(i));
+            if (any)
+              for (std::size_t i = lo;; ++i)
+                if (bad(i)) return std::min(i, found);
+          }
           return found;
         },
         [](std::size_t a, std::size_t b) { return std::min(a, b); });
@@ -359,6 +367,7 @@ public:
 private:
   static constexpr std::size_t kBlockBytes = std::size_t(64) << 10;
   static constexpr std::size_t kCheckGrain = 16384;  // elements a task checks
+  static constexpr std::size_t kCheckBlock = 512;    // elements checked before a hit is looked for
   const tinygltf::Model& model_;
   const std::vector<BufferSource>& buffers_;
   std::string where_;

@@ -10,12 +10,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "mesh/mikktspace.hpp"
+#include "qdmr/core/error.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/mesh/mesh.hpp"
 #include "support/test_support.hpp"
@@ -27,7 +30,8 @@ namespace fs = std::filesystem;
 
 // A wavy 48 x 48 grid as a .gltf beside its .bin: POSITION, NORMAL, TEXCOORD_0 (mirrored in u on its right half,
 // so MikkTSpace splits the seam's vertices), 32-bit indices, no TANGENT (MikkTSpace makes them).
-fs::path threads_test_grid(const test::TempDir& dir) {
+fs::path threads_test_grid(const test::TempDir& dir,
+                           const std::function<void(std::vector<float>&, std::vector<std::uint32_t>&)>& edit = {}) {
   constexpr int kSize = 48;
   std::vector<float> positions, normals, uvs;
   for (int j = 0; j <= kSize; ++j)
@@ -43,6 +47,7 @@ fs::path threads_test_grid(const test::TempDir& dir) {
     for (int i = 0; i < kSize; ++i)
       indices.insert(indices.end(), {vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j),
                                      vertex(i + 1, j + 1), vertex(i, j + 1)});
+  if (edit) edit(positions, indices);
   std::string bin;
   nlohmann::json views = nlohmann::json::array();
   const auto append = [&](const void* data, std::size_t bytes) {
@@ -129,6 +134,37 @@ TEST(LoadThreads, TheLoadedMeshHasTheSameBitsForAnyThreadCount) {
     EXPECT_TRUE(threads_test_same_bits(mesh.uvs, reference.uvs));
     EXPECT_TRUE(threads_test_same_bits(mesh.tangents, reference.tangents));
     EXPECT_TRUE(threads_test_same_bits(mesh.indices, reference.indices));
+  }
+}
+
+// The checks of the accessors run on threads, a block at a time: the first bad element is named, on any count.
+TEST(LoadThreads, TheFirstBadElementIsNamedOnAnyThreadCount) {
+  const auto error = [](const fs::path& file, int threads) {
+    try {
+      load_scene(file, {}, 0, threads);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const auto has = [](const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos ? testing::AssertionSuccess()
+                                                : testing::AssertionFailure() << "'" << text << "' lacks '" << part << "'";
+  };
+  test::TempDir a, b;
+  // Positions 700 (y) and 1900 (x) not finite: element 700 is named (2401 vertices: blocks of 512 floats).
+  const fs::path floats = threads_test_grid(a, [](std::vector<float>& p, std::vector<std::uint32_t>&) {
+    p[3 * 700 + 1] = std::numeric_limits<float>::quiet_NaN();
+    p[3 * 1900] = -std::numeric_limits<float>::infinity();
+  });
+  // Indices 3000 and 9000 past the vertices: index 3000 is named.
+  const fs::path indices = threads_test_grid(b, [](std::vector<float>&, std::vector<std::uint32_t>& i) {
+    i[3000] = 2401;
+    i[9000] = 5000;
+  });
+  for (const int threads : {1, 2}) {
+    EXPECT_TRUE(has(error(floats, threads), "/accessors/0: element 700 is not finite")) << threads;
+    EXPECT_TRUE(has(error(indices, threads), "/accessors/3: index 3000 is 2401, past the primitive's 2401 vertices")) << threads;
   }
 }
 
