@@ -19,6 +19,8 @@
 #include <xsimd/xsimd.hpp>
 
 #include "mesh/builders.hpp"
+#include "mesh/corner_batch.hpp"
+#include "qdmr/core/isa.hpp"
 
 namespace qdmr::mesh_detail {
 
@@ -130,157 +132,19 @@ std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<
   return same;
 }
 
-// Four faces at once in SSE2's four lanes (x86-64's baseline), a face a lane: its +u direction and UV orientation
-// (face_of), then for each corner k, one vector of four lanes each, the corner's direction (the face's +u in the
-// plane of the corner's normal, normalised) times its angle (between its edges projected onto that plane). Every
-// lane takes the scalar formulas' operations in their order (glm's dot is (x x + y y) + z z, its length the
-// square root of that, a vector over a scalar three divisions; deterministic_acos's argument chosen per lane, its
-// polynomial evaluated once), and SSE2 rounds as the scalar operations do: the same bits. The three corners' vectors are
-// independent: their divisions and square roots overlap.
-struct CornerBatch {
-  static constexpr int kFaces = 4;
-  // Input per face (lane i): its corners' positions, UVs and normals.
-  alignas(16) float px[3][kFaces]{}, py[3][kFaces]{}, pz[3][kFaces]{};
-  alignas(16) float u[3][kFaces]{}, v[3][kFaces]{};
-  alignas(16) float nx[3][kFaces]{}, ny[3][kFaces]{}, nz[3][kFaces]{};
-  // Output: corner k of face i at [k][i]; per face whether it is degenerate or preserves the UV orientation.
-  alignas(16) float wx[3][kFaces]{}, wy[3][kFaces]{}, wz[3][kFaces]{};
-  std::uint32_t degenerate = 0, preserving = 0;  // bit i: face i
-
-  void set(int face, std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-           std::span<const glm::vec2> uvs, const std::uint32_t* corner) {
-    for (int k = 0; k < 3; ++k) {
-      const glm::vec3 &p = positions[corner[k]], &n = normals[corner[k]];
-      const glm::vec2& t = uvs[corner[k]];
-      px[k][face] = p.x, py[k][face] = p.y, pz[k][face] = p.z, u[k][face] = t.x, v[k][face] = t.y;
-      nx[k][face] = n.x, ny[k][face] = n.y, nz[k][face] = n.z;
-    }
-  }
-
-  using Floats = xsimd::batch<float, xsimd::sse2>;
-  using Doubles = xsimd::batch<double, xsimd::sse2>;
-  using V = std::array<Floats, 3>;              // one vector per corner
-  using D = std::array<Doubles, 2 * 3>;         // a V's lanes 0-1 and 2-3 in double
-
-  void compute() {
-    const auto each = [](auto f, const auto&... in) {
-      std::remove_cvref_t<decltype((in, ...))> out;
-      for (std::size_t g = 0; g < out.size(); ++g) out[g] = f(in[g]...);
-      return out;
-    };
-    const auto load = [](const float (&from)[3][kFaces]) {
-      V r;
-      for (std::size_t k = 0; k < 3; ++k) r[k] = Floats::load_aligned(from[k]);
-      return r;
-    };
-    const auto add = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x + y; }, a, b); };
-    const auto sub = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x - y; }, a, b); };
-    const auto mul = [&](const V& a, const V& b) { return each([](const Floats& x, const Floats& y) { return x * y; }, a, b); };
-    const auto dot = [&](const V& ax, const V& ay, const V& az, const V& bx, const V& by, const V& bz) {
-      return add(add(mul(ax, bx), mul(ay, by)), mul(az, bz));
-    };
-    // not_zero(a) and a finite, for a = |x|.
-    const auto usable = [](const Floats& x) {
-      const Floats a = xsimd::abs(x);
-      return (a > Floats(std::numeric_limits<float>::min())) & (a <= Floats(std::numeric_limits<float>::max()));
-    };
-    // unit_or_zero, in place. Where every lane's length is exactly 1 (axis-aligned normals, and many that are
-    // already normalised) the divisions are skipped: x / 1 is x, every bit (-0, subnormals).
-    const auto unit = [&](V& x, V& y, V& z) {
-      const V len = each([](const Floats& d) { return xsimd::sqrt(d); }, dot(x, y, z, x, y, z));
-      for (std::size_t g = 0; g < len.size(); ++g) {
-        if (xsimd::all(len[g] == Floats(1.0f))) continue;
-        const auto ok = usable(len[g]);
-        x[g] = xsimd::select(ok, x[g] / len[g], Floats(0.0f));
-        y[g] = xsimd::select(ok, y[g] / len[g], Floats(0.0f));
-        z[g] = xsimd::select(ok, z[g] / len[g], Floats(0.0f));
-      }
-    };
-    const V px_ = load(px), py_ = load(py), pz_ = load(pz);
-    // face_of: the UV area's sign and the +u direction, os * (+-1 / |os|), where both are usable.
-    const Floats d1x = px_[1] - px_[0], d1y = py_[1] - py_[0], d1z = pz_[1] - pz_[0];
-    const Floats d2x = px_[2] - px_[0], d2y = py_[2] - py_[0], d2z = pz_[2] - pz_[0];
-    const Floats u0 = Floats::load_aligned(u[0]), v0 = Floats::load_aligned(v[0]);
-    const Floats t21x = Floats::load_aligned(u[1]) - u0, t21y = Floats::load_aligned(v[1]) - v0;
-    const Floats t31x = Floats::load_aligned(u[2]) - u0, t31y = Floats::load_aligned(v[2]) - v0;
-    const Floats area = t21x * t31y - t21y * t31x;
-    const auto keeps = area > Floats(0.0f);
-    const Floats osx = t31y * d1x - t21y * d2x, osy = t31y * d1y - t21y * d2y, osz = t31y * d1z - t21y * d2z;
-    const Floats os_len = xsimd::sqrt((osx * osx + osy * osy) + osz * osz);
-    const Floats scale = xsimd::select(keeps, Floats(1.0f), Floats(-1.0f)) / os_len;
-    const auto ok = (xsimd::abs(area) > Floats(std::numeric_limits<float>::min())) & usable(os_len);
-    preserving = std::uint32_t(_mm_movemask_ps(keeps));  // intrinsics: xsimd 8 has no mask-to-bits
-    degenerate = ~std::uint32_t(_mm_movemask_ps(ok)) & 0xfu;
-    const Floats ux = osx * scale, uy = osy * scale, uz = osz * scale;
-
-    V nx_ = load(nx), ny_ = load(ny), nz_ = load(nz);
-    unit(nx_, ny_, nz_);
-    // in_plane: v - n dot(n, v), normalised; the edges' projections alike (not normalised).
-    const auto project = [&](V& x, V& y, V& z) {
-      const V d = dot(nx_, ny_, nz_, x, y, z);
-      x = sub(x, mul(nx_, d));
-      y = sub(y, mul(ny_, d));
-      z = sub(z, mul(nz_, d));
-    };
-    V tx{ux, ux, ux}, ty{uy, uy, uy}, tz{uz, uz, uz};
-    project(tx, ty, tz);
-    unit(tx, ty, tz);
-    // Corner k's edges: to corner k + 2 (a) and to corner k + 1 (b).
-    const V ax_ = {px_[2], px_[0], px_[1]}, ay_ = {py_[2], py_[0], py_[1]}, az_ = {pz_[2], pz_[0], pz_[1]};
-    const V bx_ = {px_[1], px_[2], px_[0]}, by_ = {py_[1], py_[2], py_[0]}, bz_ = {pz_[1], pz_[2], pz_[0]};
-    V ex = sub(ax_, px_), ey = sub(ay_, py_), ez = sub(az_, pz_);
-    V fx = sub(bx_, px_), fy = sub(by_, py_), fz = sub(bz_, pz_);
-    project(ex, ey, ez);
-    project(fx, fy, fz);
-    // Float lanes to double lanes and back, two at a time, by intrinsics: xsimd converts only between batches of
-    // one lane count.
-    const auto wide = [](const V& x) {
-      D d;
-      for (std::size_t g = 0; g < x.size(); ++g) {
-        d[2 * g] = _mm_cvtps_pd(x[g]);
-        d[2 * g + 1] = _mm_cvtps_pd(_mm_movehl_ps(x[g], x[g]));
-      }
-      return d;
-    };
-    const D aa = wide(dot(ex, ey, ez, ex, ey, ez)), bb = wide(dot(fx, fy, fz, fx, fy, fz)),
-            ab = wide(dot(ex, ey, ez, fx, fy, fz));
-    // The corner's angle in double: cosine ab / sqrt(aa bb) (0 where aa bb is not positive and finite), then
-    // deterministic_acos (std::clamp, through which NaN passes, then its branch).
-    const D lengths2 = each([](const Doubles& a, const Doubles& b) { return a * b; }, aa, bb);
-    const D root = each([](const Doubles& l) { return xsimd::sqrt(l); }, lengths2);
-    const D x = each([](const Doubles& l, const Doubles& r, const Doubles& d) {
-      const auto fine = (l > Doubles(0.0)) & (l <= Doubles(std::numeric_limits<double>::max()));
-      const Doubles c = xsimd::select(fine, d / r, Doubles(0.0)), one(1.0), minus_one(-1.0);
-      return xsimd::select(c < minus_one, minus_one, xsimd::select(one < c, one, c));
-    }, lengths2, root, ab);
-    const D abs_x = each([](const Doubles& a) { return xsimd::abs(a); }, x);
-    // asin_small of a (|x| <= 0.5) or of sqrt((1 - a) / 2) (above): the branch's argument chosen first, the
-    // polynomial evaluated once.
-    const auto asin_small = [](const Doubles& a) {
-      const Doubles z = a * a;
-      Doubles p = Doubles(4.2163199048e-2) * z + Doubles(2.4181311049e-2);
-      p = p * z + Doubles(4.5470025998e-2);
-      p = p * z + Doubles(7.4953002686e-2);
-      p = p * z + Doubles(1.6666752422e-1);
-      return a + (a * z) * p;
-    };
-    const D angle = each([&](const Doubles& c, const Doubles& a) {
-      const Doubles half_pi(1.57079632679489661923);
-      const auto small = a <= Doubles(0.5);
-      const Doubles s = asin_small(xsimd::select(small, a, xsimd::sqrt((Doubles(1.0) - a) * Doubles(0.5))));
-      const Doubles asin_a = xsimd::select(small, s, half_pi - Doubles(2.0) * s);
-      return xsimd::select(c < Doubles(0.0), half_pi + asin_a, half_pi - asin_a);
-    }, x, abs_x);
-    for (std::size_t k = 0; k < 3; ++k) {
-      const Floats w = _mm_movelh_ps(_mm_cvtpd_ps(angle[2 * k]), _mm_cvtpd_ps(angle[2 * k + 1]));
-      (w * tx[k]).store_aligned(wx[k]);
-      (w * ty[k]).store_aligned(wy[k]);
-      (w * tz[k]).store_aligned(wz[k]);
-    }
-  }
-};
 
 std::atomic<std::size_t> parts_seen{0};
+
+// Whether the corners go through AVX2's eight lanes: where this build has them, the CPU has AVX2 and `isa` (Auto:
+// the ISA the draw would take, $QDMR_ISA where set) is AVX2 or better. Either width gives the same bits.
+bool eight_lanes(Isa isa) {
+#ifdef QDMR_KERNEL_AVX2
+  return cpu_supports(Isa::Avx2) && resolve_isa(isa, "MikkTSpace") >= Isa::Avx2;
+#else
+  static_cast<void>(isa);
+  return false;
+#endif
+}
 
 }  // namespace
 
@@ -288,7 +152,7 @@ std::size_t take_mikktspace_parts_seen() { return parts_seen.exchange(0); }
 
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                                      std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
-                                     std::span<glm::vec4> tangents) {
+                                     std::span<glm::vec4> tangents, Isa isa) {
   const std::size_t n = positions.size(), faces = indices.size() / 3;
   const auto normal = [&](std::uint32_t v) { return unit_or_zero(normals[v]); };
   const std::vector<std::uint32_t> same = weld(positions, normals, uvs, tangents);
@@ -307,19 +171,20 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
   const std::size_t parts = std::size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
   for (std::size_t seen = parts_seen.load(); seen < parts && !parts_seen.compare_exchange_weak(seen, parts);) {
   }
-  tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
+  // Faces wait in a batch for their directions and their corners' weights, then are summed in order: the same
+  // sums for either batch width.
+  const auto sum_part = [&](std::size_t part, auto batch, auto compute) {
+    constexpr int kFaces = decltype(batch)::kFaces;
     const std::uint32_t lo = std::uint32_t(n * part / parts), hi = std::uint32_t(n * (part + 1) / parts);
     const auto mine = [&](std::uint32_t v) { return same[v] >= lo && same[v] < hi; };
-    // Faces wait in a batch of four for their directions and their corners' weights, then are summed in order.
-    CornerBatch batch;
     struct Waiting {
       const std::uint32_t* corner;
       bool own[3];
     };
-    std::array<Waiting, CornerBatch::kFaces> waiting{};
+    std::array<Waiting, kFaces> waiting{};
     int count = 0;
     const auto sum_batch = [&] {
-      batch.compute();
+      compute(batch);
       for (int i = 0; i < count; ++i) {
         if (batch.degenerate >> i & 1) continue;
         const Waiting& face = waiting[std::size_t(i)];
@@ -351,9 +216,17 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
       Waiting& w = waiting[std::size_t(count)];  // field by field (a whole struct stored then copied stalls)
       w.corner = corner;
       w.own[0] = own0, w.own[1] = own1, w.own[2] = own2;
-      if (++count == CornerBatch::kFaces) sum_batch();
+      if (++count == kFaces) sum_batch();
     }
     if (count > 0) sum_batch();
+  };
+  const bool wide = eight_lanes(isa);
+  tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
+    if (wide) {
+      sum_part(part, CornerBatch<8>{}, [](CornerBatch<8>& b) { avx2::compute_corners(b); });
+    } else {
+      sum_part(part, CornerBatch<4>{}, [](CornerBatch<4>& b) { compute_corners<xsimd::sse2>(b); });
+    }
   });
   const bool any_mirrored = !mirrored_sum.empty();
 

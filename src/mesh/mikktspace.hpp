@@ -23,6 +23,8 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "qdmr/core/isa.hpp"
+
 namespace qdmr::mesh_detail {
 
 // The vertices a mirrored UV seam splits: copy k of a mesh of n vertices is vertex n + k, a copy of vertex of[k]
@@ -35,13 +37,15 @@ struct MikkTSpaceCopies {
 // positions and normals per vertex (normals need not be unit length), uvs one per vertex (qdmr's: v up),
 // `indices` 3 per triangle, rewritten where a corner moves to a copy of its vertex; `tangents` (one per vertex) is
 // written. The weld and the work over triangles run on threads, each summing the corners of its own vertices in
-// triangle order (the triangles' directions and their corners' angles four triangles at a time in SSE2 lanes,
-// rounded as the scalar formulas): the same bits for any thread count. Working memory beside the result: 4 bytes
+// triangle order (the triangles' directions and their corners' angles four or eight triangles at a time in SIMD
+// lanes, rounded as the scalar formulas): the same bits for any thread count. Working memory beside the result: 4 bytes
 // a vertex (its kind), 1 (flags); welding hashes in `tangents` before they are written; where UVs are mirrored 16
 // more (the mirrored sums, the copies).
+// The corners' arithmetic runs in SSE2's four lanes, or AVX2's eight where the CPU has them and `isa` (Auto: the
+// one the draw would take) allows them (mesh/corner_batch.hpp): the same bits either way.
 MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                                      std::span<const glm::vec2> uvs, std::span<std::uint32_t> indices,
-                                     std::span<glm::vec4> tangents);
+                                     std::span<glm::vec4> tangents, Isa isa = Isa::Auto);
 
 // The most parts (the vertices' shares, one a thread of the caller's arena) a call of mikktspace_tangents has
 // split its work into since the last take; taking it resets it. A seam for tests: the threads a load ran on.
