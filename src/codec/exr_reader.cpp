@@ -21,6 +21,9 @@
 #include <string_view>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
+#include "codec/exr_writer.hpp"
 #include "codec/native_reader.hpp"
 
 namespace qdmr::imageio {
@@ -76,7 +79,12 @@ class ExrReader final : public NativeReader {
 public:
   bool open(const std::string& path, ReadSpec& spec, std::string& error) {
     try {
-      file_ = std::make_unique<Imf::InputFile>(path.c_str());
+      // The threads of the caller's task arena, as a write takes them (codec/image_file.hpp): the chunks are
+      // decompressed on that many threads of their own, 1 being the calling thread alone (ExrThreads), never on
+      // the pool that OpenEXR's other users in the process (OpenImageIO among them) share.
+      const ExrThreads threads(tbb::this_task_arena::max_concurrency());
+      threads_ = threads.threads();
+      file_ = std::make_unique<Imf::InputFile>(path.c_str(), threads_);
       const Imf::Header& header = file_->header();
       if (header.hasType() && Imf::isDeepData(header.type())) {
         error = "deep OpenEXR data (samples per pixel) is not an image qdmr reads";
@@ -134,6 +142,7 @@ public:
     const std::int64_t band = std::clamp<std::int64_t>((std::int64_t(16) << 20) / std::int64_t(row_bytes), 1, 64);
     const auto buffer = std::make_unique_for_overwrite<char[]>(row_bytes * std::size_t(std::min(band, height_)));
     try {
+      const ExrThreads threads(threads_);
       for (std::int64_t y0 = 0; y0 < height_; y0 += band) {
         const std::int64_t rows = std::min(band, height_ - y0);
         Imf::FrameBuffer frame;
@@ -173,6 +182,7 @@ private:
   }
 
   std::unique_ptr<Imf::InputFile> file_;
+  int threads_ = 1;                // OpenEXR's threads for the file (ExrThreads)
   std::vector<Channel> channels_;  // in OpenImageIO's order
   int x_ = 0, y_ = 0;              // the data window's corner
   std::int64_t width_ = 0, height_ = 0;

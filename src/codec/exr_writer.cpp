@@ -73,12 +73,12 @@ std::vector<std::string> channel_names(const imageio::WriteSpec& spec) {
 }
 
 // OpenEXR compresses a file's chunks as tasks on its global thread pool. The provider below, installed on that pool
-// once, runs the tasks of a write that may use k threads (ExrWriteThreads, set around the write on the calling
+// once, runs the tasks of a write or read that may use k threads (ExrThreads, set around it on the calling
 // thread) on a pool of its own with k threads, and k = 1 in the calling thread itself (an OpenEXR pool of no
 // threads); every other task (OpenImageIO's reads and writes outside such a scope) goes to a shared pool of the
 // size the process set, or of one thread per core as the OpenImageIO backend sets it (pvt::set_exr_threads).
 // OpenEXR forwards setGlobalThreadCount to the provider, which sizes the shared pool.
-thread_local int t_write_threads = 0;  // 0: no ExrWriteThreads scope on this thread
+thread_local int t_exr_threads = 0;  // 0: no ExrThreads scope on this thread
 
 class ExrPools final : public IlmThread::ThreadPoolProvider {
 public:
@@ -86,7 +86,7 @@ public:
   int numThreads() const override { return shared_.numThreads(); }
   void setNumThreads(int count) override { shared_.setNumThreads(count); }
   void addTask(IlmThread::Task* task) override {
-    const int k = t_write_threads;
+    const int k = t_exr_threads;
     if (k == 0) return shared_.addTask(task);
     IlmThread::ThreadPool* pool = nullptr;
     {
@@ -121,12 +121,14 @@ void install_exr_pools() {
 
 }  // namespace
 
-ExrWriteThreads::ExrWriteThreads(int threads) : previous_(t_write_threads) {
+ExrThreads::ExrThreads(int threads) : previous_(t_exr_threads) {
   install_exr_pools();
-  t_write_threads = std::max(1, threads > 0 ? threads : int(std::thread::hardware_concurrency()));
+  t_exr_threads = std::max(1, threads > 0 ? threads : int(std::thread::hardware_concurrency()));
 }
 
-ExrWriteThreads::~ExrWriteThreads() { t_write_threads = previous_; }
+ExrThreads::~ExrThreads() { t_exr_threads = previous_; }
+
+int ExrThreads::threads() const { return t_exr_threads; }
 
 bool exr_writes(const imageio::WriteSpec& spec) {
   if (spec.type != imageio::PixelType::Float || spec.width < 1 || spec.height < 1 || spec.channels < 1 ||
@@ -148,7 +150,7 @@ bool exr_writes(const imageio::WriteSpec& spec) {
 }
 
 bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const void* data, std::string& error) {
-  const ExrWriteThreads threads(spec.threads);
+  const ExrThreads threads(spec.threads);
   CheckedStream stream(path);
   if (stream.failure() != 0) {
     error = std::strerror(stream.failure());
@@ -165,7 +167,7 @@ bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const vo
     char* base = static_cast<char*>(const_cast<void*>(data));
     for (std::size_t c = 0; c < names.size(); ++c)
       frame.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), pixel, pixel * std::size_t(spec.width)));
-    Imf::OutputFile file(stream, header, t_write_threads);  // 2 x that many chunks in flight
+    Imf::OutputFile file(stream, header, threads.threads());  // 2 x that many chunks in flight
     file.setFrameBuffer(frame);
     file.writePixels(spec.height);
   } catch (const std::exception& e) {

@@ -18,18 +18,21 @@ bool exr_writes(const imageio::WriteSpec& spec);
 
 // Writes `data` (rows top-down, channels interleaved) into the existing file `path` (truncated); on failure returns
 // false with `error` set to the first OS error (a full disk) or OpenEXR's message (the caller removes the file).
-// The chunks are compressed on spec.threads threads (ExrWriteThreads).
+// The chunks are compressed on spec.threads threads (ExrThreads).
 bool write_exr(const std::string& path, const imageio::WriteSpec& spec, const void* data, std::string& error);
 
-// While it lives, the OpenEXR files this thread writes (write_exr, or OpenImageIO's writer) are compressed on
-// `threads` threads of their own (0: one per core), and with 1 in the calling thread alone: OpenEXR's global pool
-// gets a provider that sends this thread's tasks there (exr_writer.cpp), the bytes are the same on any count.
-class ExrWriteThreads {
+// While it lives, the OpenEXR files this thread writes (write_exr, or OpenImageIO's writer) are compressed, and the
+// files it reads (codec/exr_reader.cpp) decompressed, on `threads` threads of their own (0: one per core), and with
+// 1 in the calling thread alone: OpenEXR's global pool gets a provider that sends this thread's tasks there
+// (exr_writer.cpp), not to the pool other users of OpenEXR in the process share. The bytes and pixels are the same
+// on any count.
+class ExrThreads {
 public:
-  explicit ExrWriteThreads(int threads);
-  ~ExrWriteThreads();
-  ExrWriteThreads(const ExrWriteThreads&) = delete;
-  ExrWriteThreads& operator=(const ExrWriteThreads&) = delete;
+  explicit ExrThreads(int threads);
+  ~ExrThreads();
+  ExrThreads(const ExrThreads&) = delete;
+  ExrThreads& operator=(const ExrThreads&) = delete;
+  int threads() const;  // the count in effect, at least 1: OpenEXR's numThreads for the file (its chunks in flight)
 
 private:
   int previous_;

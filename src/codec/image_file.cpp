@@ -39,7 +39,7 @@ void write_image_file(const std::filesystem::path& file, const imageio::WriteSpe
   }
   const imageio::Backend& backend = imageio::backend();  // loaded before the temporary exists
   write_atomically(file, what, [&](const std::filesystem::path& temporary) -> std::string {
-    const ExrWriteThreads threads(stamped.threads);  // an EXR that write_exr leaves to OpenImageIO
+    const ExrThreads threads(stamped.threads);  // an EXR that write_exr leaves to OpenImageIO
     std::string error;
     return backend.write(temporary.string(), stamped, data, error) ? "" : error;
   });

@@ -1,11 +1,16 @@
 // Writes keep to the threads asked for (WriteOptions::threads, qdmr/write/write.hpp): with 1, the calling thread
 // alone encodes and compresses a PNG (its bands of rows, which otherwise run on oneTBB's workers) and a float EXR
 // (OpenEXR's chunks, which otherwise go to a thread pool, codec/exr_writer.cpp), and the files hold the bytes of a
-// write on every core. Measured by CPU time: the calling thread's (RUSAGE_THREAD) against the whole process's.
+// write on every core. Reads of OpenEXR files keep to the threads of the caller's task arena the same way, and not
+// on the pool OpenEXR's other users share. Measured by CPU time: the calling thread's (RUSAGE_THREAD) against the
+// whole process's.
 #include <gtest/gtest.h>
 
+#include <ImfThreading.h>
 #include <sys/resource.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -13,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "qdmr/texture/image.hpp"
 #include "qdmr/write/write.hpp"
 #include "support/test_support.hpp"
 
@@ -82,6 +88,50 @@ TEST(WriteThreads, OneThreadWritesOnTheCallingThreadAloneWithTheSameBytes) {
     const CpuSplit cpu = cpu_of([&] { write("two-again.exr", 2); });
     EXPECT_GT(cpu.others, cpu.caller) << "the others " << cpu.others << " s";
   }
+}
+
+// A renderer or study asked for 1 thread reads its OpenEXR inputs on 1 thread, even when the process has sized
+// OpenEXR's shared pool (as OpenImageIO does, its exr_threads attribute): before, the reader handed its chunks to
+// that pool whatever the caller's arena.
+TEST(ReadThreads, OneThreadReadsAnExrOnTheCallingThreadAloneWithTheSamePixels) {
+  TempDir dir;
+  constexpr int kWidth = 1536, kHeight = 1024;
+  const std::vector<float> pixels = test_image(kWidth, kHeight);
+  const std::filesystem::path file = dir / "in.exr";
+  write_image(file, kWidth, kHeight, 3, pixels, true, WriteOptions{.threads = 1});  // float EXR: ZIP, 16-row chunks
+  const int shared = Imf::globalThreadCount();
+  Imf::setGlobalThreadCount(4);  // the process's shared pool: 4 threads waiting for chunks
+  const auto same = [&](const Image& image) {  // float EXR: the values written, the rows bottom-up (v = 0 first)
+    if (image.texels.size() != pixels.size()) return false;
+    const std::size_t row = std::size_t(kWidth) * 3;
+    for (std::size_t y = 0; y < std::size_t(kHeight); ++y)
+      if (!std::equal(pixels.begin() + std::ptrdiff_t((kHeight - 1 - y) * row),
+                      pixels.begin() + std::ptrdiff_t((kHeight - y) * row), image.texels.begin() + std::ptrdiff_t(y * row)))
+        return false;
+    return true;
+  };
+  const auto read_on = [&](int threads) {
+    tbb::task_arena arena(threads);
+    return arena.execute([&] { return read_image(file, "in.exr"); });
+  };
+  // The allowance for the other threads as in WriteThreads above: 1 ms plus 5 % of the caller's time; the shared
+  // pool would decompress nearly every chunk, tens of ms, while the caller waits.
+  Image one;
+  const CpuSplit cpu = cpu_of([&] { one = read_on(1); });
+  EXPECT_GT(cpu.caller, 0.005) << "too little work to tell";
+  EXPECT_LE(cpu.others, 0.001 + 0.05 * cpu.caller) << "the calling thread " << cpu.caller << " s";
+  EXPECT_TRUE(same(one));
+  // On 2 threads the chunks go to a pool of 2 threads of the read's own, which the measure sees; the same pixels.
+  Image two;
+  if (std::thread::hardware_concurrency() >= 2) {
+    const CpuSplit cpu2 = cpu_of([&] { two = read_on(2); });
+    EXPECT_GT(cpu2.others, cpu2.caller) << "the others " << cpu2.others << " s";
+  } else {
+    two = read_on(2);
+  }
+  EXPECT_TRUE(same(two));
+  EXPECT_TRUE(same(read_on(tbb::task_arena::automatic)));  // every core
+  Imf::setGlobalThreadCount(shared);
 }
 
 }  // namespace

@@ -34,7 +34,8 @@ struct Image {
 // qdmr accepts as an input file"): a regular file within the size limit, PNG, JPEG, OpenEXR, TIFF or PNM,
 // 1..16384 pixels a side, 1 to 4 channels, sane PNM fields, a JPEG with whole segments and its end marker (its
 // metadata segments are dropped unread: codec/jpeg_segments.hpp). Then a decoder error or warning, or a short
-// read, is an error too: never a partial image.
+// read, is an error too: never a partial image. An OpenEXR file is decompressed on the threads of the caller's
+// task arena (tbb::this_task_arena::max_concurrency(); 1: the calling thread alone).
 Image read_image(const std::filesystem::path& file, const std::string& where);
 
 struct ImageHeader {
