@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <tbb/task_arena.h>
 
 #include "cli/bench.hpp"
 #include "cli/check.hpp"
@@ -267,6 +268,7 @@ int run_plan(const SceneArgs& args, bool as_json) {
 struct ConeArgs {
   std::string height, output, kind = "conservative", channel = "r", address = "wrap";
   std::optional<std::int64_t> max_memory_mib;  // absent: half the RAM
+  std::optional<int> threads;                  // absent: every core
 };
 
 // The most `qdmr bake cone` holds at once, from the image's header: reading (the image as floats, and its 8- or
@@ -284,37 +286,9 @@ std::uint64_t cone_command_bytes(const qdmr::ImageHeader& header, qdmr::ConeKind
                    field + qdmr::cone_bake_bytes(header.width, header.height, kind, address), 2 * texels * sizeof(float)});
 }
 
-// qdmr bake cone: the cone map of one channel of a height image, as a 32-bit float EXR.
-int run_bake_cone(const ConeArgs& args) {
-  if (args.kind != "conservative" && args.kind != "relaxed")
-    throw qdmr::Error("--kind " + args.kind, "unknown cone kind (valid: conservative, relaxed)");
-  const std::string addresses[] = {"wrap", "clamp", "mirror"};
-  const auto address = std::find(std::begin(addresses), std::end(addresses), args.address);
-  if (address == std::end(addresses))
-    throw qdmr::Error("--address " + args.address, "unknown address mode (valid: wrap, clamp, mirror)");
-  const std::string channels = "rgba";
-  if (args.channel.size() != 1 || channels.find(args.channel[0]) == std::string::npos)
-    throw qdmr::Error("--channel " + args.channel, "unknown channel (valid: r, g, b, a)");
-  const std::uint64_t limit = max_memory_bytes(args.max_memory_mib);
-  const std::filesystem::path out = args.output;
-  if (out.extension() != ".exr") throw qdmr::Error("-o " + args.output, "the cone map is written as .exr");
-  const std::vector<qdmr::OutputPath> outputs{{"-o", out}};
-  qdmr::check_outputs(outputs);
-  const qdmr::ConeKind kind = args.kind == "relaxed" ? qdmr::ConeKind::Relaxed : qdmr::ConeKind::Conservative;
-  const qdmr::AddressMode mode = qdmr::AddressMode(address - std::begin(addresses));
-  // Everything that can refuse the job is checked from the header, before any pixel is decoded.
-  const qdmr::ImageHeader header = qdmr::read_image_header(args.height, args.height);
-  qdmr::check_outputs(outputs);  // the height image is a known input now
-  const int channel = int(channels.find(args.channel[0]));
-  if (channel >= header.channels)
-    throw qdmr::Error(args.height,
-                      "has " + std::to_string(header.channels) + " channel(s), no channel '" + args.channel + "'");
-  if (const std::uint64_t needed = cone_command_bytes(header, kind, mode); needed > limit)
-    throw qdmr::Error(args.height, "baking its " + std::to_string(header.width) + "x" + std::to_string(header.height) +
-                                       " " + qdmr::cone_kind_name(kind) + " cone map (address " + args.address +
-                                       ") needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +
-                                       " MiB, more than the limit of " + std::to_string(limit >> 20) + " MiB" +
-                                       max_memory_source(args.max_memory_mib));
+// The pixels of `qdmr bake cone`, once its arguments and the header are checked: read, bake, write.
+int bake_cone_in_arena(const ConeArgs& args, const qdmr::ImageHeader& header, qdmr::ConeKind kind,
+                       qdmr::AddressMode mode, int channel, const std::filesystem::path& out) {
   qdmr::HeightField field;
   {
     const qdmr::Image image = qdmr::read_image(args.height, args.height);
@@ -341,6 +315,46 @@ int run_bake_cone(const ConeArgs& args) {
   std::printf("%s: %dx%d %s cone map, %.1f ms\n", args.output.c_str(), map.width, map.height,
               qdmr::cone_kind_name(kind), bake_ms);
   return 0;
+}
+
+// qdmr bake cone: the cone map of one channel of a height image, as a 32-bit float EXR.
+int run_bake_cone(const ConeArgs& args) {
+  if (args.kind != "conservative" && args.kind != "relaxed")
+    throw qdmr::Error("--kind " + args.kind, "unknown cone kind (valid: conservative, relaxed)");
+  const std::string addresses[] = {"wrap", "clamp", "mirror"};
+  const auto address = std::find(std::begin(addresses), std::end(addresses), args.address);
+  if (address == std::end(addresses))
+    throw qdmr::Error("--address " + args.address, "unknown address mode (valid: wrap, clamp, mirror)");
+  const std::string channels = "rgba";
+  if (args.channel.size() != 1 || channels.find(args.channel[0]) == std::string::npos)
+    throw qdmr::Error("--channel " + args.channel, "unknown channel (valid: r, g, b, a)");
+  if (args.threads && (*args.threads < 1 || *args.threads > qdmr::limits::kMaxThreads))
+    throw qdmr::Error("--threads", "must be from 1 to " + std::to_string(qdmr::limits::kMaxThreads) + ", got " +
+                                       std::to_string(*args.threads) + " (omit it to use every core)");
+  const std::uint64_t limit = max_memory_bytes(args.max_memory_mib);
+  const std::filesystem::path out = args.output;
+  if (out.extension() != ".exr") throw qdmr::Error("-o " + args.output, "the cone map is written as .exr");
+  const std::vector<qdmr::OutputPath> outputs{{"-o", out}};
+  qdmr::check_outputs(outputs);
+  const qdmr::ConeKind kind = args.kind == "relaxed" ? qdmr::ConeKind::Relaxed : qdmr::ConeKind::Conservative;
+  const qdmr::AddressMode mode = qdmr::AddressMode(address - std::begin(addresses));
+  // Everything that can refuse the job is checked from the header, before any pixel is decoded.
+  const qdmr::ImageHeader header = qdmr::read_image_header(args.height, args.height);
+  qdmr::check_outputs(outputs);  // the height image is a known input now
+  const int channel = int(channels.find(args.channel[0]));
+  if (channel >= header.channels)
+    throw qdmr::Error(args.height,
+                      "has " + std::to_string(header.channels) + " channel(s), no channel '" + args.channel + "'");
+  if (const std::uint64_t needed = cone_command_bytes(header, kind, mode); needed > limit)
+    throw qdmr::Error(args.height, "baking its " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                                       " " + qdmr::cone_kind_name(kind) + " cone map (address " + args.address +
+                                       ") needs an estimated " + std::to_string((needed + (1 << 20) - 1) >> 20) +
+                                       " MiB, more than the limit of " + std::to_string(limit >> 20) + " MiB" +
+                                       max_memory_source(args.max_memory_mib));
+  // Reading, baking and writing on --threads threads: the height file's decoding (an OpenEXR file's chunks), the
+  // bake's rows and the cone map's chunks run on this arena or pools of its size (the same bits on any count).
+  tbb::task_arena arena(args.threads.value_or(tbb::task_arena::automatic));
+  return arena.execute([&] { return bake_cone_in_arena(args, header, kind, mode, channel, out); });
 }
 
 std::string mib_text(std::uint64_t bytes) {
@@ -464,6 +478,9 @@ int main(int argc, char** argv) {
   cone_cmd->add_option("--address", cone.address, "Address mode of the map: wrap (default), clamp or mirror");
   cone_cmd->add_option("--max-memory", cone.max_memory_mib,
                        "Refuse a bake whose estimated memory exceeds this many MiB (default: half the RAM)");
+  cone_cmd->add_option("--threads", cone.threads,
+                       "Worker threads reading, baking and writing, 1 to 256 (default: every core). Every count gives "
+                       "the same bits");
 
   qdmr::cli::CheckArgs check;
   CLI::App* check_cmd = app.add_subcommand(

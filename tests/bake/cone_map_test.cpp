@@ -530,12 +530,17 @@ void write_gray_png(const fs::path& file, int w, int h, const std::vector<std::u
   ASSERT_TRUE(out->close());
 }
 
+// w x h 8-bit heights of noise from `seed`.
+std::vector<std::uint8_t> noise_heights(int w, int h, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<std::uint8_t> pixels(std::size_t(w) * std::size_t(h));
+  for (auto& p : pixels) p = std::uint8_t(rng() % 256);
+  return pixels;
+}
+
 TEST(ConeMapCli, BakesTheSameMapAsTheLibrary) {
   TempDir dir;
-  std::mt19937 rng(4);
-  std::vector<std::uint8_t> pixels(24 * 20);
-  for (auto& p : pixels) p = std::uint8_t(rng() % 256);
-  write_gray_png(dir / "height.png", 24, 20, pixels);
+  write_gray_png(dir / "height.png", 24, 20, noise_heights(24, 20, 4));
   fs::create_directory(dir / "out");
   for (const auto& [kind_name, kind, address_name, address] :
        {std::tuple{"conservative", ConeKind::Conservative, "wrap", AddressMode::Wrap},
@@ -560,6 +565,34 @@ TEST(ConeMapCli, BakesTheSameMapAsTheLibrary) {
   EXPECT_EQ(count, 2u);
 }
 
+// --threads bounds the bake (and its read and write) to a task arena of that many threads, like render's: every
+// count writes the same bytes, those of a bake on every core. 160x120 texels of noise: many rows for the bake's
+// parallel loops, and an EXR input of several chunks.
+TEST(ConeMapCli, EveryThreadCountWritesTheSameBytes) {
+  TempDir dir;
+  const std::vector<std::uint8_t> pixels = noise_heights(160, 120, 7);
+  write_gray_png(dir / "height.png", 160, 120, pixels);
+  write_gray_png(dir / "height.exr", 160, 120, pixels);  // OpenImageIO writes it as OpenEXR: k / 255 as halves
+  const CommandResult help = run(cli(), {"bake", "cone", "--help"});
+  EXPECT_NE(help.output.find("--threads"), std::string::npos) << help.output;
+  for (const char* kind : {"conservative", "relaxed"}) {
+    SCOPED_TRACE(kind);
+    const auto bake = [&](const fs::path& in, const std::string& name, const std::vector<std::string>& threads) {
+      std::vector<std::string> args = {"bake", "cone", in.string(), "--kind", kind, "-o", (dir / name).string()};
+      args.insert(args.end(), threads.begin(), threads.end());
+      const CommandResult result = run(cli(), args);
+      EXPECT_EQ(result.exit_code, 0) << result.output;
+      return read_file(dir / name);
+    };
+    const std::string all = bake(dir / "height.png", "all.exr", {});
+    EXPECT_EQ(bake(dir / "height.png", "one.exr", {"--threads", "1"}), all);
+    EXPECT_EQ(bake(dir / "height.png", "two.exr", {"--threads", "2"}), all);
+    EXPECT_EQ(bake(dir / "height.png", "five.exr", {"--threads", "5"}), all);
+    // An OpenEXR input (several chunks), read on 1 thread and on every core.
+    EXPECT_EQ(bake(dir / "height.exr", "exr-one.exr", {"--threads", "1"}), bake(dir / "height.exr", "exr-all.exr", {}));
+  }
+}
+
 TEST(ConeMapCli, BadInputGivesOneErrorLineAndWritesNothing) {
   TempDir dir;
   write_gray_png(dir / "height.png", 4, 4, std::vector<std::uint8_t>(16, 100));
@@ -572,6 +605,9 @@ TEST(ConeMapCli, BadInputGivesOneErrorLineAndWritesNothing) {
       {"bake", "cone", in, "--kind", "wide", "-o", out},
       {"bake", "cone", in, "--address", "border", "-o", out},
       {"bake", "cone", in, "--channel", "g", "-o", out},
+      {"bake", "cone", in, "--threads", "0", "-o", out},
+      {"bake", "cone", in, "--threads", "257", "-o", out},
+      {"bake", "cone", in, "--threads", "many", "-o", out},
       {"bake", "cone", in, "-o", (dir / "out" / "c.png").string()},
       {"bake", "cone", in, "-o", (dir / "nowhere" / "c.exr").string()},
       {"bake", "cone", in},
