@@ -20,6 +20,7 @@
 
 #include "mesh/builders.hpp"
 #include "mesh/corner_batch.hpp"
+#include "qdmr/core/error.hpp"
 #include "qdmr/core/isa.hpp"
 
 namespace qdmr::mesh_detail {
@@ -136,10 +137,17 @@ std::vector<std::uint32_t> weld(std::span<const glm::vec3> positions, std::span<
 std::atomic<std::size_t> parts_seen{0};
 
 // Whether the corners go through AVX2's eight lanes: where this build has them, the CPU has AVX2 and `isa` (Auto:
-// the ISA the draw would take, $QDMR_ISA where set) is AVX2 or better. Either width gives the same bits.
+// the ISA the draw would take, $QDMR_ISA where set) is AVX2 or better. Either width gives the same bits, so a
+// $QDMR_ISA the draw will refuse is left for the draw to name: the load goes on with what the CPU has.
 bool eight_lanes(Isa isa) {
 #ifdef QDMR_KERNEL_AVX2
-  return cpu_supports(Isa::Avx2) && resolve_isa(isa, "MikkTSpace") >= Isa::Avx2;
+  if (!cpu_supports(Isa::Avx2)) return false;
+  try {
+    return resolve_isa(isa, "MikkTSpace") >= Isa::Avx2;
+  } catch (const Error&) {
+    if (isa != Isa::Auto) throw;
+    return true;
+  }
 #else
   static_cast<void>(isa);
   return false;
