@@ -186,22 +186,29 @@ std::vector<SceneOverride> overrides_arg(py::handle value, const char* function)
   type_error(function, "overrides", "a dict of JSON pointers and values or a list of 'POINTER=VALUE' strings", value);
 }
 
-Scene load_scene_arg(py::handle scene, py::handle overrides, py::handle base_dir) {
+Scene load_scene_arg(py::handle scene, py::handle overrides, py::handle base_dir, py::handle threads_value) {
   const char* fn = "load_scene";
   const std::vector<SceneOverride> sets = overrides_arg(overrides, fn);
+  int threads = 0;  // every core
+  if (!threads_value.is_none()) {
+    threads = int_arg(threads_value, fn, "threads");
+    if (threads < 1 || threads > limits::kMaxThreads)
+      throw BadValue("load_scene(): threads must be from 1 to " + std::to_string(limits::kMaxThreads) +
+                     " (or None for every core), got " + std::to_string(threads));
+  }
   if (PyDict_Check(scene.ptr())) {
     const nlohmann::json document = from_python(scene, fn, "scene");
     const std::filesystem::path base =
         base_dir.is_none() ? std::filesystem::current_path() : std::filesystem::path(path_arg(base_dir, fn, "base_dir"));
     py::gil_scoped_release release;
-    return Scene{load_scene_json(document, "<scene dict>", std::filesystem::absolute(base), sets)};
+    return Scene{load_scene_json(document, "<scene dict>", std::filesystem::absolute(base), sets, 0, threads)};
   }
   if (!PyUnicode_Check(scene.ptr()) && !PyObject_HasAttrString(scene.ptr(), "__fspath__"))
     type_error(fn, "scene", "a path (str or os.PathLike) or a dict", scene);
   const std::string path = path_arg(scene, fn, "scene");
   if (const std::string reason = non_regular_reason(path); !reason.empty()) throw InputFailure(path + ": " + reason);
   py::gil_scoped_release release;
-  return Scene{load_scene(path, sets)};
+  return Scene{load_scene(path, sets, 0, threads)};
 }
 
 const Scene& scene_arg(py::handle value, const char* function) {
@@ -548,11 +555,13 @@ PYBIND11_MODULE(_qdmr, m) {
       });
 
   m.def("load_scene", &load_scene_arg, py::arg("scene"), py::arg("overrides") = py::none(), py::kw_only(),
-        py::arg("base_dir") = py::none(),
-        "load_scene(scene, overrides=None, *, base_dir=None) -> Scene\n\n"
-        "Reads a scene file (str or os.PathLike) or a scene dict, applies the overrides first (a dict of JSON\n"
-        "pointers and values, or a list of 'POINTER=VALUE' strings: `qdmr render --set`), validates it and reads\n"
-        "its OBJ meshes. Relative paths of a dict resolve against base_dir (default: the current folder).\n"
+        py::arg("base_dir") = py::none(), py::arg("threads") = py::none(),
+        "load_scene(scene, overrides=None, *, base_dir=None, threads=None) -> Scene\n\n"
+        "Reads a scene file (str or os.PathLike), a glTF asset (.gltf, .glb) or a scene dict, applies the overrides\n"
+        "first (a dict of JSON pointers and values, or a list of 'POINTER=VALUE' strings: `qdmr render --set`),\n"
+        "validates it and reads its meshes. Relative paths of a dict resolve against base_dir (default: the current\n"
+        "folder). threads: at most that many threads for the load's parallel parts (a glTF mesh's reads, its\n"
+        "MikkTSpace tangents), as `qdmr render --threads`; None: every core. The same Scene for any count.\n"
         "Raises SceneError naming the file and the field, InputError for a file that cannot be read.");
 
   m.def("plan", [](py::handle scene, py::handle aovs) {

@@ -3,6 +3,7 @@
 import gc
 import json
 import os
+import struct
 import threading
 import time
 
@@ -135,3 +136,70 @@ def test_two_threads_render_at_once():
         assert numpy.array_equal(results[name], expected)
     (a_start, a_end), (b_start, b_end) = intervals["a"], intervals["b"]
     assert max(a_start, b_start) < min(a_end, b_end)  # the two draws overlapped
+
+
+def grid_glb(path, resolution):
+    """A flat grid of resolution^2 quads as one .glb without TANGENT: its load derives MikkTSpace tangents."""
+    n = resolution + 1
+    u, v = numpy.meshgrid(numpy.arange(n, dtype=numpy.float32) / resolution,
+                          numpy.arange(n, dtype=numpy.float32) / resolution)
+    positions = numpy.stack([2 * u - 1, numpy.zeros_like(u), 1 - 2 * v], -1).astype("<f4").tobytes()
+    normals = numpy.tile(numpy.array([0, 1, 0], "<f4"), n * n).tobytes()
+    uvs = numpy.stack([u, 1 - v], -1).astype("<f4").tobytes()
+    a = (numpy.arange(resolution)[:, None] * n + numpy.arange(resolution)[None, :]).ravel().astype(numpy.uint32)
+    indices = numpy.stack([a, a + 1, a + n + 1, a, a + n + 1, a + n], -1).astype("<u4").tobytes()
+    blobs, views, offset = [positions, normals, uvs, indices], [], 0
+    for b in blobs:
+        views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(b)})
+        offset += len(b)
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3}]}],
+           "accessors": [
+               {"bufferView": 0, "componentType": 5126, "count": n * n, "type": "VEC3", "min": [-1, 0, -1], "max": [1, 0, 1]},
+               {"bufferView": 1, "componentType": 5126, "count": n * n, "type": "VEC3"},
+               {"bufferView": 2, "componentType": 5126, "count": n * n, "type": "VEC2"},
+               {"bufferView": 3, "componentType": 5125, "count": len(indices) // 4, "type": "SCALAR"}],
+           "bufferViews": views, "buffers": [{"byteLength": offset}]}
+    js = json.dumps(doc).encode()
+    js += b" " * (-len(js) % 4)
+    body = b"".join(blobs)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<4sII", b"glTF", 2, 28 + len(js) + len(body)) + struct.pack("<II", len(js), 0x4E4F534A) + js +
+                struct.pack("<II", len(body), 0x004E4942) + body)
+
+
+def test_load_scene_threads_bound_the_load(tmp_path):
+    # 320k triangles without tangents: MikkTSpace's parts take tens of ms, split over the cores unless bounded.
+    path = str(tmp_path / "grid.glb")
+    grid_glb(path, 400)
+    small = {"/output/width": 32, "/output/height": 18}
+
+    def load(threads):
+        # The call releases the GIL: the calling thread's CPU time is the load's own thread's; the process's minus
+        # it is every other thread's (time.thread_time / time.process_time: the scheduler's exact run times).
+        thread0, process0 = time.thread_time(), time.process_time()
+        scene = qdmr.load_scene(path, small, threads=threads)
+        caller = time.thread_time() - thread0
+        return scene, caller, (time.process_time() - process0) - caller
+
+    one, caller, others = load(1)
+    assert caller > 0.005, "too little work to tell"
+    # As tests/write/write_threads_test.cpp allows: 1 ms (a wake-up or two of idle workers) plus 5 % of the caller's.
+    assert others <= 0.001 + 0.05 * caller, f"others {others} s against the caller's {caller} s"
+    if (os.cpu_count() or 1) >= 2:
+        every, _, others_every = load(None)
+        assert others_every > 0.001 + 0.05 * caller, "the measure sees the other threads when they work"
+    else:
+        every = qdmr.load_scene(path, small)
+    renderer = qdmr.Renderer(threads=1)
+    pixels = []
+    for scene in (one, every):
+        renderer.set_scene(scene)
+        pixels.append(renderer.draw().color.copy())
+    assert numpy.array_equal(pixels[0], pixels[1])  # the same scene for any count
+
+
+@pytest.mark.parametrize("threads, error", [(0, ValueError), (100000, ValueError), ("many", TypeError), (1.5, TypeError)])
+def test_load_scene_refuses_bad_threads(threads, error):
+    with pytest.raises(error, match="threads"):
+        qdmr.load_scene(PLANE, threads=threads)
