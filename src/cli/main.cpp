@@ -353,7 +353,8 @@ int run_bake_cone(const ConeArgs& args) {
                                        max_memory_source(args.max_memory_mib));
   // Reading, baking and writing on --threads threads: the height file's decoding (an OpenEXR file's chunks), the
   // bake's rows and the cone map's chunks run on this arena or pools of its size (the same bits on any count).
-  tbb::task_arena arena(args.threads.value_or(tbb::task_arena::automatic));
+  // (automatic by value: value_or binds a reference, and oneTBB's static const member has no definition to bind to.)
+  tbb::task_arena arena(args.threads ? *args.threads : int(tbb::task_arena::automatic));
   return arena.execute([&] { return bake_cone_in_arena(args, header, kind, mode, channel, out); });
 }
 

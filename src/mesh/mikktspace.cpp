@@ -228,13 +228,15 @@ MikkTSpaceCopies mikktspace_tangents(std::span<const glm::vec3> positions, std::
     }
     if (count > 0) sum_batch();
   };
-  const bool wide = eight_lanes(isa);
+  [[maybe_unused]] const bool wide = eight_lanes(isa);  // used where the AVX2 copy is built
   tbb::parallel_for(std::size_t(0), parts, [&](std::size_t part) {
+#ifdef QDMR_KERNEL_AVX2  // else mesh/corner_batch_avx2.cpp is not built (the fuzz preset), and `wide` is false
     if (wide) {
       sum_part(part, CornerBatch<8>{}, [](CornerBatch<8>& b) { avx2::compute_corners(b); });
-    } else {
-      sum_part(part, CornerBatch<4>{}, [](CornerBatch<4>& b) { compute_corners<xsimd::sse2>(b); });
+      return;
     }
+#endif
+    sum_part(part, CornerBatch<4>{}, [](CornerBatch<4>& b) { compute_corners<xsimd::sse2>(b); });
   });
   const bool any_mirrored = !mirrored_sum.empty();
 

@@ -297,7 +297,9 @@ TEST(MikkTSpace, TheSameBitsAsTheSlowPathOnRandomMeshes) {
     std::vector<std::uint32_t> slow_indices = indices;
     const Tangents slow = slow_tangents(positions, normals, uvs, slow_indices);
     with_copies += !slow.copies_of.empty();
-    for (const auto& [threads, isa] : runs) {
+    for (const auto& run : runs) {
+      const int threads = run.first;  // not a structured binding: clang 14 lets no lambda capture one
+      const Isa isa = run.second;
       std::vector<std::uint32_t> fast_indices = indices;
       tbb::task_arena arena(threads);
       const Tangents fast =
