@@ -24,7 +24,7 @@ namespace {
 // Bump when the definition, the rounding or the file layout of an AO map changes: old files stop matching.
 // Version 2: the shared bake-cache header (bake/float_cache.hpp).
 constexpr std::uint32_t kAoFormatVersion = 2;
-constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
+constexpr std::array<char, 8> kAoCacheMagic = {'Q', 'D', 'M', 'R', 'A', 'O', 'M', 'P'};
 
 template <class T>
 AoMapSize map_size(const HeightView<T>& field, const AoDesc& desc) { return ao_map_size(field.width, field.height, desc); }
@@ -198,7 +198,7 @@ Image load_or_bake_ao_map(const HeightView<T>& field, double depth_scale, const 
   const std::uint64_t key = ao_map_key(field, depth_scale, desc);
   const std::filesystem::path file = cache_dir / ("ao-" + hex(key) + ".bin");
   const AoMapSize size = map_size(field, desc);
-  const FloatCacheId id{kMagic, kAoFormatVersion, 0, size.width, size.height, key};
+  const FloatCacheId id{kAoCacheMagic, kAoFormatVersion, 0, size.width, size.height, key};
   if (Image cached(size.width, size.height, 1); read_float_cache(file, id, 0.0f, 1.0f, cached.texels)) return cached;
   Image map = bake_ao_map(field, depth_scale, desc, row);
   write_float_cache(file, id, map.texels);

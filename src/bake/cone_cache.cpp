@@ -17,7 +17,7 @@ namespace {
 
 // Bump when the definition, the rounding or the file layout of a cone map changes: old files stop matching.
 constexpr std::uint32_t kConeFormatVersion = 1;
-constexpr std::array<char, 8> kMagic = {'Q', 'D', 'M', 'R', 'C', 'O', 'N', 'E'};
+constexpr std::array<char, 8> kConeCacheMagic = {'Q', 'D', 'M', 'R', 'C', 'O', 'N', 'E'};
 
 }  // namespace
 
@@ -43,7 +43,7 @@ ConeMap load_or_bake_cone_map(const HeightField& field, ConeKind kind, const std
   const std::uint64_t key = cone_map_key(field, kind);
   const std::filesystem::path file =
       cache_dir / ("cone-" + std::string(cone_kind_name(kind)) + "-" + hex(key) + ".bin");
-  const FloatCacheId id{kMagic, kConeFormatVersion, std::uint32_t(kind), field.width, field.height, key};
+  const FloatCacheId id{kConeCacheMagic, kConeFormatVersion, std::uint32_t(kind), field.width, field.height, key};
   if (field.width > 0 && field.height > 0) {
     ConeMap cached;
     cached.width = field.width;
