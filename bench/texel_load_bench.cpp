@@ -80,6 +80,50 @@ void BM_Pairs(benchmark::State& state, Method method) {
   state.SetItemsProcessed(state.iterations() * 64 * (method == Method::Portable4 ? 4 : 8));
 }
 
+// Single 4-byte texels (load_bytes4, load_f32): one `vpgatherdd` against 8 scalar loads packed by vpinsrd
+// (simd::avx2_loads4), and 8 scalar loads through memory (the portable path). `Chained`: each vector's offsets
+// depend on the previous vector's loaded values (a walk that waits on its loads, as QDM's traversal does), else
+// independent (throughput). Name: single/<method>/<chained 0|1>/<table KiB>; items/s = lanes loaded per second.
+enum class Single { Gather, ByHand, Portable };
+
+void BM_Single(benchmark::State& state, Single method) {
+  const int bytes = int(state.range(1)) * 1024;
+  const bool chained = state.range(0) != 0;
+  std::vector<std::uint8_t> table(std::size_t(bytes) + 4);
+  for (std::size_t i = 0; i < table.size(); ++i) table[i] = std::uint8_t(i * 7);
+  const std::uint8_t* base = table.data();
+  __m256i seed = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8), sum = _mm256_setzero_si256();
+  for (auto _ : state) {
+    for (int i = 0; i < 64; ++i) {
+      __m256i offsets = next_offsets(seed, bytes);
+      if (chained) offsets = _mm256_and_si256(_mm256_xor_si256(offsets, sum), _mm256_set1_epi32((bytes - 1) & ~7));
+      __m256i value;
+      switch (method) {
+        case Single::Gather: value = _mm256_i32gather_epi32(reinterpret_cast<const int*>(base), offsets, 1); break;
+        case Single::ByHand: {
+          alignas(32) std::int32_t o[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(o), offsets);
+          value = simd::avx2_loads4<1>(base, o);
+          break;
+        }
+        case Single::Portable: value = simd::load_bytes4(base, simd::Int(offsets), simd::FetchPath::Portable); break;
+      }
+      sum = _mm256_add_epi32(sum, value);
+    }
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetItemsProcessed(state.iterations() * 64 * 8);
+}
+
+void single_args(benchmark::internal::Benchmark* b) {
+  for (const int chained : {0, 1})
+    for (const int kib : {16, 256, 16384}) b->Args({chained, kib});
+}
+
+BENCHMARK_CAPTURE(BM_Single, gather, Single::Gather)->Apply(single_args);
+BENCHMARK_CAPTURE(BM_Single, by_hand, Single::ByHand)->Apply(single_args);
+BENCHMARK_CAPTURE(BM_Single, portable, Single::Portable)->Apply(single_args);
+
 void table_sizes(benchmark::internal::Benchmark* b) { b->Arg(16)->Arg(256)->Arg(16384); }
 
 BENCHMARK_CAPTURE(BM_Pairs, by_hand, Method::ByHand)->Apply(table_sizes);

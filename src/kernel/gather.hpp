@@ -1,8 +1,9 @@
 #pragma once
-// Per-lane loads for texel fetch. On the Gather path the AVX2 and AVX-512 builds use the hardware gathers (xsimd
-// 8.1 never emits them), except where loads built by hand were measured faster (texel pairs, load_bytes8 and
-// load_f32x4_pair); the portable versions load lane by lane. Both return the same bits; FetchPath picks one at run
-// time so they can be measured side by side.
+// Per-lane loads for texel fetch. On the Gather path the AVX-512 build uses the hardware gathers (xsimd 8.1 never
+// emits them), except where loads built by hand were measured faster (texel pairs, load_bytes8 and load_f32x4_pair);
+// the AVX2 build builds its loads of single 4-byte values by hand too (avx2_loads4: Zen 3's gathers are microcoded).
+// The portable versions load lane by lane. All return the same bits; FetchPath picks one at run time so they can be
+// measured side by side.
 #include <cstdint>
 #include <cstring>
 
@@ -37,10 +38,47 @@ Float gather_f32(const float* base, const Int& index) { return _mm256_i32gather_
 inline constexpr bool kHasHardwareGather = false;
 #endif
 
+#if defined(__AVX2__) && !defined(__AVX512F__)
+// The AVX2 build's load_bytes4, load_i32 and load_f32: eight scalar loads instead of one vpgatherdd / vgatherdps.
+// On Zen 3 (AMD family 25, the AVX2-only machines issue #53 is judged on) a ymm gather is microcoded: 39 uops, one
+// per 8 cycles, latency up to 28 cycles (uops.info), against 8 loads and 7 inserts here. qdmr_texel_load_bench
+// (single/*, Zen 3): independent vectors alike (L1 1.84 G lanes/s gathered, 1.71 by hand; L2 1.22, 1.49), a chain
+// of dependent loads 1.29-1.35x faster by hand; frames in docs/performance-history.md. On Zen 5, whose gathers are
+// fast, hand-built loads measured 0.976-1.002x (sessions 33-37); the AVX-512 build keeps its gathers.
+// The 4 bytes at base + Scale * o[lane] for lanes a..a+3 in one 128-bit register: vmovd and three vpinsrd from memory.
+template <int Scale>
+[[gnu::always_inline]] inline __m128i load_four4(const void* base, const std::int32_t* o, int a) {
+  std::int32_t v[4];
+  for (int i = 0; i < 4; ++i)
+    std::memcpy(&v[i], static_cast<const std::uint8_t*>(base) + std::ptrdiff_t(o[a + i]) * Scale, 4);
+  __m128i r = _mm_cvtsi32_si128(v[0]);
+  r = _mm_insert_epi32(r, v[1], 1);
+  r = _mm_insert_epi32(r, v[2], 2);
+  return _mm_insert_epi32(r, v[3], 3);
+}
+
+// gather_i32<Scale> of 8 lanes from 8 scalar loads, o: the lanes' indices in memory.
+template <int Scale>
+[[gnu::always_inline]] inline __m256i avx2_loads4(const void* base, const std::int32_t* o) {
+  return _mm256_inserti128_si256(_mm256_castsi128_si256(load_four4<Scale>(base, o, 0)), load_four4<Scale>(base, o, 4),
+                                 1);
+}
+
+// avx2_loads4 with the indices in a vector.
+template <int Scale>
+[[gnu::always_inline]] inline __m256i avx2_loads4(const void* base, const Int& index) {
+  alignas(32) std::int32_t o[kLanes];
+  index.store_aligned(o);
+  return avx2_loads4<Scale>(base, o);
+}
+#endif
+
 // 4 bytes at base + byte_offset[lane] (unaligned), as a little-endian int32 per lane.
 inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPath path) {
-#if defined(__AVX2__)
+#if defined(__AVX512F__)
   if (path == FetchPath::Gather) return gather_i32<1>(base, byte_offset);
+#elif defined(__AVX2__)
+  if (path == FetchPath::Gather) return Int(avx2_loads4<1>(base, byte_offset));
 #endif
   (void)path;
   alignas(64) std::int32_t offset[kLanes], value[kLanes];
@@ -204,8 +242,10 @@ inline Int load_bytes4(const std::uint8_t* base, const Int& byte_offset, FetchPa
 
 // table[index[lane]] for int32 and float tables.
 inline Int load_i32(const std::int32_t* table, const Int& index, FetchPath path) {
-#if defined(__AVX2__)
+#if defined(__AVX512F__)
   if (path == FetchPath::Gather) return gather_i32<4>(table, index);
+#elif defined(__AVX2__)
+  if (path == FetchPath::Gather) return Int(avx2_loads4<4>(table, index));
 #endif
   (void)path;
   alignas(64) std::int32_t i[kLanes], value[kLanes];
@@ -230,8 +270,10 @@ inline Int lookup16(const std::int32_t* table, const Int& index) {
 }
 
 inline Float load_f32(const float* table, const Int& index, FetchPath path) {
-#if defined(__AVX2__)
+#if defined(__AVX512F__)
   if (path == FetchPath::Gather) return gather_f32<4>(table, index);
+#elif defined(__AVX2__)
+  if (path == FetchPath::Gather) return Float(_mm256_castsi256_ps(avx2_loads4<4>(table, index)));
 #endif
   (void)path;
   alignas(64) std::int32_t i[kLanes];
