@@ -1,6 +1,6 @@
 #pragma once
-// The kernels' side of the texture-cache recorder (texture/fetch_recorder.hpp): one test of a thread-local
-// pointer per texel fetch and per loop iteration when the cache is off.
+// The kernels' side of the texture-cache recorder (texture/fetch_recorder.hpp): one test of a process-wide count
+// per texel fetch and per loop iteration when the cache is off.
 #include <cstdint>
 
 #include "core/simd.hpp"
@@ -9,11 +9,11 @@
 namespace qdmr::QDMR_ISA_NAMESPACE {
 
 // Whether a texture-cache recorder listens on this thread (a program may then pick loops that never ask).
-inline bool fetch_recorder_listens() { return t_fetch_recorder != nullptr; }
+inline bool fetch_recorder_listens() { return listening_fetch_recorder() != nullptr; }
 
 // Reports texel (x, y) of the level starting at byte `level_offset` of `texture`, per lane, to the recorder.
 inline void trace_fetch(const Texture& texture, const simd::Int& level_offset, const simd::Int& x, const simd::Int& y) {
-  FetchRecorder* recorder = t_fetch_recorder;
+  FetchRecorder* recorder = listening_fetch_recorder();
   if (recorder == nullptr) [[likely]]
     return;
   alignas(64) std::int32_t o[simd::kLanes], xs[simd::kLanes], ys[simd::kLanes];
@@ -29,11 +29,11 @@ inline void trace_fetch(const Texture& texture, const simd::Int& level_offset, c
 // or the statistics would depend on which pixels share a batch, i.e. on the SIMD width.
 class FetchLanes {
 public:
-  FetchLanes() : recorder_(t_fetch_recorder) {
+  FetchLanes() : recorder_(listening_fetch_recorder()) {
     if (recorder_ != nullptr) [[unlikely]]
       saved_ = recorder_->enter(recorder_->phase());
   }
-  explicit FetchLanes(FetchPhase phase) : recorder_(t_fetch_recorder) {
+  explicit FetchLanes(FetchPhase phase) : recorder_(listening_fetch_recorder()) {
     if (recorder_ != nullptr) [[unlikely]]
       saved_ = recorder_->enter(phase);
   }

@@ -18,8 +18,14 @@ constexpr int y_of(std::uint64_t t) { return int(t & 0xFFFFFFu); }
 
 }  // namespace
 
-FetchRecorder::Listening::Listening(FetchRecorder& r) : saved_(t_fetch_recorder) { t_fetch_recorder = &r; }
-FetchRecorder::Listening::~Listening() { t_fetch_recorder = saved_; }
+FetchRecorder::Listening::Listening(FetchRecorder& r) : saved_(t_fetch_recorder) {
+  t_fetch_recorder = &r;
+  g_fetch_recorders_listening.fetch_add(1, std::memory_order_relaxed);
+}
+FetchRecorder::Listening::~Listening() {
+  g_fetch_recorders_listening.fetch_sub(1, std::memory_order_relaxed);
+  t_fetch_recorder = saved_;
+}
 
 FetchRecorder::FetchRecorder(const TextureCacheDesc& desc, const TextureAddressMap& addresses, int x0, int y0, int x1,
                              int y1)

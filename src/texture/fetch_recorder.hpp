@@ -7,6 +7,7 @@
 // runs of whole quads in draw order, so the result does not depend on the SIMD width or the thread count.
 // ISA-neutral and out of line (the kernels of every ISA call the same copy), reached through
 // kernel/fetch_trace.hpp.
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -24,11 +25,22 @@ struct CacheCounters {
 };
 
 class FetchRecorder;
-// The recorder of the tile this thread draws, or null (the cache is off): read on every texel fetch and per batch.
-// Initial-exec: a load at a fixed offset from %fs in the Python module as in the command (the default model in a
-// shared object is a call per read, even with TLS descriptors: 0.33 % of the module's draw). The module's
-// thread-locals (216 bytes) then live in glibc's static TLS reserve for modules loaded later (512 bytes).
-[[gnu::tls_model("initial-exec")]] inline thread_local FetchRecorder* t_fetch_recorder = nullptr;
+// The recorder of the tile this thread draws, or null (the cache is off). Read through listening_fetch_recorder().
+inline thread_local FetchRecorder* t_fetch_recorder = nullptr;
+// How many recorders listen in the process, on any thread (FetchRecorder::Listening counts them).
+inline std::atomic<int> g_fetch_recorders_listening{0};
+
+// This thread's recorder, or null: asked on every texel fetch and per batch. A plain load of the process-wide count
+// first, the thread-local only when some thread records. In a shared object (the Python module) a thread-local
+// read is a call (0.08 % of the module's draw with TLS descriptors), unless initial-exec, which would put the
+// module's thread-locals in glibc's small static TLS reserve for modules loaded later (`import qdmr` could fail
+// with "cannot allocate memory in static TLS block"). A thread sees its own Listening's count, so it never misses
+// its own recorder; another thread's count only sends it to its own, null, thread-local.
+inline FetchRecorder* listening_fetch_recorder() {
+  if (g_fetch_recorders_listening.load(std::memory_order_relaxed) == 0) [[likely]]
+    return nullptr;
+  return t_fetch_recorder;
+}
 
 class FetchRecorder {
 public:
