@@ -44,8 +44,9 @@ endfunction()
 # `fuzz` preset, do the same): the library's shared headers (nlohmann/json, OpenEXR, oneTBB) are parsed, and their
 # inline functions compiled, once per batch instead of once per file. The library's and the command's objects took
 # 279 s of CPU instead of 372 s from an empty Release folder (Zen 3, 2026-12-07, GCC 12; the second figure from the
-# ninja log of a CI run); a one-file change recompiles its batch. A file-local name (anonymous namespace or `static`) must not repeat in another file
-# of the same target. The draw kernels stay one object per file: their code is what the benchmarks time.
+# ninja log of a CI run); a one-file change recompiles its batch. A file-local name (anonymous namespace or
+# `static`) must not repeat in another file of the same target. The draw kernels stay one object per file: their
+# code is what the benchmarks time.
 function(qdmr_unity_build target)
   set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
