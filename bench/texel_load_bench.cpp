@@ -26,10 +26,16 @@ __m256i next_offsets(__m256i& state, int bytes) {
   return _mm256_and_si256(_mm256_srli_epi32(state, 4), _mm256_set1_epi32((bytes - 1) & ~7));
 }
 
-void BM_Pairs(benchmark::State& state, Method method) {
-  const int bytes = int(state.range(0)) * 1024;  // a power of two
-  std::vector<std::uint8_t> table(std::size_t(bytes) + 8);
+// A table of `bytes` (a power of two) to load from, and `tail` bytes more for a load at its last offset.
+std::vector<std::uint8_t> texel_table(int bytes, int tail) {
+  std::vector<std::uint8_t> table(std::size_t(bytes + tail));
   for (std::size_t i = 0; i < table.size(); ++i) table[i] = std::uint8_t(i * 7);
+  return table;
+}
+
+void BM_Pairs(benchmark::State& state, Method method) {
+  const int bytes = int(state.range(0)) * 1024;
+  const std::vector<std::uint8_t> table = texel_table(bytes, 8);
   const std::uint8_t* base = table.data();
   __m256i seed = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8), sum = _mm256_setzero_si256();
   for (auto _ : state) {
@@ -89,8 +95,7 @@ enum class Single { Gather, ByHand, Portable };
 void BM_Single(benchmark::State& state, Single method) {
   const int bytes = int(state.range(1)) * 1024;
   const bool chained = state.range(0) != 0;
-  std::vector<std::uint8_t> table(std::size_t(bytes) + 4);
-  for (std::size_t i = 0; i < table.size(); ++i) table[i] = std::uint8_t(i * 7);
+  const std::vector<std::uint8_t> table = texel_table(bytes, 4);
   const std::uint8_t* base = table.data();
   __m256i seed = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8), sum = _mm256_setzero_si256();
   for (auto _ : state) {
