@@ -425,19 +425,35 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
     return;
   }
   const BilinearTaps t = bilinear_taps(va, ka, u, v, info);
-  Float a00[4], a10[4], a01[4], a11[4], b00[4], b10[4], b01[4], b11[4];
   if (t.adjacent && interleaved != nullptr) {
-    // Per tap one 16-byte texel: a's rgb, then b's code, decoded as its chain's texel would be.
+    // Per tap one 16-byte texel: a's rgb, then b's code, decoded as its chain's texel would be. Each row is
+    // blended across as soon as it is read (filter_taps' operations, so its bits): the four taps of both textures
+    // at once (28 vectors) outgrew the registers, and their spills were a fifth of the sample's instructions.
     alignas(64) std::int32_t top[kLanes], bottom[kLanes];
     (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
     (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
-    simd::load_f32x4_pair_at(interleaved, top, ka.fetch, a00, a10);
-    simd::load_f32x4_pair_at(interleaved, bottom, ka.fetch, a01, a11);
-    decode(kb, xsimd::bitwise_cast<Int>(a00[3]), b00, 3);
-    decode(kb, xsimd::bitwise_cast<Int>(a10[3]), b10, 3);
-    decode(kb, xsimd::bitwise_cast<Int>(a01[3]), b01, 3);
-    decode(kb, xsimd::bitwise_cast<Int>(a11[3]), b11, 3);
-  } else if (t.adjacent) {
+    const auto across = [&](const std::int32_t* row, Float* rgb_a, Float* rgb_b) __attribute__((always_inline)) {
+      Float left[4], right[4], left_b[3], right_b[3];
+      simd::load_f32x4_pair_at(interleaved, row, ka.fetch, left, right);
+      decode(kb, xsimd::bitwise_cast<Int>(left[3]), left_b, 3);
+      decode(kb, xsimd::bitwise_cast<Int>(right[3]), right_b, 3);
+      for (int c = 0; c < 3; ++c) {
+        rgb_a[c] = left[c] + (right[c] - left[c]) * t.wx;
+        rgb_b[c] = left_b[c] + (right_b[c] - left_b[c]) * t.wx;
+      }
+    };
+    Float top_a[3], top_b[3], bottom_a[3], bottom_b[3];
+    across(top, top_a, top_b);
+    across(bottom, bottom_a, bottom_b);
+    for (int c = 0; c < 3; ++c) {
+      out[c] = top_a[c] + (bottom_a[c] - top_a[c]) * t.wy;
+      out[4 + c] = top_b[c] + (bottom_b[c] - top_b[c]) * t.wy;
+    }
+    out[3] = Float(1.0f);
+    return;
+  }
+  Float a00[4], a10[4], a01[4], a11[4], b00[4], b10[4], b01[4], b11[4];
+  if (t.adjacent) {
     alignas(64) std::int32_t top[kLanes], bottom[kLanes];
     (info.offset + (t.ya * info.width + t.xa) * Int(4)).store_aligned(top);
     (info.offset + (t.yb * info.width + t.xa) * Int(4)).store_aligned(bottom);
