@@ -8,6 +8,7 @@ import hashlib
 import json
 import os
 import re
+import select
 import shutil
 import signal
 import subprocess
@@ -68,10 +69,18 @@ def kill_after(args, seconds, sig=signal.SIGKILL, **kw):
     return p.returncode, err
 
 
-def start_study(spec, out, file):
-    """A study into `out`, returned once `file` appeared there."""
+def start_study(spec, out, file, limit=120):
+    """A study into `out`, returned once `file` appeared there; a failure if the study ends without it, or if it
+    has not appeared after `limit` seconds (a hang here would only show as the whole test's CTest timeout)."""
     p = subprocess.Popen([QDMR, "study", spec, "-o", out], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    while not os.path.exists(os.path.join(out, file)):
+    end = time.monotonic() + limit
+    path = os.path.join(out, file)
+    while not os.path.exists(path):
+        if p.poll() is not None and not os.path.exists(path):
+            pytest.fail(f"the study ended (exit {p.returncode}) before {file} appeared: {p.communicate()[1]}")
+        if time.monotonic() > end:
+            p.kill()
+            pytest.fail(f"{file} did not appear within {limit} s: {p.communicate()[1]}")
         time.sleep(0.002)
     return p
 
@@ -274,7 +283,11 @@ def test_a_long_bake_shows_its_progress_on_a_terminal_only(work):
     p = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=slave)
     os.close(slave)
     shown = b""
+    end = time.monotonic() + 120
     while True:
+        if not select.select([master], [], [], max(0.0, end - time.monotonic()))[0]:
+            p.kill()
+            pytest.fail(f"the bake did not end within 120 s; it showed {shown!r}")
         try:
             chunk = os.read(master, 4096)
         except OSError:  # the terminal's other end closed: the bake ended
@@ -387,7 +400,8 @@ def mounts(work):
     mounted = []
     try:
         for folder in (full, readonly):
-            r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", folder], capture_output=True, text=True)
+            r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", folder], capture_output=True, text=True,
+                               timeout=60)
             if r.returncode != 0:
                 pytest.skip(f"cannot mount a tmpfs ({r.stderr.strip() or 'mount failed'}): needs root")
             mounted.append(folder)
@@ -402,13 +416,13 @@ def mounts(work):
             except OSError:
                 pass
         os.close(filler)
-        r = subprocess.run(["mount", "-o", "remount,ro", readonly], capture_output=True, text=True)
+        r = subprocess.run(["mount", "-o", "remount,ro", readonly], capture_output=True, text=True, timeout=60)
         if r.returncode != 0:
             pytest.skip(f"cannot remount read-only: {r.stderr.strip()}")
         yield {"full": (full, "No space left on device"), "readonly": (readonly, "Read-only file system")}
     finally:
         for folder in mounted:
-            subprocess.run(["umount", folder])
+            subprocess.run(["umount", folder], timeout=60)
 
 
 def writers(work, folder):
