@@ -4,7 +4,7 @@
 // 4 bytes), two `vpgatherdq` (4 lanes of 8 bytes each); and the 4-lane portable path the SSE4.2 kernel takes, for
 // the per-lane comparison. Offsets are random in tables of 16 KiB (L1), 256 KiB (L2) and 16 MiB (beyond), and do
 // not depend on the loaded data (throughput, not latency).
-// Name: pairs/<method>/<table KiB>; items/s = lanes loaded per second.
+// Name: BM_Pairs/<method>/<table KiB>; items/s = lanes loaded per second.
 #include <benchmark/benchmark.h>
 
 #include <immintrin.h>
@@ -89,7 +89,7 @@ void BM_Pairs(benchmark::State& state, Method method) {
 // Single 4-byte texels (load_bytes4, load_f32): one `vpgatherdd` against 8 scalar loads packed by vpinsrd
 // (simd::avx2_loads4), and 8 scalar loads through memory (the portable path). `Chained`: each vector's offsets
 // depend on the previous vector's loaded values (a walk that waits on its loads, as QDM's traversal does), else
-// independent (throughput). Name: single/<method>/<chained 0|1>/<table KiB>; items/s = lanes loaded per second.
+// independent (throughput). Name: BM_Single/<method>/<chained 0|1>/<table KiB>; items/s = lanes loaded per second.
 enum class Single { Gather, ByHand, Portable };
 
 void BM_Single(benchmark::State& state, Single method) {
