@@ -13,13 +13,13 @@ namespace qdmr::test {
 namespace {
 
 // Small: the point is the file bytes, not the pixels (the golden test covers those at 480x270).
-constexpr int kWidth = 96, kHeight = 54;
+constexpr int kSameBytesWidth = 96, kSameBytesHeight = 54;
 
 void render_small(const ShippedScene& scene, const std::vector<std::string>& extra) {
   std::vector<std::string> args{"render"};
   const std::vector<std::string> scene_part = scene_args(scene);
   args.insert(args.end(), scene_part.begin(), scene_part.end());
-  args.insert(args.end(), {"--width", std::to_string(kWidth), "--height", std::to_string(kHeight)});
+  args.insert(args.end(), {"--width", std::to_string(kSameBytesWidth), "--height", std::to_string(kSameBytesHeight)});
   args.insert(args.end(), extra.begin(), extra.end());
   const CommandResult result = run(cli(), args);
   ASSERT_EQ(result.exit_code, 0) << scene.name << ":\n" << result.output;
