@@ -155,7 +155,13 @@ public:
     setup_ = &s;
     steps_ = edge_steps(s);
     program_ = static_cast<const ShadingProgram*>(ctx_.programs[s.material]);
+    varyings_ = program_->varying_count();
     for (int v = 0; v < 3; ++v) vertex_[v] = &ctx_.geometry->vertices[s.vertex[v]];
+    // Broadcast once where a few batches will read them (a 1-pixel triangle of a dense mesh would pay for nothing).
+    broadcast_once_ = (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) >= 4 * kLanes;
+    if (broadcast_once_)
+      for (int v = 0; v < 3; ++v)
+        for (int k = 0; k < varyings_; ++k) vertex_varyings_[v][k] = Float(vertex_[v]->varyings[k]);
 
     // Quads of different triangles share a batch only among triangles of one program.
     if (packed_quads_ > 0 && slots_[packing_].program != program_) flush_packed();
@@ -432,9 +438,10 @@ private:
     // float(x) + (dx + 0.5) is float(x + dx) + 0.5: every value is exact (pixel coordinates far below 2^23).
     in.pixel_x = Float(float(x)) + lane_centre_x_;
     in.pixel_y = Float(float(y)) + lane_centre_y_;
-    for (int k = 0; k < program_->varying_count(); ++k)
-      in.varyings[k] = b0 * Float(vertex_[0]->varyings[k]) + b1 * Float(vertex_[1]->varyings[k]) +
-                       b2 * Float(vertex_[2]->varyings[k]);
+    if (varyings_ == kVaryingCount)
+      interpolate<kVaryingCount>(in, b0, b1, b2);
+    else
+      interpolate<kBaseVaryingCount>(in, b0, b1, b2);
     in.view_depth = Float(float(s.area2)) * inv_sum;
     in.covered = simd::from_bits(pass);
     for (int q = 0; q < simd::kQuadsPerBatch; ++q) {
@@ -446,6 +453,21 @@ private:
     p.z = z;
     p.program = program_;
     return true;
+  }
+
+  // The first Count varyings at every lane from the barycentrics. A program interpolates every varying or all but
+  // the blend weights (kBaseVaryingCount): a count known at compile time unrolls the loop. AVX2: 6 instructions a
+  // varying with the vertex values broadcast once per triangle, 9 broadcasting them here, 11 before either.
+  template <int Count>
+  void interpolate(Fragments& in, const Float& b0, const Float& b1, const Float& b2) const {
+    if (broadcast_once_) {
+      for (int k = 0; k < Count; ++k)
+        in.varyings[k] = b0 * vertex_varyings_[0][k] + b1 * vertex_varyings_[1][k] + b2 * vertex_varyings_[2][k];
+    } else {
+      for (int k = 0; k < Count; ++k)
+        in.varyings[k] = b0 * Float(vertex_[0]->varyings[k]) + b1 * Float(vertex_[1]->varyings[k]) +
+                         b2 * Float(vertex_[2]->varyings[k]);
+    }
   }
 
   // The late depth test of a program that moved the surface, then the write.
@@ -550,6 +572,9 @@ private:
   EdgeSteps steps_{};
   const ShadingProgram* program_ = nullptr;
   const ScreenVertex* vertex_[3] = {};
+  int varyings_ = 0;  // program_'s varying count
+  bool broadcast_once_ = false;  // vertex_varyings_ holds the triangle's
+  Float vertex_varyings_[3][kVaryingCount];  // the vertices' first varyings_ varyings, broadcast
   FetchRecorder* recorder_;
   // Batches with an empty quad give their live quads to a packing batch, shared by consecutive triangles of one
   // program (only where a batch holds several quads; not while the recorder attributes fetches to triangles'
