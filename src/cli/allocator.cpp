@@ -5,7 +5,7 @@
 //                         the process's peak, which the plan's memory estimate already bounds.
 // Its memory is not asked onto transparent huge pages (jemalloc's thp:default; the framebuffer and the zeroed
 // buffers advise their own): on the AVX2 and AVX-512 VMs measured, a fresh 2 MiB page cost more per MB than 4 KiB
-// ones, and the cold terrain prepared in 387-434 ms against 587-758 with thp:always, warm frames alike
+// ones: the cold terrain prepared in 380-462 ms against 493-653 with thp:always on Zen 3, warm frames alike
 // (docs/performance-history.md). MALLOC_CONF=thp:always turns it back on.
 // The allocator never changes a result: no computation reads memory it did not write.
 #if defined(QDMR_JEMALLOC)
