@@ -39,9 +39,10 @@ void shade_lights_with(const Vec3& shading_normal, const Vec3& geometric_normal,
                        const SurfaceSample& surface, const Float* light_visibility, LightingModel model,
                        const LightingParams& lighting, const Roughness& roughness, const LightRig& lights, Float* color) {
   const Float zero(0.0f);
-  Float diffuse[3] = {Float(lights.ambient.x) * surface.ambient_occlusion, Float(lights.ambient.y) * surface.ambient_occlusion,
-                      Float(lights.ambient.z) * surface.ambient_occlusion};
-  Float specular[3] = {zero, zero, zero};
+  // The sums in named values, not arrays: GCC kept arrays of them on the stack, stored and reloaded at every batch.
+  Vec3 diffuse{Float(lights.ambient.x) * surface.ambient_occlusion, Float(lights.ambient.y) * surface.ambient_occlusion,
+               Float(lights.ambient.z) * surface.ambient_occlusion};
+  Vec3 specular{zero, zero, zero};
   const bool cook_torrance_model = model == LightingModel::CookTorrance;
   const Float n_dot_v = xsimd::max(dot(shading_normal, view), zero);
   for (std::size_t i = 0; i < lights.directional.size(); ++i) {
@@ -60,13 +61,13 @@ void shade_lights_with(const Vec3& shading_normal, const Vec3& geometric_normal,
       n_dot_l = n_dot_l * light_visibility[i];
       spec = spec * light_visibility[i];
     }
-    const float radiance[3] = {light.radiance.x, light.radiance.y, light.radiance.z};
-    for (int c = 0; c < 3; ++c) {
-      diffuse[c] += n_dot_l * Float(radiance[c]);
-      specular[c] += spec * Float(radiance[c]);
-    }
+    const Float red(light.radiance.x), green(light.radiance.y), blue(light.radiance.z);
+    diffuse = {diffuse.x + n_dot_l * red, diffuse.y + n_dot_l * green, diffuse.z + n_dot_l * blue};
+    specular = {specular.x + spec * red, specular.y + spec * green, specular.z + spec * blue};
   }
-  for (int c = 0; c < 3; ++c) color[c] = surface.albedo[c] * diffuse[c] + specular[c];
+  color[0] = surface.albedo[0] * diffuse.x + specular.x;
+  color[1] = surface.albedo[1] * diffuse.y + specular.y;
+  color[2] = surface.albedo[2] * diffuse.z + specular.z;
 }
 
 }  // namespace
