@@ -15,7 +15,7 @@ struct NormalMappingProgram::Samples {
   Float albedo[4], tangent_normal[4], orm[4];
 };
 
-UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
+[[gnu::always_inline]] inline UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
   return UvDerivatives::from(in.varyings[kU], in.varyings[kV], lod_mode_);
 }
 
@@ -24,7 +24,7 @@ UvDerivatives NormalMappingProgram::derivatives(const Fragments& in) const {
 // most 0. The sampler then reads level 0 of both maps whatever the exact LOD (sample_levels clamps any LOD plus
 // bias of at most 0 to level 0, and the LOD is read by nothing else here), so 0 serves, without the logarithm's
 // chain of dependent operations.
-bool NormalMappingProgram::magnified(const UvDerivatives& d) const {
+[[gnu::always_inline]] inline bool NormalMappingProgram::magnified(const UvDerivatives& d) const {
   const TextureSampler& albedo = textures_.first();
   if (albedo.state().lod_bias > 0.0f) return false;
   Float px, py;
@@ -60,12 +60,12 @@ void NormalMappingProgram::albedo_lods(const UvDerivatives& da, const UvDerivati
   lod_b = simd::from_quad_corners<2, 2, 2, 2>(both);
 }
 
-Float NormalMappingProgram::normal_lod(const UvDerivatives& d, const Float& albedo_lod) const {
+[[gnu::always_inline]] inline Float NormalMappingProgram::normal_lod(const UvDerivatives& d, const Float& albedo_lod) const {
   if (textures_.second().same_lod_as(textures_.first())) return albedo_lod;
   return textures_.second().lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }
 
-Float NormalMappingProgram::orm_lod(const UvDerivatives& d, const Float& albedo_lod) const {
+[[gnu::always_inline]] inline Float NormalMappingProgram::orm_lod(const UvDerivatives& d, const Float& albedo_lod) const {
   if (orm_->same_lod_as(textures_.first())) return albedo_lod;
   return orm_->lod(d.dudx, d.dvdx, d.dudy, d.dvdy);
 }

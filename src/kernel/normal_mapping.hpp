@@ -36,13 +36,15 @@ private:
   template <bool Orm>
   class Stages;
   struct Samples;
-  shading::UvDerivatives derivatives(const Fragments& in) const;
-  bool magnified(const shading::UvDerivatives& d) const;
+  // Inline (defined in normal_mapping.cpp, its only user): out of line, each call of a pair's setup passed its
+  // batches' values through the stack.
+  inline shading::UvDerivatives derivatives(const Fragments& in) const;
+  inline bool magnified(const shading::UvDerivatives& d) const;
   simd::Float albedo_lod(const shading::UvDerivatives& d) const;
   void albedo_lods(const shading::UvDerivatives& a, const shading::UvDerivatives& b, simd::Float& lod_a,
                    simd::Float& lod_b) const;
-  simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
-  simd::Float orm_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  inline simd::Float normal_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
+  inline simd::Float orm_lod(const shading::UvDerivatives& d, const simd::Float& albedo_lod) const;
   // Lights a batch whose frame, shading normal and view vector are computed.
   template <bool Orm>
   void light(const Samples& samples, const shading::TangentFrame& frame, const shading::Vec3& shading_normal,
