@@ -602,8 +602,20 @@ constexpr int kMaxTileColorPixels = 128 * 128;
 
 // The n floats at src to dst by streaming stores (movntps: the frame's cache lines are written whole, never read
 // for ownership), dst's unaligned head and tail by plain stores. Raw intrinsics: xsimd 8 has no streaming store.
+// With AVX, 64 bytes a loop from a 32-byte boundary (16 bytes a loop took 7 instructions: 2.7 M of a 960x540 frame).
 void stream_floats(float* dst, const float* src, std::size_t n) {
-  for (; n > 0 && reinterpret_cast<std::uintptr_t>(dst) % 16 != 0; --n) *dst++ = *src++;
+#if defined(__AVX__)
+  constexpr std::uintptr_t kAlign = 32;
+#else
+  constexpr std::uintptr_t kAlign = 16;
+#endif
+  for (; n > 0 && reinterpret_cast<std::uintptr_t>(dst) % kAlign != 0; --n) *dst++ = *src++;
+#if defined(__AVX__)
+  for (; n >= 16; n -= 16, dst += 16, src += 16) {
+    _mm256_stream_ps(dst, _mm256_loadu_ps(src));
+    _mm256_stream_ps(dst + 8, _mm256_loadu_ps(src + 8));
+  }
+#endif
   for (; n >= 4; n -= 4, dst += 4, src += 4) _mm_stream_ps(dst, _mm_loadu_ps(src));
   for (; n > 0; --n) *dst++ = *src++;
 }
