@@ -73,7 +73,7 @@ void NormalMappingProgram::albedo_lods(const UvDerivatives& da, const UvDerivati
 namespace {
 
 // The tangent-space normal (an RGB sample in [0, 1]) to world space, unit length.
-Vec3 shading_normal_of(const TangentFrame& frame, const Float* tangent_normal) {
+[[gnu::always_inline]] inline Vec3 shading_normal_of(const TangentFrame& frame, const Float* tangent_normal) {
   return normalize(frame.to_world({tangent_normal[0] * Float(2.0f) - Float(1.0f), tangent_normal[1] * Float(2.0f) - Float(1.0f),
                                    tangent_normal[2] * Float(2.0f) - Float(1.0f)}));
 }
