@@ -64,14 +64,19 @@ private:
   std::optional<ScopedEnv> python_, package_;
 };
 
-// Whether process `pid` has ended (gone, or a zombie no one has reaped yet), waiting up to 10 s for it.
+// Whether process `pid` has ended: gone, or a zombie no one has reaped yet.
+bool ended(int pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!std::getline(stat, text)) return true;
+  const std::size_t paren = text.rfind(')');
+  return paren != std::string::npos && paren + 2 < text.size() && text[paren + 2] == 'Z';
+}
+
+// ended(), waiting up to 10 s for it.
 bool ends(int pid) {
   for (const auto deadline = Clock::now() + std::chrono::seconds(10); Clock::now() < deadline;) {
-    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-    std::string text;
-    if (!std::getline(stat, text)) return true;
-    const std::size_t paren = text.rfind(')');
-    if (paren != std::string::npos && paren + 2 < text.size() && text[paren + 2] == 'Z') return true;
+    if (ended(pid)) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;
@@ -89,30 +94,52 @@ int exit_status(int pid) {
   return -1;
 }
 
+// `qdmr report` on a folder of `dir` with the stand-in generator, running: its process id and the generator's (0
+// when it never started). Whatever a test leaves running is killed and reaped when it ends.
+class RunningReport {
+public:
+  explicit RunningReport(const TempDir& dir)
+      : generator_(dir), command_(spawn(cli(), {"report", (dir / "results").string()})), pid_(generator_.pid()) {}
+  ~RunningReport() {
+    if (pid_ > 0 && !ended(pid_)) ::kill(pid_, SIGKILL);
+    if (command_ > 0) {
+      ::kill(command_, SIGKILL);
+      ::waitpid(command_, nullptr, 0);
+    }
+  }
+  RunningReport(const RunningReport&) = delete;
+  RunningReport& operator=(const RunningReport&) = delete;
+
+  int generator() const { return pid_; }
+  // Signals the command and reaps it: its exit status as exit_status() gives it.
+  int signal_and_wait(int signal) {
+    ::kill(command_, signal);
+    const int status = exit_status(command_);
+    command_ = 0;
+    return status;
+  }
+
+private:
+  SleepingGenerator generator_;
+  int command_;
+  int pid_;
+};
+
 TEST(ReportCommand, AKilledCommandLeavesNoGeneratorRunning) {
   TempDir dir;
-  const SleepingGenerator generator(dir);
-  const int command = spawn(cli(), {"report", (dir / "results").string()});
-  const int pid = generator.pid();
-  ASSERT_GT(pid, 0) << "the stand-in generator never started";
-  ::kill(command, SIGKILL);
-  int status = 0;
-  ::waitpid(command, &status, 0);
-  EXPECT_TRUE(ends(pid)) << "the generator outlived the killed command";
-  if (!ends(pid)) ::kill(pid, SIGKILL);
+  RunningReport report(dir);
+  ASSERT_GT(report.generator(), 0) << "the stand-in generator never started";
+  report.signal_and_wait(SIGKILL);
+  EXPECT_TRUE(ends(report.generator())) << "the generator outlived the killed command";
 }
 
 TEST(ReportCommand, AStopRequestIsPassedOnToTheGenerator) {
   for (const int signal : {SIGTERM, SIGINT}) {
     TempDir dir;
-    const SleepingGenerator generator(dir);
-    const int command = spawn(cli(), {"report", (dir / "results").string()});
-    const int pid = generator.pid();
-    ASSERT_GT(pid, 0) << "the stand-in generator never started";
-    ::kill(command, signal);
-    EXPECT_EQ(exit_status(command), 130) << "signal " << signal;  // stopped (docs/studies.md)
-    EXPECT_TRUE(ends(pid)) << "signal " << signal;
-    if (!ends(pid)) ::kill(pid, SIGKILL);
+    RunningReport report(dir);
+    ASSERT_GT(report.generator(), 0) << "the stand-in generator never started";
+    EXPECT_EQ(report.signal_and_wait(signal), 130) << "signal " << signal;  // stopped (docs/studies.md)
+    EXPECT_TRUE(ends(report.generator())) << "signal " << signal;
   }
 }
 
