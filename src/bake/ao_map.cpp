@@ -42,19 +42,23 @@ ao::MaxPyramid<T>::MaxPyramid(const HeightView<T>& field) {
   while (width.back() > 1 || height.back() > 1) {
     const int w = width.back(), h = height.back();
     const int pw = std::max(1, w / 2), ph = std::max(1, h / 2);
-    // Zero pages, first touched by the rows' own threads; a parent starts at 0, below every height.
+    // Zero pages, first touched by the rows' own threads, each cell written once and never read first: a read
+    // maps the shared zero page, and the write after it then copies the page and flushes the TLB of every thread
+    // (an interrupt to the other cores per 4 KiB page). A cell's maximum starts at 0, below every height.
     ZeroedBuffer<T> parent(std::size_t(pw) * std::size_t(ph));
     const T* child = level.back();
     tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& rows) {
       for (int py = rows.begin(); py < rows.end(); ++py) {
         T* out = parent.data() + std::size_t(py) * std::size_t(pw);
-        const int y_end = py == ph - 1 ? h : std::min(h, 2 * py + 2);  // the last row takes the leftover
-        for (int y = 2 * py; y < y_end; ++y) {
-          const T* in = child + std::size_t(y) * std::size_t(w);
-          for (int x = 0; x < w; ++x) {
-            T& p = out[std::min(x / 2, pw - 1)];
-            p = std::max(p, in[x]);
+        const int y_end = py == ph - 1 ? h : std::min(h, 2 * py + 2);  // the last row and column take the leftover
+        for (int px = 0; px < pw; ++px) {
+          const int x_end = px == pw - 1 ? w : std::min(w, 2 * px + 2);
+          T m = T(0);
+          for (int y = 2 * py; y < y_end; ++y) {
+            const T* in = child + std::size_t(y) * std::size_t(w);
+            for (int x = 2 * px; x < x_end; ++x) m = std::max(m, in[x]);
           }
+          out[px] = m;
         }
       }
     });
