@@ -35,16 +35,7 @@ std::string source_key(const TextureDesc& d) {
     case TextureSource::None: k << "none"; break;
     case TextureSource::File: k << "file:" << d.file.string() << ":ch" << int(d.channel) << ":srgb" << d.srgb; break;
     case TextureSource::Constant: k << "const:" << d.constant.x << "," << d.constant.y << "," << d.constant.z << "," << d.constant.w; break;
-    case TextureSource::Procedural: {
-      const ProceduralDesc& p = d.procedural;
-      k << "proc:" << int(p.pattern) << ":" << p.size << ":" << p.seed << ":" << p.cells << ":" << p.octaves << ":" << p.gain
-        << ":" << p.mortar;
-      for (const WaveDesc& w : p.waves)
-        k << ":wave" << w.amplitude << "," << w.speed << "," << w.sharpness << "," << w.cycles_u << "," << w.cycles_v;
-      // Time is content only where the pattern moves: a still texture keeps its key from frame to frame.
-      if (time_dependent(p)) k << ":scroll" << p.scroll.x << "," << p.scroll.y << ":t" << p.time;
-      break;
-    }
+    case TextureSource::Procedural: k << "proc:" << procedural_key(d.procedural); break;
     case TextureSource::FromHeight: k << "from_height"; break;
     case TextureSource::Pixels: k << "pixels:" << d.pixels_version; break;
   }

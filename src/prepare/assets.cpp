@@ -18,6 +18,7 @@
 #include "texture/twin_texels.hpp"
 #include "texture/blend_weights.hpp"
 #include "texture/height_family.hpp"
+#include "texture/pattern_reuse.hpp"
 
 namespace qdmr {
 namespace {
@@ -158,9 +159,12 @@ public:
     begin_ = Clock::now();
     const std::vector<std::string> items = plan_.items();
     items_ = items.size();
-    weight_maps();
-    meshes();
-    textures();
+    {
+      const PatternReuse reuse;  // while patterns are made: the derived items after them hold the memory
+      weight_maps();
+      meshes();
+      textures();
+    }
     assets_.derived.resize(plan_.derived.size());
     for (std::size_t i = 0, end = 0; i < plan_.derived.size(); i = end) {
       // Consecutive twin-texel items read built textures only and hold no working memory: each is a one-thread

@@ -1,5 +1,7 @@
 // Time in a scene: which textures change with it, and the scene at one frame.
 #include <algorithm>
+#include <sstream>
+#include <string>
 #include <tuple>
 
 #include <glm/vec3.hpp>
@@ -14,6 +16,16 @@ bool time_dependent(const ProceduralDesc& p) {
   if (p.scroll.x != 0.0f || p.scroll.y != 0.0f) return true;
   return p.pattern == ProceduralPattern::Waves &&
          std::any_of(p.waves.begin(), p.waves.end(), [](const WaveDesc& w) { return w.speed != 0.0f; });
+}
+
+std::string procedural_key(const ProceduralDesc& p) {
+  std::ostringstream k;
+  k << std::hexfloat << int(p.pattern) << ":" << p.size << ":" << p.seed << ":" << p.cells << ":" << p.octaves << ":"
+    << p.gain << ":" << p.mortar;
+  for (const WaveDesc& w : p.waves)
+    k << ":wave" << w.amplitude << "," << w.speed << "," << w.sharpness << "," << w.cycles_u << "," << w.cycles_v;
+  if (time_dependent(p)) k << ":scroll" << p.scroll.x << "," << p.scroll.y << ":t" << p.time;
+  return k.str();
 }
 
 bool time_dependent(const TextureDesc& t) {

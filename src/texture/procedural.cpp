@@ -9,6 +9,9 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +21,7 @@
 #include "qdmr/texture/texture_level0.hpp"
 #include "texture/height_rows_code.hpp"
 #include "texture/internal.hpp"
+#include "texture/pattern_reuse.hpp"
 
 namespace qdmr {
 namespace {
@@ -442,8 +446,32 @@ void WaveRows::row(int y, float* out, AddWave add) const {
     add(t.sharpness, out, size, t.su.data(), t.cu.data(), t.sv[std::size_t(y)], t.cv[std::size_t(y)], t.weight);
 }
 
-Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
-  validate(d);
+namespace {
+
+// The patterns kept while a PatternReuse lives, with their cells (channel 0 alone is the pattern without them:
+// fill() writes the same heights either way).
+struct KeptPatterns {
+  static constexpr std::size_t kMaxPatternBytes = std::size_t(8) << 20;  // 1024 x 1024 with cells
+  static constexpr std::size_t kMaxBytes = std::size_t(32) << 20;
+  std::mutex mutex;
+  int scopes = 0;
+  std::map<std::string, std::shared_ptr<const Image>> patterns;
+  std::size_t bytes = 0;
+};
+
+KeptPatterns& kept_patterns() {
+  static KeptPatterns kept;
+  return kept;
+}
+
+Image with_or_without_cells(const Image& pattern, bool with_cells) {
+  if (with_cells) return pattern;
+  Image heights(pattern.width, pattern.height, 1);
+  for (std::size_t i = 0; i < heights.texels.size(); ++i) heights.texels[i] = pattern.texels[2 * i];
+  return heights;
+}
+
+Image evaluate_pattern(const ProceduralDesc& d, bool with_cells) {
   const Offset o = scroll_offset(d);
   switch (d.pattern) {
     case ProceduralPattern::Bricks: return fill(d.size, with_cells, Bricks{d.cells, d.mortar, d.seed}, o);
@@ -459,8 +487,45 @@ Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
   throw Error("procedural pattern", "unknown pattern");
 }
 
+}  // namespace
+
+Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
+  validate(d);
+  KeptPatterns& kept = kept_patterns();
+  const std::size_t bytes = std::size_t(d.size) * std::size_t(d.size) * 2 * sizeof(float);
+  std::string key;
+  std::shared_ptr<const Image> pattern;
+  {
+    std::lock_guard lock(kept.mutex);
+    if (kept.scopes > 0 && bytes <= KeptPatterns::kMaxPatternBytes) {
+      key = procedural_key(d);
+      if (auto it = kept.patterns.find(key); it != kept.patterns.end()) pattern = it->second;
+    }
+  }
+  if (key.empty()) return evaluate_pattern(d, with_cells);
+  if (!pattern) {  // made here (two threads asking at once may both make it: the same bits)
+    pattern = std::make_shared<const Image>(evaluate_pattern(d, true));
+    std::lock_guard lock(kept.mutex);
+    if (kept.scopes > 0 && kept.bytes + bytes <= KeptPatterns::kMaxBytes && kept.patterns.emplace(key, pattern).second)
+      kept.bytes += bytes;
+  }
+  return with_or_without_cells(*pattern, with_cells);
+}
+
 }  // namespace texture_detail
 
 Image generate_procedural(const ProceduralDesc& desc) { return texture_detail::generate_pattern(desc, false); }
+
+PatternReuse::PatternReuse() {
+  auto& kept = texture_detail::kept_patterns();
+  std::lock_guard lock(kept.mutex);
+  ++kept.scopes;
+}
+
+PatternReuse::~PatternReuse() {
+  auto& kept = texture_detail::kept_patterns();
+  std::lock_guard lock(kept.mutex);
+  if (--kept.scopes == 0) kept.patterns.clear(), kept.bytes = 0;
+}
 
 }  // namespace qdmr

@@ -10,6 +10,8 @@
 
 #include "qdmr/core/error.hpp"
 #include "qdmr/texture/texture_level0.hpp"
+#include "texture/internal.hpp"
+#include "texture/pattern_reuse.hpp"
 
 namespace qdmr {
 namespace {
@@ -141,6 +143,35 @@ TEST(TextureProcedural, NoiseKeepsTheBitsOfItsPerTexelDefinition) {
     d.octaves = c.octaves;
     d.gain = c.gain;
     EXPECT_EQ(digest(generate_procedural(d).texels), c.digest) << "size " << c.size << " cells " << c.cells;
+  }
+}
+
+TEST(TextureProcedural, ReusedPatternsHaveTheBitsOfAFreshEvaluation) {
+  // Outside a PatternReuse every call evaluates; inside, the second call of a spec copies the first, whichever of
+  // the two (heights alone or with cells) came first, and another seed or size is another pattern.
+  std::vector<ProceduralDesc> descs;
+  for (ProceduralPattern p : kAll) descs.push_back(desc(p, 32));
+  ProceduralDesc waves = desc(ProceduralPattern::Waves, 32);
+  waves.waves = {WaveDesc{}, WaveDesc{0.5f, 0.1f, 30.0f, 0.2f, 3, 2, 1}};
+  waves.time = 1.5;
+  descs.push_back(waves);
+  for (const ProceduralDesc& d : descs) {
+    const Image heights = texture_detail::generate_pattern(d, false);
+    const Image cells = texture_detail::generate_pattern(d, true);
+    ProceduralDesc other_seed = d, other_size = d;
+    other_seed.seed += 1;
+    other_size.size = 16;
+    const Image seed_heights = texture_detail::generate_pattern(other_seed, false);
+    const Image size_heights = texture_detail::generate_pattern(other_size, false);
+    for (bool cells_first : {false, true}) {
+      const PatternReuse reuse;
+      const Image first = texture_detail::generate_pattern(d, cells_first);
+      const Image again = texture_detail::generate_pattern(d, !cells_first);
+      EXPECT_EQ((cells_first ? first : again).texels, cells.texels) << int(d.pattern);
+      EXPECT_EQ((cells_first ? again : first).texels, heights.texels) << int(d.pattern);
+      EXPECT_EQ(texture_detail::generate_pattern(other_seed, false).texels, seed_heights.texels) << int(d.pattern);
+      EXPECT_EQ(texture_detail::generate_pattern(other_size, false).texels, size_heights.texels) << int(d.pattern);
+    }
   }
 }
 

@@ -104,6 +104,10 @@ struct ProceduralDesc {
 // Whether the pattern changes with ProceduralDesc::time: a scroll, or a wave with a speed.
 bool time_dependent(const ProceduralDesc& procedural);
 
+// What the pattern's texels depend on, floats printed exactly (hexfloat): equal keys, equal patterns. The time
+// and scroll are in it only where the pattern moves (time_dependent), so a still pattern keeps its key.
+std::string procedural_key(const ProceduralDesc& procedural);
+
 // Heights from a frame-numbered sequence of files (`"file": "h_%04d.exr"`, printf-style %d or %0Nd): frame n of
 // the animation reads file number first + n * step. The loader checks that every frame's file exists and that
 // they all have one size.
