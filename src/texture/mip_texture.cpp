@@ -59,17 +59,18 @@ const Tables& tables() {
   return t;
 }
 
-// Round to nearest (ties up) after clamping to [0, 1]; NaN gives 0. v * 255 and v * 65535 are exact in double.
-std::uint8_t quantise_unorm8(float v) {
-  if (!(v > 0.0f)) return 0;
-  if (v >= 1.0f) return 255;
-  return std::uint8_t(std::floor(double(v) * 255.0 + 0.5));
+// Round to nearest (ties up) after clamping to [0, 1]; NaN gives 0. v * 255 and v * 65535 are exact in double,
+// and the sum with 1/2 is positive, so truncation is its floor: no branches, no floor emulation (this file is
+// compiled for the baseline ISA, which has no rounding instruction).
+float clamp_unit(float v) {
+  const float positive = v > 0.0f ? v : 0.0f;  // NaN too
+  return positive < 1.0f ? positive : 1.0f;
 }
 
+std::uint8_t quantise_unorm8(float v) { return std::uint8_t(std::int32_t(double(clamp_unit(v)) * 255.0 + 0.5)); }
+
 std::uint16_t quantise_unorm16(float v) {
-  if (!(v > 0.0f)) return 0;
-  if (v >= 1.0f) return 65535;
-  return std::uint16_t(std::floor(double(v) * 65535.0 + 0.5));
+  return std::uint16_t(std::int32_t(double(clamp_unit(v)) * 65535.0 + 0.5));
 }
 
 // round(encode(v) * 255) with the exact curve: the number of decoded midpoints between codes at or below v (no
@@ -125,30 +126,36 @@ void reduce_box(const Texture& t, int level, const C& codec, std::uint8_t* out_b
   const TextureLevel& in = t.levels[std::size_t(level)];
   const TextureLevel& out = t.levels[std::size_t(level) + 1];
   const std::uint8_t* in_base = t.storage.data() + in.offset;
+  const int in_width = in.width, in_height = in.height, out_width = out.width, out_height = out.height;
   // A texel costs about 8x more here than in a Max build: weight the row size accordingly.
-  for_rows(out.height, std::size_t(out.width) * texel_bytes * 8, [&](int y0, int y1) {
+  for_rows(out_height, std::size_t(out_width) * texel_bytes * 8, [&](int y0, int y1) {
+    // Locals: a byte store may alias anything in memory, so members and captures would be read again per texel.
+    const C local_codec = codec;
+    const std::uint8_t* const in_texels = in_base;
+    std::uint8_t* const out_texels = out_base;
+    const int iw = in_width, ih = in_height, ow = out_width, oh = out_height;
     for (int y = y0; y < y1; ++y) {
-      const Taps ty = taps(y, in.height, out.height);
-      for (int x = 0; x < out.width; ++x) {
-        const Taps tx = taps(x, in.width, out.width);
+      const Taps ty = taps(y, ih, oh);
+      for (int x = 0; x < ow; ++x) {
+        const Taps tx = taps(x, iw, ow);
         float sum[4] = {0, 0, 0, 0};
         for (int j = ty.first; j < ty.first + ty.count; ++j)
           for (int i = tx.first; i < tx.first + tx.count; ++i) {
-            const std::uint8_t* texel = in_base + (std::size_t(j) * in.width + i) * texel_bytes;
+            const std::uint8_t* texel = in_texels + (std::size_t(j) * iw + i) * texel_bytes;
             for (int c = 0; c < channels; ++c) {
-              const float v = codec.decode(texel, c);
+              const float v = local_codec.decode(texel, c);
               sum[c] += Normal && c < 3 ? 2.0f * v - 1.0f : v;
             }
           }
-        std::uint8_t* texel = out_base + (std::size_t(y) * out.width + x) * texel_bytes;
+        std::uint8_t* texel = out_texels + (std::size_t(y) * ow + x) * texel_bytes;
         const float count = float(tx.count * ty.count);
-        for (int c = Normal ? 3 : 0; c < channels; ++c) codec.encode(texel, c, sum[c] / count);
+        for (int c = Normal ? 3 : 0; c < channels; ++c) local_codec.encode(texel, c, sum[c] / count);
         if constexpr (Normal) {
           const double len2 = double(sum[0]) * sum[0] + double(sum[1]) * sum[1] + double(sum[2]) * sum[2];
           const double inv = len2 > 0.0 ? 1.0 / std::sqrt(len2) : 0.0;
           const float n[3] = {len2 > 0.0 ? float(sum[0] * inv) : 0.0f, len2 > 0.0 ? float(sum[1] * inv) : 0.0f,
                               len2 > 0.0 ? float(sum[2] * inv) : 1.0f};
-          for (int c = 0; c < 3; ++c) codec.encode(texel, c, 0.5f + 0.5f * n[c]);
+          for (int c = 0; c < 3; ++c) local_codec.encode(texel, c, 0.5f + 0.5f * n[c]);
         }
       }
     }
@@ -217,11 +224,15 @@ void add_linear_copy(Texture& texture) {
     for (int k = 0; k < texture.level_count(); ++k) {
       const TextureLevel& l = texture.levels[std::size_t(k)];
       for_rows(l.height, std::size_t(l.width) * 4 * channels, [&](int y0, int y1) {
+        const auto local_codec = codec;  // locals, read once (as in make_mip_texture)
+        const std::uint8_t* const storage = texture.storage.data();
+        float* const linear = texture.linear.data();
+        const std::size_t width = std::size_t(l.width), first = l.offset / texel_bytes;
         for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < l.width; ++x) {
-            const std::size_t texel = l.offset / texel_bytes + std::size_t(y) * std::size_t(l.width) + std::size_t(x);
+          for (std::size_t x = 0; x < width; ++x) {
+            const std::size_t texel = first + std::size_t(y) * width + x;
             for (std::size_t c = 0; c < channels; ++c)
-              texture.linear[texel * channels + c] = codec.decode(texture.storage.data() + texel * texel_bytes, int(c));
+              linear[texel * channels + c] = local_codec.decode(storage + texel * texel_bytes, int(c));
           }
       });
     }
@@ -280,12 +291,17 @@ Texture make_mip_texture(const Image& level0, TexelFormat format, bool srgb, Mip
     constexpr int channels = std::decay_t<decltype(codec)>::kChannels;
     constexpr int texel_bytes = std::decay_t<decltype(codec)>::kTexelBytes;
     for_rows(level0.height, std::size_t(level0.width) * texel_bytes * 8, [&](int y0, int y1) {
-      for (int y = y0; y < y1; ++y)
-        for (int x = 0; x < level0.width; ++x) {
-          std::uint8_t* texel = t.storage.data() + (std::size_t(y) * level0.width + x) * texel_bytes;
-          for (int c = 0; c < channels; ++c)
-            codec.encode(texel, c, c < level0.channels ? level0.at(x, y, c) : c == 3 ? 1.0f : 0.0f);
-        }
+      // Locals: a byte store may alias anything in memory, so members and captures would be read again per texel.
+      const auto local_codec = codec;
+      std::uint8_t* const storage = t.storage.data();
+      const float* const texels = level0.texels.data();
+      const int width = level0.width, in_channels = level0.channels;
+      for (int y = y0; y < y1; ++y) {
+        const float* in = texels + std::size_t(y) * std::size_t(width) * std::size_t(in_channels);
+        std::uint8_t* texel = storage + std::size_t(y) * std::size_t(width) * texel_bytes;
+        for (int x = 0; x < width; ++x, in += in_channels, texel += texel_bytes)
+          for (int c = 0; c < channels; ++c) local_codec.encode(texel, c, c < in_channels ? in[c] : c == 3 ? 1.0f : 0.0f);
+      }
     });
   });
   build_mip_levels(t, reduce, extremum);
