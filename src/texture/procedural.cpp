@@ -237,67 +237,44 @@ struct Noise {
     return gx[k] * dx + gy[k] * dy;
   }
 
-  // What the texels of one lattice cell share, per octave: the four corners' gradients (k = hash >> 29), and per
-  // lattice row the inner halves of the corners' hashes, mix(j + seed). fill() evaluates a row's texels in order,
-  // so a Cursor hashes once per cell and octave instead of four times per texel; the operations on each texel
-  // are the per-texel formula's, in its order, so the bits are the same.
-  class Cursor {
-  public:
-    explicit Cursor(const Noise& noise) : n_(&noise), cells_(noise.frequency.size()) {}
-
-    Texel operator()(double u, double v) {
-      double sum = 0.0;
-      for (std::size_t o = 0; o < n_->frequency.size(); ++o) {
-        const std::int64_t f = n_->frequency[o];
-        Cell& c = cells_[o];
-        if (!c.valid || c.v != v) {  // a new row: what depends on v alone
-          const double y = v * double(f), fy = std::floor(y);
-          c.v = v, c.row_j = std::int64_t(fy), c.ty = y - fy, c.wy = fade(c.ty);
+  // The raw sums of one row of texels at v, texel x at us[x]: octave after octave along the whole row, so the
+  // texels' chains of dependent operations overlap (a texel at a time, each waited on the one before). Per octave
+  // what depends on v alone once, and each lattice cell's corner gradients (k = hash >> 29) once per run of its
+  // texels; each texel's operations are the per-texel formula's, in its order, so the bits are the same.
+  void row(double v, const double* us, int n, double* sum) const {
+    std::fill_n(sum, n, 0.0);
+    for (std::size_t o = 0; o < frequency.size(); ++o) {
+      const std::int64_t f = frequency[o];
+      const std::uint32_t seed = mixed_seed[o];
+      const double amp = amplitude[o];
+      const double y = v * double(f), fy = std::floor(y);
+      const double ty = y - fy, wy = fade(ty);
+      // u, v in (0, 1): lattice indices in [0, f), only the next one wraps. hash_mixed(x, y, seed) is
+      // mix(x + mix(y + seed)): its inner half depends on the row alone.
+      const std::int64_t j = std::int64_t(fy), j1 = j + 1 == f ? 0 : j + 1;
+      const std::uint32_t row0 = mix(std::uint32_t(j) + seed), row1 = mix(std::uint32_t(j1) + seed);
+      std::int64_t cell = -1;
+      std::uint32_t k0 = 0, k1 = 0, k2 = 0, k3 = 0;  // corners (i, j), (i1, j), (i, j1), (i1, j1)
+      for (int x = 0; x < n; ++x) {
+        const double ux = us[x] * double(f);
+        const double fx = std::floor(ux);
+        if (const std::int64_t i = std::int64_t(fx); i != cell) {
+          const std::int64_t i1 = i + 1 == f ? 0 : i + 1;
+          cell = i;
+          k0 = mix(std::uint32_t(i) + row0) >> 29;
+          k1 = mix(std::uint32_t(i1) + row0) >> 29;
+          k2 = mix(std::uint32_t(i) + row1) >> 29;
+          k3 = mix(std::uint32_t(i1) + row1) >> 29;
         }
-        const double x = u * double(f);
-        const double fx = std::floor(x);
-        // u, v in (0, 1): lattice indices in [0, f), only the next one wraps.
-        const std::int64_t i = std::int64_t(fx), j = c.row_j;
-        if (!c.valid || c.i != i || c.j != j) c.enter(i, j, f, n_->mixed_seed[o]);
-        const double tx = x - fx, ty = c.ty;
-        const double n00 = gradient(c.k[0], tx, ty), n10 = gradient(c.k[1], tx - 1, ty);
-        const double n01 = gradient(c.k[2], tx, ty - 1), n11 = gradient(c.k[3], tx - 1, ty - 1);
-        const double wx = fade(tx), wy = c.wy;
+        const double tx = ux - fx;
+        const double n00 = gradient(k0, tx, ty), n10 = gradient(k1, tx - 1, ty);
+        const double n01 = gradient(k2, tx, ty - 1), n11 = gradient(k3, tx - 1, ty - 1);
+        const double wx = fade(tx);
         const double a = n00 + (n10 - n00) * wx, b = n01 + (n11 - n01) * wx;
-        sum += n_->amplitude[o] * (a + (b - a) * wy);
+        sum[x] += amp * (a + (b - a) * wy);
       }
-      return {sum};
     }
-
-  private:
-    struct Cell {
-      bool valid = false;  // i, j, row and k hold a cell (v, row_j, ty and wy a row as soon as one is seen)
-      double v = 0.0, ty = 0.0, wy = 0.0;  // the row's v, its fraction in the cell and fade(ty)
-      std::int64_t row_j = 0;
-      std::int64_t i = 0, j = -1;
-      std::uint32_t row[2] = {0, 0};  // mix(j + seed), mix(j1 + seed)
-      std::uint32_t k[4] = {0, 0, 0, 0};  // corners (i, j), (i1, j), (i, j1), (i1, j1)
-
-      // hash_mixed(x, y, seed) is mix(x + mix(y + seed)): its inner half depends on the row alone.
-      void enter(std::int64_t ci, std::int64_t cj, std::int64_t f, std::uint32_t seed) {
-        const std::int64_t i1 = ci + 1 == f ? 0 : ci + 1, j1 = cj + 1 == f ? 0 : cj + 1;
-        if (!valid || cj != j) {
-          row[0] = mix(std::uint32_t(cj) + seed);
-          row[1] = mix(std::uint32_t(j1) + seed);
-        }
-        valid = true, i = ci, j = cj;
-        k[0] = mix(std::uint32_t(ci) + row[0]) >> 29;
-        k[1] = mix(std::uint32_t(i1) + row[0]) >> 29;
-        k[2] = mix(std::uint32_t(ci) + row[1]) >> 29;
-        k[3] = mix(std::uint32_t(i1) + row[1]) >> 29;
-      }
-    };
-
-    const Noise* n_;
-    std::vector<Cell> cells_;
-  };
-
-  Cursor cursor() const { return Cursor(*this); }
+  }
 };
 
 // The top (h = 1), so a flat pattern adds no depth.
@@ -350,9 +327,21 @@ Image fill(int size, bool with_cells, const Pattern& pattern, Offset offset) {
   return out;
 }
 
-// Noise: remap the raw sums to [0,1] by the image's min and max (exact, so independent of the split).
+// Noise: the raw sums row by row (Noise::row), remapped to [0,1] by the image's min and max (exact, so
+// independent of the split).
 Image fill_normalised(int size, bool with_cells, const Noise& noise, Offset offset) {
-  Image out = fill(size, with_cells, noise, offset);
+  Image out(size, size, with_cells ? 2 : 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, size), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<double> us(static_cast<std::size_t>(size)), sums(static_cast<std::size_t>(size));
+    for (int x = 0; x < size; ++x) us[std::size_t(x)] = at((x + 0.5) / size, offset.u);
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      noise.row(at((y + 0.5) / size, offset.v), us.data(), size, sums.data());
+      for (int x = 0; x < size; ++x) {
+        out.at(x, y, 0) = float(sums[std::size_t(x)]);
+        if (with_cells) out.at(x, y, 1) = 0.5f;  // Texel's default cell: noise has none
+      }
+    }
+  });
   const int c = out.channels;
   const std::size_t n = std::size_t(size) * size;
   using Range = std::pair<float, float>;
