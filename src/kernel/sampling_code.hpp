@@ -410,8 +410,8 @@ QDMR_SAMPLER_INLINE void prefetch_twin_texels(const TextureView& va, const Sampl
   }
 }
 
-// sample_level() of two textures (twin_keys) at once: out[0..2] texture a's rgb, out[4..6] texture b's rgb (the
-// alphas are not filtered; out[3] is 1). interleaved: the two interleaved (twin_texels.hpp), or null.
+// sample_level() of two textures (twin_keys) at once: out[0..2] texture a's rgb, out[3..5] texture b's rgb (the
+// alphas are not filtered). interleaved: the two interleaved (twin_texels.hpp), or null.
 // Never recorded: the caller knows no texture-cache recorder listens.
 QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerKey& ka, const TextureView& vb,
                                            const SamplerKey& kb, const float* interleaved, const Float& u,
@@ -419,9 +419,10 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
   if (!linear) {
     Int x, y;
     point_texel(va, ka, u, v, info, x, y);
-    fetch(va, ka, info, x, y, out, false);
-    fetch(vb, kb, info, x, y, out + 4, false);
-    out[3] = Float(1.0f);
+    Float a[4], b[4];
+    fetch(va, ka, info, x, y, a, false);
+    fetch(vb, kb, info, x, y, b, false);
+    for (int c = 0; c < 3; ++c) out[c] = a[c], out[3 + c] = b[c];
     return;
   }
   const BilinearTaps t = bilinear_taps(va, ka, u, v, info);
@@ -447,9 +448,8 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
     across(bottom, bottom_a, bottom_b);
     for (int c = 0; c < 3; ++c) {
       out[c] = top_a[c] + (bottom_a[c] - top_a[c]) * t.wy;
-      out[4 + c] = top_b[c] + (bottom_b[c] - top_b[c]) * t.wy;
+      out[3 + c] = top_b[c] + (bottom_b[c] - top_b[c]) * t.wy;
     }
-    out[3] = Float(1.0f);
     return;
   }
   Float a00[4], a10[4], a01[4], a11[4], b00[4], b10[4], b01[4], b11[4];
@@ -466,8 +466,7 @@ QDMR_SAMPLER_INLINE void sample_level_twin(const TextureView& va, const SamplerK
     fetch_taps(vb, kb, info, t, b00, b10, b01, b11, false);
   }
   filter_taps(ka, t, a00, a10, a01, a11, out, 3);
-  out[3] = Float(1.0f);
-  filter_taps(kb, t, b00, b10, b01, b11, out + 4, 3);
+  filter_taps(kb, t, b00, b10, b01, b11, out + 3, 3);
 }
 
 // Whether a mip-linear sample may skip its coarse level: no lane weighs it (f, the LOD's fraction, is 0 in every
@@ -537,14 +536,14 @@ QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey
                                           const TextureView& vb, const float* interleaved, const SamplerState& s,
                                           const Float& u, const Float& v, const Float& lod, const UvAhead* ahead,
                                           Float* out_a, Float* out_b) {
-  float first_texel[8];
-  for (int c = 0; c < 4; ++c) {
+  float first_texel[6];  // a's rgb, then b's
+  for (int c = 0; c < 3; ++c) {
     first_texel[c] = va.first_texel()[std::size_t(c)];
-    first_texel[4 + c] = vb.first_texel()[std::size_t(c)];
+    first_texel[3 + c] = vb.first_texel()[std::size_t(c)];
   }
-  Float out[8];
+  Float out[6];
   bool finest = true;  // sample_levels() reads the finer level first
-  sample_levels(ka, va, s, u, v, lod, 7, first_texel, false,
+  sample_levels(ka, va, s, u, v, lod, 6, first_texel, false,
                 [&](const Float& ru, const Float& rv, const LevelInfo& info, bool linear,
                     Float* level_out) __attribute__((always_inline)) {
                   if (finest && ahead != nullptr) {
@@ -559,11 +558,11 @@ QDMR_SAMPLER_INLINE void sample_twin_with(const SamplerKey& ka, const SamplerKey
                   sample_level_twin(va, ka, vb, kb, interleaved, ru, rv, info, linear, level_out);
                 },
                 out);
-  for (int c = 0; c < 3; ++c) {
-    out_a[c] = out[c];
-    out_b[c] = out[4 + c];
-  }
-  out_a[3] = out_b[3] = Float(1.0f);
+  // Read before the first store: out_a and out_b might overlap as far as the compiler knows, and a copy loop
+  // became a byte copy in 16-byte halves behind an overlap test.
+  const Float ar = out[0], ag = out[1], ab = out[2], br = out[3], bg = out[4], bb = out[5];
+  out_a[0] = ar, out_a[1] = ag, out_a[2] = ab, out_a[3] = Float(1.0f);
+  out_b[0] = br, out_b[1] = bg, out_b[2] = bb, out_b[3] = Float(1.0f);
 }
 
 // wrap: x and y wrapped into the level by masking (power-of-two sizes), else clamped.
