@@ -1,6 +1,7 @@
 #include "prepare/assets.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_pipeline.h>
 
 #include <algorithm>
@@ -162,8 +163,9 @@ public:
     {
       const PatternReuse reuse;  // while patterns are made: the derived items after them hold the memory
       weight_maps();
-      meshes();
-      textures();
+      // A mesh is built on one thread (the grid, its heights, its tangents): beside the textures, whose builds
+      // take the other threads, instead of before them with the others idle.
+      tbb::parallel_invoke([&] { meshes(); }, [&] { textures(); });
     }
     assets_.derived.resize(plan_.derived.size());
     for (std::size_t i = 0, end = 0; i < plan_.derived.size(); i = end) {

@@ -125,10 +125,11 @@ Image make_weight_map(const WeightsDesc& desc, int layers, const std::string& wh
 
 Image resample_weight_map(const Image& map, int resolution) {
   Image level0(resolution, resolution, 4);
-  for (int y = 0; y < resolution; ++y)
+  tbb::parallel_for(0, resolution, [&](int y) {  // texels alone: the same bits on any thread count
     for (int x = 0; x < resolution; ++x)
       for (int c = 0; c < 4; ++c)
         level0.at(x, y, c) = bilinear(map, (x + 0.5) * map.width / resolution, (y + 0.5) * map.height / resolution, c);
+  });
   return level0;
 }
 
