@@ -38,6 +38,27 @@ def render(qdmr, scene, sets, width, height, tmp, env=None, extra=()):
     return result
 
 
+def cpu_model():
+    """The model name with the family, model and stepping (a VM often names only "AMD EPYC") and the widest vector
+    extensions the CPU reports: the figures of the AVX2 class and the AVX-512 class are judged apart."""
+    fields = {}
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if not line.strip():
+                    break  # the first processor's block
+                key, _, value = line.partition(":")
+                fields[key.strip()] = value.strip()
+    except OSError:
+        return "unknown CPU"
+    flags = set(fields.get("flags", "").split())
+    vector = [name for flag, name in (("avx512f", "AVX-512"), ("avx2", "AVX2"), ("fma", "FMA")) if flag in flags]
+    if "avx512f" not in flags:
+        vector.append("no AVX-512")
+    return (f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')} model "
+            f"{fields.get('model', '?')} stepping {fields.get('stepping', '?')}; {', '.join(vector)})")
+
+
 def bits_version(qdmr):
     """The bits version of a qdmr build ("qdmr 0.1.0 (bits version 2)"), for the manifests a benchmark writes."""
     out = subprocess.run([qdmr, "--version"], check=True, capture_output=True, text=True).stdout

@@ -25,6 +25,8 @@ import sys
 import tempfile
 import time
 
+from bench_util import cpu_model
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -85,20 +87,6 @@ def run(binary, args):
     if int(code) != 0:
         raise SystemExit("gltf_load: %s %s exited with %s" % (binary, " ".join(args), code))
     return float(seconds), float(cpu), int(kib) / 1024
-
-
-def cpu_model():
-    """The model name and, where the name is short (virtual machines), the family and model numbers."""
-    fields = {}
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                key, _, value = line.partition(":")
-                fields.setdefault(key.strip(), value.strip())
-    except OSError:
-        pass
-    return "%s (family %s, model %s)" % (fields.get("model name", "unknown CPU"), fields.get("cpu family", "?"),
-                                        fields.get("model", "?"))
 
 
 def main():

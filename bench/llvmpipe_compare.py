@@ -40,7 +40,7 @@ except ImportError:
     sys.exit("llvmpipe_compare.py needs numpy and OpenImageIO's Python module (Debian: python3-openimageio, "
              "for the system python3)")
 
-from bench_util import read_exr  # noqa: E402
+from bench_util import cpu_model, read_exr  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "bench", "llvmpipe", "canonical.json")
@@ -99,27 +99,6 @@ def llvmpipe_env(threads, pair=None):
     if pair:
         env.update(PAIRS[pair][1])
     return env
-
-
-def cpu_model():
-    """The model name with the family, model and stepping (a VM often names only "AMD EPYC") and the widest vector
-    extensions the CPU reports: the figures of the AVX2 class and the AVX-512 class are judged apart."""
-    fields = {}
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if not line.strip():
-                    break  # the first processor's block
-                key, _, value = line.partition(":")
-                fields[key.strip()] = value.strip()
-    except OSError:
-        return "unknown CPU"
-    flags = set(fields.get("flags", "").split())
-    vector = [name for flag, name in (("avx512f", "AVX-512"), ("avx2", "AVX2"), ("fma", "FMA")) if flag in flags]
-    if "avx512f" not in flags:
-        vector.append("no AVX-512")
-    return (f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')} model "
-            f"{fields.get('model', '?')} stepping {fields.get('stepping', '?')}; {', '.join(vector)})")
 
 
 def read_pfm(path):
