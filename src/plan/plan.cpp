@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -20,6 +21,7 @@
 #include "texture/height_texture.hpp"
 #include "qdmr/texture/image.hpp"
 #include "texture/layer_heights.hpp"
+#include "texture/pattern_reuse.hpp"
 #include "texture/twin_texels.hpp"
 
 namespace qdmr {
@@ -130,6 +132,39 @@ std::uint64_t textures_working_bytes(const std::vector<TextureRequest>& textures
   std::uint64_t sum = 0;
   for (std::size_t i = 0; i < working.size() && i < kTexturesBuiltAtOnce; ++i) sum += working[i];
   return sum;
+}
+
+// The patterns asked for more than once while the weight maps, meshes and textures are built (PatternReuse): per
+// texture build group, the layer's heights once where a member is made from them (the group shares them) and each
+// member's own procedural source; a terrain blend's weight heights; a grid's height map. A pattern larger than
+// kMaxReusedPatternSide is never kept. Textures a previous frame still holds are counted too: an upper bound.
+void find_reused_patterns(FramePlan& plan) {
+  std::map<std::string, std::pair<int, int>> uses;  // key -> (how many times, side)
+  const auto use = [&](const TextureDesc& t) {
+    if (t.source != TextureSource::Procedural || t.procedural.size > kMaxReusedPatternSide) return;
+    auto& [count, side] = uses[procedural_key(t.procedural)];
+    ++count, side = t.procedural.size;
+  };
+  for (const std::vector<std::size_t>& group : texture_build_groups(plan.textures)) {
+    bool from_height = false;
+    for (std::size_t i : group) {
+      const TextureRequest& r = plan.textures[i];
+      if (r.purpose == TexturePurpose::Height || r.desc.source == TextureSource::FromHeight)
+        from_height = true;
+      else
+        use(r.desc);
+    }
+    if (from_height) use(plan.textures[group.front()].layer.height);
+  }
+  for (const MaterialPlan& m : plan.materials)
+    if (m.blend && m.desc.blend.weights.source == WeightSource::Terrain) use(m.desc.blend.weights.height);
+  for (const ObjectDesc& object : plan.scene.objects)
+    if (object.mesh.kind == MeshKind::Grid) use(object.mesh.height_map);
+  for (const auto& [key, count_side] : uses)
+    if (count_side.first > 1) {
+      plan.reused_patterns.push_back(key);
+      plan.reused_pattern_bytes += reused_pattern_bytes(count_side.second);
+    }
 }
 
 int mip_levels(int w, int h) {
@@ -696,7 +731,8 @@ FramePlan plan_frame(const SceneDesc& scene, const PlanOptions& options) {
 
   for (const MeshPlan& m : plan.meshes) plan.mesh_bytes += m.bytes;
   for (const TextureRequest& t : plan.textures) plan.texture_bytes += t.bytes;
-  plan.texture_working_bytes = textures_working_bytes(plan.textures);
+  find_reused_patterns(plan);
+  plan.texture_working_bytes = textures_working_bytes(plan.textures) + plan.reused_pattern_bytes;
   plan.working_bytes = plan.texture_working_bytes;
   for (const DerivedPlan& d : plan.derived) {
     plan.derived_bytes += d.bytes;
@@ -903,7 +939,8 @@ nlohmann::json FramePlan::to_json() const {
                           {"quadtree", quadtree_storage_name(c.quadtree)}, {"region", c.region}, {"warp", c.warp}};
   j["memory"] = {{"framebuffer_bytes", framebuffer_bytes}, {"texture_bytes", texture_bytes}, {"mesh_bytes", mesh_bytes},
                  {"derived_bytes", derived_bytes},
-                 {"texture_working_bytes", texture_working_bytes}, {"working_bytes", working_bytes},
+                 {"texture_working_bytes", texture_working_bytes}, {"reused_pattern_bytes", reused_pattern_bytes},
+                 {"working_bytes", working_bytes},
                  {"image_module_bytes", image_module_bytes}, {"total_bytes", total_bytes()}};
   return j;
 }

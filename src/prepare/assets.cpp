@@ -161,7 +161,7 @@ public:
     const std::vector<std::string> items = plan_.items();
     items_ = items.size();
     {
-      const PatternReuse reuse;  // while patterns are made: the derived items after them hold the memory
+      const PatternReuse reuse(plan_.reused_patterns);  // until the textures are built (the plan counts it there)
       weight_maps();
       // A mesh is built on one thread (the grid, its heights, its tangents): beside the textures, whose builds
       // take the other threads, instead of before them with the others idle.

@@ -437,15 +437,12 @@ void WaveRows::row(int y, float* out, AddWave add) const {
 
 namespace {
 
-// The patterns kept while a PatternReuse lives, with their cells (channel 0 alone is the pattern without them:
-// fill() writes the same heights either way).
+// The patterns kept while a PatternReuse names them, with their cells (channel 0 alone is the pattern without
+// them: fill() writes the same heights either way).
 struct KeptPatterns {
-  static constexpr std::size_t kMaxPatternBytes = std::size_t(8) << 20;  // 1024 x 1024 with cells
-  static constexpr std::size_t kMaxBytes = std::size_t(32) << 20;
   std::mutex mutex;
-  int scopes = 0;
+  std::map<std::string, int> wanted;  // key -> how many live scopes name it
   std::map<std::string, std::shared_ptr<const Image>> patterns;
-  std::size_t bytes = 0;
 };
 
 KeptPatterns& kept_patterns() {
@@ -481,22 +478,21 @@ Image evaluate_pattern(const ProceduralDesc& d, bool with_cells) {
 Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
   validate(d);
   KeptPatterns& kept = kept_patterns();
-  const std::size_t bytes = std::size_t(d.size) * std::size_t(d.size) * 2 * sizeof(float);
   std::string key;
   std::shared_ptr<const Image> pattern;
   {
     std::lock_guard lock(kept.mutex);
-    if (kept.scopes > 0 && bytes <= KeptPatterns::kMaxPatternBytes) {
+    if (!kept.wanted.empty() && d.size <= kMaxReusedPatternSide) {
       key = procedural_key(d);
-      if (auto it = kept.patterns.find(key); it != kept.patterns.end()) pattern = it->second;
+      if (!kept.wanted.count(key)) key.clear();
+      else if (auto it = kept.patterns.find(key); it != kept.patterns.end()) pattern = it->second;
     }
   }
   if (key.empty()) return evaluate_pattern(d, with_cells);
   if (!pattern) {  // made here (two threads asking at once may both make it: the same bits)
     pattern = std::make_shared<const Image>(evaluate_pattern(d, true));
     std::lock_guard lock(kept.mutex);
-    if (kept.scopes > 0 && kept.bytes + bytes <= KeptPatterns::kMaxBytes && kept.patterns.emplace(key, pattern).second)
-      kept.bytes += bytes;
+    if (kept.wanted.count(key)) kept.patterns.emplace(key, pattern);
   }
   return with_or_without_cells(*pattern, with_cells);
 }
@@ -505,16 +501,20 @@ Image generate_pattern(const ProceduralDesc& d, bool with_cells) {
 
 Image generate_procedural(const ProceduralDesc& desc) { return texture_detail::generate_pattern(desc, false); }
 
-PatternReuse::PatternReuse() {
+PatternReuse::PatternReuse(std::vector<std::string> keys) : keys_(std::move(keys)) {
   auto& kept = texture_detail::kept_patterns();
   std::lock_guard lock(kept.mutex);
-  ++kept.scopes;
+  for (const std::string& key : keys_) ++kept.wanted[key];
 }
 
 PatternReuse::~PatternReuse() {
   auto& kept = texture_detail::kept_patterns();
   std::lock_guard lock(kept.mutex);
-  if (--kept.scopes == 0) kept.patterns.clear(), kept.bytes = 0;
+  for (const std::string& key : keys_)
+    if (auto it = kept.wanted.find(key); it != kept.wanted.end() && --it->second == 0) {
+      kept.wanted.erase(it);
+      kept.patterns.erase(key);
+    }
 }
 
 }  // namespace qdmr

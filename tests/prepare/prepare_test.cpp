@@ -11,6 +11,7 @@
 #include "prepare/assets.hpp"
 #include "qdmr/load/load.hpp"
 #include "qdmr/plan/plan.hpp"
+#include "texture/pattern_reuse.hpp"
 
 namespace qdmr::test {
 namespace {
@@ -85,6 +86,27 @@ TEST_P(PreparePlan, BuildsExactlyWhatThePlanLists) {
 }
 
 INSTANTIATE_TEST_SUITE_P(, PreparePlan, testing::ValuesIn(shipped_scenes()), scene_name);
+
+TEST(PrepareReuse, ThePlanNamesThePatternsAskedForTwiceAndCountsThem) {
+  // The terrain: each of the four layers' albedos is coloured by the pattern its heights are made of, and the blend
+  // weights' terrain heights are the mesh's height map; the weights' own noise is asked for once.
+  const FramePlan terrain = plan_frame(load_shipped(ShippedScene{"terrain", false}));
+  EXPECT_EQ(terrain.reused_patterns.size(), 5u);
+  EXPECT_EQ(terrain.reused_pattern_bytes, 5 * reused_pattern_bytes(512));
+  const std::set<std::string> keys(terrain.reused_patterns.begin(), terrain.reused_patterns.end());
+  EXPECT_TRUE(keys.count(procedural_key(terrain.scene.objects.at(0).mesh.height_map.procedural)));
+  // Counted with the textures' working memory (held until they are built).
+  EXPECT_GE(terrain.texture_working_bytes, terrain.reused_pattern_bytes);
+  // A pattern larger than kMaxReusedPatternSide is never kept, so never counted; nor is a spec asked for once.
+  const FramePlan big = plan_frame(load_shipped(
+      ShippedScene{"terrain", false}, {{"/objects/0/mesh/height_map/size", "2048"},
+                                       {"/materials/ground/blend/weights/height/size", "2048"}}));
+  EXPECT_EQ(big.reused_patterns.size(), 4u);
+  const FramePlan apart =
+      plan_frame(load_shipped(ShippedScene{"terrain", false}, {{"/objects/0/mesh/height_map/seed", "12"}}));
+  EXPECT_EQ(apart.reused_patterns.size(), 4u);
+  EXPECT_EQ(apart.reused_pattern_bytes, 4 * reused_pattern_bytes(512));
+}
 
 TEST(PrepareReuse, ObjMaterialsAreKnownAfterLoad) {
   const SceneDesc scene = load_shipped({"objects", false});

@@ -147,8 +147,9 @@ TEST(TextureProcedural, NoiseKeepsTheBitsOfItsPerTexelDefinition) {
 }
 
 TEST(TextureProcedural, ReusedPatternsHaveTheBitsOfAFreshEvaluation) {
-  // Outside a PatternReuse every call evaluates; inside, the second call of a spec copies the first, whichever of
-  // the two (heights alone or with cells) came first, and another seed or size is another pattern.
+  // Outside a PatternReuse every call evaluates; inside, the second call of a spec it names copies the first,
+  // whichever of the two (heights alone or with cells) came first; another seed (named too) or size (not named) is
+  // another pattern.
   std::vector<ProceduralDesc> descs;
   for (ProceduralPattern p : kAll) descs.push_back(desc(p, 32));
   ProceduralDesc waves = desc(ProceduralPattern::Waves, 32);
@@ -164,7 +165,7 @@ TEST(TextureProcedural, ReusedPatternsHaveTheBitsOfAFreshEvaluation) {
     const Image seed_heights = texture_detail::generate_pattern(other_seed, false);
     const Image size_heights = texture_detail::generate_pattern(other_size, false);
     for (bool cells_first : {false, true}) {
-      const PatternReuse reuse;
+      const PatternReuse reuse({procedural_key(d), procedural_key(other_seed)});
       const Image first = texture_detail::generate_pattern(d, cells_first);
       const Image again = texture_detail::generate_pattern(d, !cells_first);
       EXPECT_EQ((cells_first ? first : again).texels, cells.texels) << int(d.pattern);

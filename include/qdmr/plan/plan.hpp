@@ -151,7 +151,13 @@ struct FramePlan {
   std::vector<MeshPlan> meshes;          // one per scene object
   std::vector<Aov> aovs;
   std::uint64_t framebuffer_bytes = 0, texture_bytes = 0, mesh_bytes = 0, derived_bytes = 0;
-  // The working memory of the kTexturesBuiltAtOnce texture build groups whose builds need the most.
+  // The procedural patterns (procedural_key) the weight maps, meshes and textures ask for more than once: prepare
+  // keeps each the first time it is made (texture/pattern_reuse.hpp) until the textures are built, holding
+  // reused_pattern_bytes.
+  std::vector<std::string> reused_patterns;
+  std::uint64_t reused_pattern_bytes = 0;
+  // The working memory of the kTexturesBuiltAtOnce texture build groups whose builds need the most, and the
+  // reused patterns.
   std::uint64_t texture_working_bytes = 0;
   // The most working memory held at once: texture_working_bytes, or the largest DerivedPlan::working_bytes
   // (derived data is built one item at a time, after the textures). Counted on top of everything kept.
