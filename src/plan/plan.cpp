@@ -163,7 +163,7 @@ void find_reused_patterns(FramePlan& plan) {
   for (const auto& [key, count_side] : uses)
     if (count_side.first > 1) {
       plan.reused_patterns.push_back(key);
-      plan.reused_pattern_bytes += reused_pattern_bytes(count_side.second);
+      plan.reused_pattern_bytes += kept_pattern_bytes(count_side.second);
     }
 }
 

@@ -14,7 +14,7 @@ namespace qdmr {
 inline constexpr int kMaxReusedPatternSide = 1024;
 
 // What a kept pattern of size x size texels holds: heights and cells in floats.
-constexpr std::uint64_t reused_pattern_bytes(int size) { return std::uint64_t(size) * std::uint64_t(size) * 2 * 4; }
+constexpr std::uint64_t kept_pattern_bytes(int size) { return std::uint64_t(size) * std::uint64_t(size) * 2 * 4; }
 
 class PatternReuse {
  public:

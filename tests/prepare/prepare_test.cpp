@@ -92,7 +92,7 @@ TEST(PrepareReuse, ThePlanNamesThePatternsAskedForTwiceAndCountsThem) {
   // weights' terrain heights are the mesh's height map; the weights' own noise is asked for once.
   const FramePlan terrain = plan_frame(load_shipped(ShippedScene{"terrain", false}));
   EXPECT_EQ(terrain.reused_patterns.size(), 5u);
-  EXPECT_EQ(terrain.reused_pattern_bytes, 5 * reused_pattern_bytes(512));
+  EXPECT_EQ(terrain.reused_pattern_bytes, 5 * kept_pattern_bytes(512));
   const std::set<std::string> keys(terrain.reused_patterns.begin(), terrain.reused_patterns.end());
   EXPECT_TRUE(keys.count(procedural_key(terrain.scene.objects.at(0).mesh.height_map.procedural)));
   // Counted with the textures' working memory (held until they are built).
@@ -105,7 +105,7 @@ TEST(PrepareReuse, ThePlanNamesThePatternsAskedForTwiceAndCountsThem) {
   const FramePlan apart =
       plan_frame(load_shipped(ShippedScene{"terrain", false}, {{"/objects/0/mesh/height_map/seed", "12"}}));
   EXPECT_EQ(apart.reused_patterns.size(), 4u);
-  EXPECT_EQ(apart.reused_pattern_bytes, 4 * reused_pattern_bytes(512));
+  EXPECT_EQ(apart.reused_pattern_bytes, 4 * kept_pattern_bytes(512));
 }
 
 TEST(PrepareReuse, ObjMaterialsAreKnownAfterLoad) {
