@@ -126,14 +126,13 @@ void reduce_box(const Texture& t, int level, const C& codec, std::uint8_t* out_b
   const TextureLevel& in = t.levels[std::size_t(level)];
   const TextureLevel& out = t.levels[std::size_t(level) + 1];
   const std::uint8_t* in_base = t.storage.data() + in.offset;
-  const int in_width = in.width, in_height = in.height, out_width = out.width, out_height = out.height;
   // A texel costs about 8x more here than in a Max build: weight the row size accordingly.
-  for_rows(out_height, std::size_t(out_width) * texel_bytes * 8, [&](int y0, int y1) {
+  for_rows(out.height, std::size_t(out.width) * texel_bytes * 8, [&](int y0, int y1) {
     // Locals: a byte store may alias anything in memory, so members and captures would be read again per texel.
     const C local_codec = codec;
     const std::uint8_t* const in_texels = in_base;
     std::uint8_t* const out_texels = out_base;
-    const int iw = in_width, ih = in_height, ow = out_width, oh = out_height;
+    const int iw = in.width, ih = in.height, ow = out.width, oh = out.height;
     for (int y = y0; y < y1; ++y) {
       const Taps ty = taps(y, ih, oh);
       for (int x = 0; x < ow; ++x) {
